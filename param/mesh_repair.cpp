@@ -1,0 +1,169 @@
+// The only translation unit of geomip::param that includes CGAL's Polygon Mesh Processing (compile time).
+#include "param/mesh_repair.h"
+
+#include "param/errors.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <map>
+#include <set>
+#include <unordered_map>
+
+namespace geomip {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using SurfaceMesh = CGAL::Surface_mesh<Point>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+void report(const RepairOptions& o, const char* stage, double f) {
+  if (o.progress) o.progress(stage, f);
+}
+
+struct PositionHash {
+  std::size_t operator()(const Eigen::Vector3d& p) const {
+    std::size_t h = std::hash<double>()(p.x());
+    h ^= std::hash<double>()(p.y()) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    h ^= std::hash<double>()(p.z()) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    return h;
+  }
+};
+struct PositionEqual {
+  bool operator()(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const { return a == b; }
+};
+
+}  // namespace
+
+RepairResult repair_mesh(const TriMesh& input, const RepairOptions& options) {
+  if (input.triangles.empty()) throw InvalidInput("repair_mesh: the mesh has no triangles");
+  const std::size_t nv = input.positions.size();
+  RepairResult result;
+
+  // 1. Referenced vertices, duplicates merged, original order kept.
+  report(options, "cleaning", 0.0);
+  std::vector<char> referenced(nv, 0);
+  for (const auto& t : input.triangles) {
+    for (int v : t) {
+      if (v < 0 || static_cast<std::size_t>(v) >= nv) throw InvalidInput("repair_mesh: vertex index out of range");
+      referenced[v] = 1;
+    }
+  }
+  std::vector<int> remap(nv, -1);
+  std::vector<Point> points;
+  std::unordered_map<Eigen::Vector3d, int, PositionHash, PositionEqual> first_at;
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!referenced[v]) {
+      ++result.removed_unreferenced_vertices;
+      continue;
+    }
+    const Eigen::Vector3d& p = input.positions[v];
+    if (!p.allFinite()) throw InvalidInput("repair_mesh: vertex " + std::to_string(v) + " is not finite");
+    auto [it, inserted] = first_at.emplace(p, static_cast<int>(points.size()));
+    if (inserted) {
+      points.emplace_back(p.x(), p.y(), p.z());
+    } else {
+      ++result.merged_duplicate_vertices;
+    }
+    remap[v] = it->second;
+  }
+
+  // 2. Faces with a repeated vertex and duplicate faces (either orientation).
+  std::vector<std::array<std::size_t, 3>> polygons;
+  polygons.reserve(input.triangles.size());
+  std::set<std::array<int, 3>> seen;
+  for (const auto& t : input.triangles) {
+    const std::array<int, 3> r{remap[t[0]], remap[t[1]], remap[t[2]]};
+    if (r[0] == r[1] || r[1] == r[2] || r[0] == r[2]) {
+      ++result.removed_degenerate_faces;
+      continue;
+    }
+    std::array<int, 3> key = r;
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) {
+      ++result.removed_degenerate_faces;
+      continue;
+    }
+    polygons.push_back({std::size_t(r[0]), std::size_t(r[1]), std::size_t(r[2])});
+  }
+  if (polygons.empty()) throw InvalidInput("repair_mesh: every face is degenerate");
+
+  // 3. Non-manifold vertices and edges: orient_polygon_soup duplicates the points it must split (appended).
+  report(options, "splitting non-manifold vertices", 0.2);
+  const std::size_t points_before = points.size();
+  PMP::orient_polygon_soup(points, polygons);
+  result.split_non_manifold_vertices = points.size() - points_before;
+
+  SurfaceMesh sm;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
+  if (!CGAL::is_triangle_mesh(sm) || !sm.is_valid(false)) {
+    throw SolverFailure("repair_mesh: the oriented polygon soup did not form a valid surface mesh");
+  }
+
+  // Zero-area faces: collapse them away (only if there are any; the collapse can remove vertices).
+  const std::size_t faces_before = sm.number_of_faces();
+  bool has_degenerate = false;
+  for (auto f : sm.faces()) {
+    if (PMP::is_degenerate_triangle_face(f, sm)) {
+      has_degenerate = true;
+      break;
+    }
+  }
+  if (has_degenerate) {
+    PMP::remove_degenerate_faces(sm);
+    result.removed_degenerate_faces += faces_before - sm.number_of_faces();
+  }
+
+  // 4. Holes.
+  if (options.fill_holes) {
+    std::vector<SurfaceMesh::Halfedge_index> holes;
+    PMP::extract_boundary_cycles(sm, std::back_inserter(holes));
+    for (std::size_t i = 0; i < holes.size(); ++i) {
+      report(options, "filling holes", 0.3 + 0.6 * double(i) / double(holes.size()));
+      std::vector<SurfaceMesh::Face_index> new_faces;
+      std::vector<SurfaceMesh::Vertex_index> new_vertices;
+      const auto filled = PMP::triangulate_refine_and_fair_hole(
+          sm, holes[i], std::back_inserter(new_faces), std::back_inserter(new_vertices),
+          CGAL::parameters::density_control_factor(options.hole_density)
+              .fairing_continuity(options.fairing_continuity));
+      ++result.filled_holes;
+      if (!std::get<0>(filled)) ++result.unfaired_holes;
+      result.added_vertices += new_vertices.size();
+    }
+  }
+
+  // 5. Outward orientation of a closed result.
+  if (CGAL::is_closed(sm) && !PMP::is_outward_oriented(sm)) {
+    PMP::reverse_face_orientations(sm);
+    result.reoriented = true;
+  }
+
+  // Export in vertex index order (removed vertices skipped, so surviving originals keep their order).
+  report(options, "exporting", 0.95);
+  std::vector<int> index(sm.num_vertices(), -1);
+  TriMesh& out = result.mesh;
+  out.positions.reserve(sm.number_of_vertices());
+  for (auto v : sm.vertices()) {
+    index[v.idx()] = static_cast<int>(out.positions.size());
+    const Point& p = sm.point(v);
+    out.positions.emplace_back(p.x(), p.y(), p.z());
+  }
+  out.triangles.reserve(sm.number_of_faces());
+  for (auto f : sm.faces()) {
+    std::array<int, 3> t{};
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) t[k++] = index[v.idx()];
+    out.triangles.push_back(t);
+  }
+  report(options, "done", 1.0);
+  return result;
+}
+
+}  // namespace geomip

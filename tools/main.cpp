@@ -1,0 +1,59 @@
+// geomip: consistent geometry images from triangle meshes. This file maps every failure to one line on
+// stderr and an exit code: 2 for bad input or usage, 1 for geomip's own failures.
+#include "param/errors.h"
+#include "tools/commands.h"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <new>
+#include <vector>
+
+int main(int argc, char** argv) {
+  using namespace geomip::tools;
+  CLI::App app{"geomip — consistent geometry images from triangle meshes, streamed.\n"
+               "Exit codes: 0 ok, 1 internal failure, 2 bad input or usage.",
+               "geomip"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "geomip 0.1.0");
+
+  struct Entry {
+    CLI::App* cmd;
+    CommandRunner run;
+  };
+  std::vector<Entry> commands;
+  auto add = [&](CommandRunner run) { commands.push_back({app.get_subcommands({}).back(), std::move(run)}); };
+  add(add_info_command(app));
+  add(add_repair_command(app));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitBadInput;
+  }
+
+  for (const auto& c : commands) {
+    if (!c.cmd->parsed()) continue;
+    const std::string name = "geomip " + c.cmd->get_name();
+    try {
+      return c.run();
+    } catch (const geomip::InvalidInput& e) {
+      std::cerr << name << ": " << e.what() << "\n";
+      return kExitBadInput;
+    } catch (const geomip::IoError& e) {
+      std::cerr << name << ": " << e.what() << "\n";
+      return kExitFailure;
+    } catch (const geomip::SolverFailure& e) {
+      std::cerr << name << ": internal failure: " << e.what() << "\n";
+      return kExitFailure;
+    } catch (const std::bad_alloc&) {
+      std::cerr << name << ": out of memory\n";
+      return kExitFailure;
+    } catch (const std::exception& e) {
+      std::cerr << name << ": unexpected error: " << e.what() << "\n";
+      return kExitFailure;
+    }
+  }
+  return kExitBadInput;
+}

@@ -1,0 +1,18 @@
+// Conversions of library results to the JSON and text that commands print.
+#pragma once
+
+#include "param/mesh_topology.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace geomip::tools {
+
+/// The keys of `geomip info --json` (genus is null when undefined).
+nlohmann::json topology_to_json(const TopologyReport& report);
+
+/// Human-readable multi-line form of the same report.
+std::string topology_to_text(const TopologyReport& report);
+
+}  // namespace geomip::tools

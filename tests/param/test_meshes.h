@@ -1,0 +1,33 @@
+// Small synthetic meshes for property tests, and access to ../shared/meshes.
+#pragma once
+
+#include "param/mesh.h"
+
+#include <string>
+
+namespace geomip::test {
+
+/// Regular tetrahedron, outward oriented: closed, genus 0.
+TriMesh tetrahedron();
+/// Axis-aligned cube of 12 triangles, outward oriented.
+TriMesh cube();
+/// Torus sampled on an n×m grid (radii R=1, r=0.3): closed, genus 1, 2·n·m triangles.
+TriMesh torus(int n, int m);
+/// Open cylinder (two boundary loops), n around × m along, radius 1, height 2.
+TriMesh open_cylinder(int n, int m);
+/// Flat (n+1)×(n+1) grid on the unit square in z = 0: a disk with one boundary loop.
+TriMesh grid(int n);
+/// Concatenation of two meshes (indices of `b` shifted).
+TriMesh join(const TriMesh& a, const TriMesh& b);
+
+/// Absolute path of a mesh in ../shared/meshes (empty when that folder is absent).
+std::string shared_mesh(const std::string& name);
+/// A fresh empty directory under the system temp dir, for test outputs.
+std::string temp_dir(const std::string& tag);
+
+}  // namespace geomip::test
+
+/// Skips the current test when ../shared/meshes is not beside the checkout.
+#define GEOMIP_REQUIRE_SHARED_MESH(var, name)                                  \
+  const std::string var = ::geomip::test::shared_mesh(name);                  \
+  if (var.empty()) GTEST_SKIP() << "../shared/meshes/" << name << " not found"

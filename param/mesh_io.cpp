@@ -240,55 +240,82 @@ int ply_type_size(const std::string& t) {
   return 0;
 }
 
-bool parse_ply_header(std::istream& in, PlyHeader& h) {
+// Strict header check: OpenMesh's PLY reader crashes on some malformed headers (a property before any
+// element, for one), so anything but the grammar below is rejected here with `problem` set.
+bool parse_ply_header(std::istream& in, PlyHeader& h, std::string& problem) {
   std::string line;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return false;
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) {
+    problem = "not a PLY file (no 'ply' magic)";
+    return false;
+  }
   std::string element;
+  bool has_format = false;
+  auto bad = [&](const std::string& what) {
+    problem = "malformed PLY header: " + what;
+    return false;
+  };
   while (std::getline(in, line)) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream ls(line);
     std::string word;
     ls >> word;
     if (word == "format") {
-      std::string fmt;
-      ls >> fmt;
-      h.binary = fmt.rfind("binary", 0) == 0;
+      std::string fmt, version;
+      ls >> fmt >> version;
+      if (fmt != "ascii" && fmt != "binary_little_endian" && fmt != "binary_big_endian") {
+        return bad("unknown format '" + fmt + "'");
+      }
+      if (version != "1.0") return bad("unknown version '" + version.substr(0, 16) + "' (PLY 1.0 expected)");
+      h.binary = fmt != "ascii";
       h.ascii = fmt == "ascii";
+      has_format = true;
     } else if (word == "element") {
-      std::uint64_t n = 0;
-      ls >> element >> n;
+      long long n = -1;
+      if (!(ls >> element >> n) || n < 0) return bad("bad element line '" + line + "'");
       h.elements.push_back(element);
-      if (element == "vertex") h.vertex_count = n;
-      if (element == "face") h.face_count = n;
+      if (element == "vertex") h.vertex_count = static_cast<std::uint64_t>(n);
+      if (element == "face") h.face_count = static_cast<std::uint64_t>(n);
     } else if (word == "property") {
-      std::string type;
+      if (element.empty()) return bad("property before any element");
+      std::string type, name;
       ls >> type;
-      if (element == "vertex") {
-        if (type == "list") {
-          h.vertex_fixed = false;
-        } else {
-          const int s = ply_type_size(type);
-          if (s == 0) h.vertex_fixed = false;
-          h.vertex_record_bytes += s;
-          std::string name;
-          ls >> name;
-          h.vertex_props.push_back(name);
+      if (type == "list") {
+        std::string count_type, index_type;
+        ls >> count_type >> index_type >> name;
+        if (ply_type_size(count_type) == 0 || ply_type_size(index_type) == 0 || name.empty()) {
+          return bad("bad list property '" + line + "'");
         }
-      } else if (element == "face") {
-        if (type == "list" && h.face_count_bytes == 0) {
-          std::string count_type, index_type;
-          ls >> count_type >> index_type;
+        if (element == "vertex") {
+          h.vertex_fixed = false;
+        } else if (element == "face" && h.face_count_bytes == 0) {
           h.face_count_bytes = ply_type_size(count_type);
           h.face_index_bytes = ply_type_size(index_type);
-        } else {
+        } else if (element == "face") {
+          h.face_simple = false;
+        }
+      } else {
+        ls >> name;
+        const int size = ply_type_size(type);
+        if (size == 0 || name.empty()) return bad("bad property '" + line + "'");
+        if (element == "vertex") {
+          h.vertex_record_bytes += size;
+          h.vertex_props.push_back(name);
+        } else if (element == "face") {
           h.face_simple = false;
         }
       }
+    } else if (word == "comment" || word == "obj_info" || word.empty()) {
+      continue;
     } else if (word == "end_header") {
+      if (!has_format) return bad("no format line");
+      if (h.elements.empty() || h.elements[0] != "vertex") return bad("the first element is not 'vertex'");
       h.header_bytes = static_cast<std::uint64_t>(in.tellg());
       return true;
+    } else {
+      return bad("unknown keyword '" + word.substr(0, 32) + "'");
     }
   }
+  problem = "malformed PLY header: no 'end_header'";
   return false;
 }
 
@@ -337,6 +364,22 @@ void validate_obj(const std::string& path) {
   std::vector<double> xyz;
   while (lines.next(line)) {
     const auto first = line.find_first_not_of(" \t");
+    const bool is_face = line.compare(first, 2, "f ") == 0 || line.compare(first, 2, "f\t") == 0;
+    if (is_face) {
+      // Every corner must start with a (possibly negative) index: OpenMesh asserts on "f /8 2 3".
+      std::istringstream corners(line.substr(first + 1));
+      std::string corner;
+      int count = 0;
+      while (corners >> corner) {
+        const std::size_t digit = corner[0] == '-' ? 1 : 0;
+        if (digit >= corner.size() || !std::isdigit(static_cast<unsigned char>(corner[digit]))) {
+          fail(path, at_line(lines.line_no()) + "malformed face corner '" + corner.substr(0, 16) + "'");
+        }
+        ++count;
+      }
+      if (count < 3) fail(path, at_line(lines.line_no()) + "face with fewer than 3 corners");
+      continue;
+    }
     if (line.compare(first, 2, "v ") != 0 && line.compare(first, 2, "v\t") != 0) continue;
     if (!parse_numbers(line.c_str() + first + 1, 3, xyz)) fail(path, at_line(lines.line_no()) + "malformed vertex");
     for (double v : xyz) {
@@ -405,7 +448,8 @@ void validate_off(const std::string& path) {
 void validate_ply(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   PlyHeader h;
-  if (!parse_ply_header(in, h)) fail(path, "not a PLY file (no 'ply' magic or no 'end_header')");
+  std::string problem;
+  if (!parse_ply_header(in, h, problem)) fail(path, problem);
   const std::uint64_t size = std::filesystem::file_size(path);
   if (h.binary && h.vertex_fixed) {
     const std::uint64_t need_vertices = h.header_bytes + h.vertex_count * h.vertex_record_bytes;
@@ -458,6 +502,27 @@ void validate_ply(const std::string& path) {
   }
 }
 
+// Binary STL: 80-byte header, uint32 facet count, 50 bytes per facet. OpenMesh's stream reader cannot tell
+// binary from ascii by itself, so the size decides (an ascii file matching it by chance is vanishingly rare).
+bool is_binary_stl(const std::string& path) {
+  const std::uint64_t size = std::filesystem::file_size(path);
+  if (size < 84) return false;
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(80);
+  unsigned char c[4] = {0, 0, 0, 0};
+  in.read(reinterpret_cast<char*>(c), 4);
+  const std::uint64_t facets = c[0] | (c[1] << 8) | (c[2] << 16) | (std::uint64_t(c[3]) << 24);
+  if (size == 84 + 50 * facets) return true;
+  std::string head(5, '\0');
+  in.seekg(0);
+  in.read(head.data(), 5);
+  if (head != "solid") {
+    fail(path, "neither ascii STL (no 'solid') nor binary STL (" + std::to_string(facets) + " facets need " +
+                   std::to_string(84 + 50 * facets) + " bytes, the file has " + std::to_string(size) + ")");
+  }
+  return false;
+}
+
 }  // namespace
 
 MeshFormat mesh_format_from_path(const std::string& path) {
@@ -484,11 +549,12 @@ TriMesh read_mesh(const std::string& path, const ReadMeshOptions& options) {
     case MeshFormat::kObj: validate_obj(path); break;
     case MeshFormat::kOff: validate_off(path); break;
     case MeshFormat::kPly: validate_ply(path); break;
-    case MeshFormat::kStl: break;  // binary STL size and ascii STL parsing are robust in OpenMesh
+    case MeshFormat::kStl: break;  // the facet count is checked against the size below
   }
 
   RecordingImporter importer;
   OpenMesh::IO::Options io_options;
+  if (format == MeshFormat::kStl && is_binary_stl(path)) io_options += OpenMesh::IO::Options::Binary;
   bool ok = false;
   try {
     std::ifstream in(path, std::ios::binary);

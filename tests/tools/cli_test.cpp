@@ -1,0 +1,158 @@
+// End-to-end tests of the geomip program: exit codes, one-line errors, JSON keys, atomic outputs.
+#include "tests/param/test_meshes.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace geomip {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int exit_code = -1;
+  bool crashed = false;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  std::string dir_ = test::temp_dir("cli");
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Outcome geomip(const std::string& args) {
+    const std::string cmd = std::string("timeout 300 '") + GEOMIP_BINARY + "' " + args + " > '" + dir_ +
+                            "/stdout' 2> '" + dir_ + "/stderr' < /dev/null";
+    const int status = std::system(cmd.c_str());
+    Outcome r;
+    r.crashed = !WIFEXITED(status) || WEXITSTATUS(status) >= 124;  // signal, or timeout's 124/137
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(fs::path(dir_) / "stdout");
+    r.err = slurp(fs::path(dir_) / "stderr");
+    return r;
+  }
+  std::string file(const std::string& name, const std::string& text) {
+    const std::string path = dir_ + "/" + name;
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  }
+  // Exit 2, exactly one line on stderr naming `path`.
+  void expect_bad_input(const std::string& args, const std::string& path) {
+    const Outcome r = geomip(args);
+    EXPECT_FALSE(r.crashed) << args;
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line expected:\n" << r.err;
+  }
+};
+
+TEST_F(Cli, HelpOnEveryCommand) {
+  for (const char* args : {"--help", "info --help", "repair --help"}) {
+    const Outcome r = geomip(args);
+    EXPECT_EQ(r.exit_code, 0) << args;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << args;
+  }
+  EXPECT_EQ(geomip("").exit_code, 2);             // no subcommand
+  EXPECT_EQ(geomip("frobnicate x").exit_code, 2);  // unknown subcommand
+  EXPECT_EQ(geomip("info").exit_code, 2);          // missing argument
+}
+
+TEST_F(Cli, InfoJsonHasTheDocumentedKeys) {
+  const std::string mesh = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
+  const Outcome r = geomip("info --json '" + mesh + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"vertices", "faces", "components", "boundary_loops", "genus", "manifold",
+                          "non_manifold_edges", "non_manifold_vertices", "degenerate_faces",
+                          "unreferenced_vertices", "bbox_diagonal"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["vertices"], 2930);
+  EXPECT_EQ(j["faces"], 5856);
+  EXPECT_EQ(j["genus"], 0);
+  EXPECT_EQ(j["manifold"], true);
+}
+
+TEST_F(Cli, BadInputsExitTwoWithOneLine) {
+  const std::string missing = dir_ + "/missing.obj";
+  expect_bad_input("info '" + missing + "'", missing);
+  const std::string empty = file("empty.obj", "");
+  expect_bad_input("info '" + empty + "'", empty);
+  std::string noise(4096, '\0');
+  for (std::size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<char>((i * 7919u) ^ (i >> 3));
+  for (const char* ext : {"obj", "ply", "off", "stl"}) {
+    const std::string garbage = file(std::string("garbage.") + ext, noise);
+    expect_bad_input("info '" + garbage + "'", garbage);
+  }
+  const std::string nan = file("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
+  expect_bad_input("info '" + nan + "'", nan);
+  const std::string oob = file("oob.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+  expect_bad_input("info '" + oob + "'", oob);
+  const std::string ply = file("short.ply",
+                               "ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty float x\n"
+                               "property float y\nproperty float z\nelement face 10\n"
+                               "property list uchar int vertex_indices\nend_header\n" +
+                                   std::string(50, '\1'));
+  expect_bad_input("info '" + ply + "'", ply);
+  expect_bad_input("repair '" + nan + "' -o '" + dir_ + "/out.obj'", nan);
+}
+
+TEST_F(Cli, RepairWritesAtomicallyAndNeverLeavesPartialFiles) {
+  const std::string out = dir_ + "/out.obj";
+  // Failing run: no output file, no temporary left behind.
+  const std::string nan = file("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
+  EXPECT_EQ(geomip("repair '" + nan + "' -o '" + out + "'").exit_code, 2);
+  EXPECT_FALSE(fs::exists(out));
+  // An existing output survives a failing run untouched.
+  file("out.obj", "precious");
+  EXPECT_EQ(geomip("repair '" + nan + "' -o '" + out + "'").exit_code, 2);
+  EXPECT_EQ(slurp(out), "precious");
+  // Output into a missing directory: a clear error, nothing written.
+  const Outcome bad_dir = geomip("repair '" + std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj' -o '" + dir_ +
+                             "/no/such/dir/x.obj'");
+  EXPECT_NE(bad_dir.exit_code, 0);
+  EXPECT_NE(bad_dir.err.find("does not exist"), std::string::npos) << bad_dir.err;
+  // Unsupported output format is rejected before any work.
+  EXPECT_EQ(geomip("repair '" + nan + "' -o '" + dir_ + "/x.stl'").exit_code, 2);
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+  }
+}
+
+TEST_F(Cli, RepairCowThenInfoSaysManifold) {
+  GEOMIP_REQUIRE_SHARED_MESH(cow, "cow.obj");
+  const std::string out = dir_ + "/cow.ply";
+  const Outcome r = geomip("repair --json '" + cow + "' -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["split_non_manifold_vertices"], 1);
+  const Outcome info = geomip("info --json '" + out + "'");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const auto j = nlohmann::json::parse(info.out);
+  EXPECT_EQ(j["manifold"], true);
+  EXPECT_EQ(j["genus"], 0);
+}
+
+TEST_F(Cli, RepairBunnyThenInfoSaysClosedGenusZero) {
+  GEOMIP_REQUIRE_SHARED_MESH(bunny, "bunny.obj");
+  const std::string out = dir_ + "/bunny.obj";
+  const Outcome r = geomip("repair --quiet '" + bunny + "' -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());  // --quiet
+  const auto j = nlohmann::json::parse(geomip("info --json '" + out + "'").out);
+  EXPECT_EQ(j["boundary_loops"], 0);
+  EXPECT_EQ(j["genus"], 0);
+  EXPECT_EQ(j["manifold"], true);
+}
+
+}  // namespace
+}  // namespace geomip

@@ -348,7 +348,9 @@ bool parse_numbers(const char* p, int count, std::vector<double>& out) {
   for (int i = 0; i < count; ++i) {
     char* end = nullptr;
     const double v = std::strtod(p, &end);
-    if (end == p) return false;
+    // A number must end at whitespace or the end of the line: "0.1S63" is garbage, not 0.1 (OpenMesh's
+    // stream-based ascii readers can loop forever on it).
+    if (end == p || (*end != '\0' && !std::isspace(static_cast<unsigned char>(*end)))) return false;
     out.push_back(v);
     p = end;
   }
@@ -356,6 +358,21 @@ bool parse_numbers(const char* p, int count, std::vector<double>& out) {
 }
 
 std::string at_line(std::size_t n) { return "line " + std::to_string(n) + ": "; }
+
+// An OBJ face corner: v, v/vt, v//vn or v/vt/vn, each an optionally negative integer (v required).
+bool is_obj_corner(const std::string& corner) {
+  std::size_t i = 0;
+  for (int field = 0; field < 3; ++field) {
+    if (i < corner.size() && corner[i] == '-') ++i;
+    const std::size_t digits = i;
+    while (i < corner.size() && std::isdigit(static_cast<unsigned char>(corner[i]))) ++i;
+    if (field == 0 && i == digits) return false;  // the vertex index is required
+    if (i == corner.size()) return true;
+    if (corner[i] != '/') return false;
+    ++i;
+  }
+  return false;
+}
 
 void validate_obj(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -371,8 +388,7 @@ void validate_obj(const std::string& path) {
       std::string corner;
       int count = 0;
       while (corners >> corner) {
-        const std::size_t digit = corner[0] == '-' ? 1 : 0;
-        if (digit >= corner.size() || !std::isdigit(static_cast<unsigned char>(corner[digit]))) {
+        if (!is_obj_corner(corner)) {
           fail(path, at_line(lines.line_no()) + "malformed face corner '" + corner.substr(0, 16) + "'");
         }
         ++count;
@@ -432,11 +448,19 @@ void validate_off(const std::string& path) {
                      std::to_string(f));
     }
     std::istringstream face(line);
+    // Whole-token integers: "5S" must not pass as 5 (OpenMesh's OFF reader can loop forever on it).
+    auto next_integer = [&](long long& value) {
+      std::string token;
+      if (!(face >> token)) return false;
+      char* end = nullptr;
+      value = std::strtoll(token.c_str(), &end, 10);
+      return end != token.c_str() && *end == '\0';
+    };
     long long k = 0;
-    if (!(face >> k) || k < 3 || k > nv) fail(path, at_line(lines.line_no()) + "malformed face");
+    if (!next_integer(k) || k < 3 || k > nv) fail(path, at_line(lines.line_no()) + "malformed face");
     for (long long i = 0; i < k; ++i) {
       long long index = -1;
-      if (!(face >> index)) fail(path, at_line(lines.line_no()) + "malformed face");
+      if (!next_integer(index)) fail(path, at_line(lines.line_no()) + "malformed face");
       if (index < 0 || index >= nv) {
         fail(path, at_line(lines.line_no()) + "face " + std::to_string(f) + " references vertex " +
                        std::to_string(index) + ", but the file has " + std::to_string(nv) + " vertices");
@@ -497,6 +521,26 @@ void validate_ply(const std::string& path) {
       if (!lines.next(line)) {
         fail(path, "truncated PLY: the header promises " + std::to_string(h.face_count) +
                        " faces, the file ends after " + std::to_string(f));
+      }
+      if (!h.face_simple) continue;
+      // "k i1 ... ik" and nothing else, all integers.
+      std::istringstream face(line);
+      std::string token;
+      std::vector<long long> values;
+      while (face >> token) {
+        char* end = nullptr;
+        const long long value = std::strtoll(token.c_str(), &end, 10);
+        if (*end != '\0') fail(path, "malformed face " + std::to_string(f) + " in the ascii PLY data");
+        values.push_back(value);
+      }
+      if (values.empty() || values[0] < 3 || static_cast<long long>(values.size()) != values[0] + 1) {
+        fail(path, "malformed face " + std::to_string(f) + " in the ascii PLY data");
+      }
+      for (std::size_t k = 1; k < values.size(); ++k) {
+        if (values[k] < 0 || static_cast<std::uint64_t>(values[k]) >= h.vertex_count) {
+          fail(path, "face " + std::to_string(f) + " references vertex " + std::to_string(values[k]) +
+                         ", but the file has " + std::to_string(h.vertex_count) + " vertices");
+        }
       }
     }
   }

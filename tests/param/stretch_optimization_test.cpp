@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <random>
 
 namespace geomip {
@@ -313,6 +314,34 @@ TEST(OptimizeVertex, NeverFlipsAndNeverRaisesStretch) {
     EXPECT_NEAR(previous, expected, 1e-9 * expected) << "trial " << trial;
   }
   EXPECT_GT(moved, total / 10);  // the property is not vacuous: vertices do move
+}
+
+// Repeated calls converge to a local minimum of the (smooth) L2 ring energy: afterwards no small step in any
+// direction lowers local_stretch. This checks that the line searches minimize the true energy.
+TEST(OptimizeVertex, ConvergesToLocalMinimumOfL2Energy) {
+  std::mt19937 shapes(77);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<Eigen::Vector2d> uv;
+    const TriMesh m = random_star(shapes, uv, /*closed=*/true);
+    std::vector<int> ring(m.triangles.size());
+    for (std::size_t f = 0; f < ring.size(); ++f) ring[f] = static_cast<int>(f);
+    VertexOptimizationOptions options;
+    options.tolerance = 1e-6;
+    std::mt19937 rng(static_cast<unsigned>(trial));
+    double value = 0;
+    for (int call = 0; call < 60; ++call) value = optimize_vertex(0, ring, m.positions, m.triangles, uv, options, rng);
+    // Scale of the ring: the shortest uv distance from the center to a neighbour.
+    double scale = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 1; i < uv.size(); ++i) scale = std::min(scale, (uv[i] - uv[0]).norm());
+    const Eigen::Vector2d optimum = uv[0];
+    for (int k = 0; k < 16; ++k) {
+      const double h = 1e-3 * scale;
+      uv[0] = optimum + h * Eigen::Vector2d(std::cos(k * kPi / 8), std::sin(k * kPi / 8));
+      const double nearby = local_stretch(0, ring, m.positions, m.triangles, uv, options);
+      EXPECT_GE(nearby, value * (1 - 1e-7)) << "relative gap " << (value - nearby) / value << ", trial " << trial << " direction " << k;
+    }
+    uv[0] = optimum;
+  }
 }
 
 // One interior vertex of a flat grid displaced inside its ring returns to its isometric position.

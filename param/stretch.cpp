@@ -41,7 +41,8 @@ StretchValues triangle_stretch(const Eigen::Vector3d q[3], const Eigen::Vector2d
 }
 
 StretchValues mesh_stretch(const std::vector<Eigen::Vector3d>& positions,
-                           const std::vector<std::array<int, 3>>& triangles, const std::vector<Eigen::Vector2d>& uv) {
+                           const std::vector<std::array<int, 3>>& triangles,
+                           const std::vector<Eigen::Vector2d>& uv) {
   if (uv.size() != positions.size()) {
     throw InvalidInput("mesh_stretch: " + std::to_string(uv.size()) + " uv coordinates for " +
                        std::to_string(positions.size()) + " vertices");
@@ -71,7 +72,8 @@ StretchValues mesh_stretch(const std::vector<Eigen::Vector3d>& positions,
   return {std::sqrt(sum_l2sq_a3 / sum_a3) * normalization, max_linf * normalization};
 }
 
-std::size_t count_flipped(const std::vector<std::array<int, 3>>& triangles, const std::vector<Eigen::Vector2d>& uv) {
+std::size_t count_flipped(const std::vector<std::array<int, 3>>& triangles,
+                          const std::vector<Eigen::Vector2d>& uv) {
   check_triangles("count_flipped", triangles, uv.size());
   std::size_t flipped = 0;
   for (const auto& t : triangles) {

@@ -17,7 +17,9 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPi = 3.14159265358979323846;
 
-inline double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+inline double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 /// The 3D data of one triangle that stretch needs, independent of which corner moves: squared edge lengths
 /// opposite each corner and the 3D area. Γ²+γ² and Γγ depend on the 3D triangle only through these (the Gram
@@ -27,7 +29,8 @@ struct TriangleMetric {
   double area3;
 };
 
-TriangleMetric triangle_metric(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2) {
+TriangleMetric triangle_metric(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
+                               const Eigen::Vector3d& q2) {
   return {{(q2 - q1).squaredNorm(), (q2 - q0).squaredNorm(), (q1 - q0).squaredNorm()},
           0.5 * (q1 - q0).cross(q2 - q0).norm()};
 }
@@ -71,7 +74,8 @@ Weights ring_weights(const RingTriangle* ring, std::size_t n, double w) {
 }
 
 /// E(v) from per-triangle (Γ²+γ², 2·A2) values; adds one triangle to running sums.
-inline void accumulate(double trace, double twice_a2, double area3, const Weights& w, double& sum, double& max_sq) {
+inline void accumulate(double trace, double twice_a2, double area3, const Weights& w, double& sum,
+                       double& max_sq) {
   sum += area3 * trace;
   if (w.linf > 0) {
     const double det = 2 * area3 / twice_a2;  // Γγ = A3 / A2
@@ -124,7 +128,10 @@ std::pair<double, double> brent_minimize(const F& f, double a, double b, double 
       double q = (x - v) * (fx - fw);
       double p = (x - v) * q - (x - w) * r;
       q = 2 * (q - r);
-      if (q > 0) p = -p; else q = -q;
+      if (q > 0)
+        p = -p;
+      else
+        q = -q;
       const double e_prev = e;
       e = d;
       if (std::abs(p) < std::abs(0.5 * q * e_prev) && p > q * (a - x) && p < q * (b - x)) {
@@ -194,10 +201,11 @@ double optimize_point(Eigen::Vector2d& p, const RingTriangle* ring, std::size_t 
     if (!(lo < 0 && hi > 0)) continue;
 
     const auto f = [&](double t) { return line_energy(t, terms, n, weights); };
-    const auto [t, f_t] = brent_minimize(f, lo, hi, 0.0, f(0.0), options.tolerance * (hi - lo),
-                                         options.max_evaluations);
+    const auto [t, f_t] =
+        brent_minimize(f, lo, hi, 0.0, f(0.0), options.tolerance * (hi - lo), options.max_evaluations);
     if (!(f_t < energy) || t == 0) continue;
-    // Accept only what the direct formula confirms: positive areas (ring_energy is +inf otherwise) and a lower E.
+    // Accept only what the direct formula confirms: positive areas (ring_energy is +inf otherwise) and a
+    // lower E.
     const Eigen::Vector2d candidate = p + t * d;
     const double candidate_energy = ring_energy(candidate, ring, n, weights);
     if (candidate_energy < energy) {
@@ -209,8 +217,9 @@ double optimize_point(Eigen::Vector2d& p, const RingTriangle* ring, std::size_t 
 }
 
 void check_vertex_options(const char* function, const VertexOptimizationOptions& o) {
-  const bool ok = o.linf_weight >= 0 && o.linf_weight <= 1 && o.num_directions >= 1 && o.bracket_fraction > 0 &&
-                  o.bracket_fraction < 1 && o.max_step > 0 && o.tolerance > 0 && o.max_evaluations >= 1;
+  const bool ok = o.linf_weight >= 0 && o.linf_weight <= 1 && o.num_directions >= 1 &&
+                  o.bracket_fraction > 0 && o.bracket_fraction < 1 && o.max_step > 0 && o.tolerance > 0 &&
+                  o.max_evaluations >= 1;
   if (!ok) throw InvalidInput(std::string(function) + ": invalid VertexOptimizationOptions");
 }
 
@@ -258,7 +267,8 @@ double optimize_vertex(int v, const std::vector<int>& ring, const std::vector<Ei
                        const VertexOptimizationOptions& options, std::mt19937& rng) {
   check_vertex_options("optimize_vertex", options);
   const std::vector<RingTriangle> r = build_ring("optimize_vertex", v, ring, positions, triangles, uv);
-  if (!uv[v].allFinite()) throw InvalidInput("optimize_vertex: uv of vertex " + std::to_string(v) + " not finite");
+  if (!uv[v].allFinite())
+    throw InvalidInput("optimize_vertex: uv of vertex " + std::to_string(v) + " not finite");
   std::vector<LineTerm> terms(r.size());
   Eigen::Vector2d p = uv[v];
   const double energy = optimize_point(p, r.data(), r.size(), options, rng, terms.data());
@@ -271,7 +281,8 @@ double local_stretch(int v, const std::vector<int>& ring, const std::vector<Eige
                      const VertexOptimizationOptions& options) {
   check_vertex_options("local_stretch", options);
   const std::vector<RingTriangle> r = build_ring("local_stretch", v, ring, positions, triangles, uv);
-  return std::sqrt(ring_energy(uv[v], r.data(), r.size(), ring_weights(r.data(), r.size(), blend_weight(options))));
+  return std::sqrt(
+      ring_energy(uv[v], r.data(), r.size(), ring_weights(r.data(), r.size(), blend_weight(options))));
 }
 
 StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& positions,
@@ -286,7 +297,8 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
   if (!(options.threshold >= 0)) throw InvalidInput("optimize_stretch: threshold must be >= 0");
   check_vertex_options("optimize_stretch", options.vertex);
   for (std::size_t i = 0; i < uv.size(); ++i) {
-    if (!uv[i].allFinite()) throw InvalidInput("optimize_stretch: uv of vertex " + std::to_string(i) + " not finite");
+    if (!uv[i].allFinite())
+      throw InvalidInput("optimize_stretch: uv of vertex " + std::to_string(i) + " not finite");
   }
 
   StretchOptimizationResult result;
@@ -312,7 +324,8 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
   }
 
   std::size_t max_ring = 0;
-  for (std::size_t i = 0; i < nv; ++i) max_ring = std::max<std::size_t>(max_ring, offsets[i + 1] - offsets[i]);
+  for (std::size_t i = 0; i < nv; ++i)
+    max_ring = std::max<std::size_t>(max_ring, offsets[i + 1] - offsets[i]);
   std::vector<RingTriangle> ring(max_ring);
   std::vector<LineTerm> terms(max_ring);
   const double w = blend_weight(options.vertex);
@@ -325,7 +338,7 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
       const auto& t = triangles[f];
       const int corner = t[0] == v ? 0 : t[1] == v ? 1 : 2;
       const TriangleMetric& m = metrics[f];
-      ring[n++] = {uv[t[(corner + 1) % 3]], uv[t[(corner + 2) % 3]], m.opposite_sq[corner],
+      ring[n++] = {uv[t[(corner + 1) % 3]],         uv[t[(corner + 2) % 3]],         m.opposite_sq[corner],
                    m.opposite_sq[(corner + 1) % 3], m.opposite_sq[(corner + 2) % 3], m.area3};
     }
     return n;
@@ -381,7 +394,8 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
   return result;
 }
 
-std::vector<char> boundary_vertex_mask(std::size_t num_vertices, const std::vector<std::array<int, 3>>& triangles) {
+std::vector<char> boundary_vertex_mask(std::size_t num_vertices,
+                                       const std::vector<std::array<int, 3>>& triangles) {
   std::vector<std::pair<int, int>> edges;
   edges.reserve(3 * triangles.size());
   for (std::size_t f = 0; f < triangles.size(); ++f) {
@@ -390,7 +404,8 @@ std::vector<char> boundary_vertex_mask(std::size_t num_vertices, const std::vect
       const int a = t[i], b = t[(i + 1) % 3];
       if (a < 0 || b < 0 || static_cast<std::size_t>(a) >= num_vertices ||
           static_cast<std::size_t>(b) >= num_vertices) {
-        throw InvalidInput("boundary_vertex_mask: triangle " + std::to_string(f) + " has an index out of range");
+        throw InvalidInput("boundary_vertex_mask: triangle " + std::to_string(f) +
+                           " has an index out of range");
       }
       edges.emplace_back(std::min(a, b), std::max(a, b));
     }

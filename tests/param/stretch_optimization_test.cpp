@@ -1,9 +1,9 @@
-// Properties of the stretch optimization (paper §3.3.2, Sander et al. 2001): it recovers the isometry of a flat
-// grid from a distorted embedding, lowers stretch monotonically on curved surfaces, never flips a triangle and
-// never moves a locked vertex.
+// Properties of the stretch optimization (paper §3.3.2, Sander et al. 2001): it recovers the isometry of a
+// flat grid from a distorted embedding, lowers stretch monotonically on curved surfaces, never flips a
+// triangle and never moves a locked vertex.
+#include "param/stretch_optimization.h"
 #include "param/errors.h"
 #include "param/stretch.h"
-#include "param/stretch_optimization.h"
 #include "tests/param/test_meshes.h"
 
 #include <Eigen/Geometry>
@@ -39,7 +39,8 @@ std::vector<Eigen::Vector2d> pushed_to_corner(const std::vector<Eigen::Vector2d>
   return out;
 }
 
-/// The grid lifted onto a paraboloid cap z = a·((x−½)² + (y−½)²): curved, its xy projection is the unit square.
+/// The grid lifted onto a paraboloid cap z = a·((x−½)² + (y−½)²): curved, its xy projection is the unit
+/// square.
 TriMesh paraboloid(int n, double a) {
   TriMesh m = test::grid(n);
   for (auto& p : m.positions) p.z() = a * ((p.x() - 0.5) * (p.x() - 0.5) + (p.y() - 0.5) * (p.y() - 0.5));
@@ -70,8 +71,8 @@ TEST(BoundaryVertexMask, GridHasItsSquareBoundary) {
   EXPECT_TRUE(std::all_of(closed.begin(), closed.end(), [](char c) { return c == 0; }));
 }
 
-// A distorted embedding of a flat grid with its boundary fixed on the unit square: the optimum is the identity
-// (stretch 1), and the optimization must get close to it.
+// A distorted embedding of a flat grid with its boundary fixed on the unit square: the optimum is the
+// identity (stretch 1), and the optimization must get close to it.
 TEST(OptimizeStretch, FlatGridRecoversIsometry) {
   const TriMesh g = test::grid(12);
   std::vector<Eigen::Vector2d> uv = pushed_to_corner(xy(g), 0.6);
@@ -107,8 +108,8 @@ TEST(OptimizeStretch, FlatGridRecoversIsometry) {
   }
 }
 
-// On a curved cap the optimum is not 1, but every sweep must lower (never raise) the normalized L2 stretch, since
-// the boundary is fixed and each move lowers its ring's area-weighted L2 energy.
+// On a curved cap the optimum is not 1, but every sweep must lower (never raise) the normalized L2 stretch,
+// since the boundary is fixed and each move lowers its ring's area-weighted L2 energy.
 TEST(OptimizeStretch, CurvedCapDecreasesMonotonically) {
   const TriMesh m = paraboloid(16, 2.0);
   for (double alpha : {0.0, 0.6}) {
@@ -227,8 +228,8 @@ TEST(OptimizeStretch, RejectsBadInput) {
   EXPECT_THROW(optimize_vertex(99, rings[5], g.positions, g.triangles, uv, {}, rng), InvalidInput);
 }
 
-/// A random star: center vertex 0 inside a fan of k random uv neighbours (angular gaps < π so the center is in
-/// the kernel), with random 3D positions (an arbitrary, strongly anisotropic target).
+/// A random star: center vertex 0 inside a fan of k random uv neighbours (angular gaps < π so the center is
+/// in the kernel), with random 3D positions (an arbitrary, strongly anisotropic target).
 TriMesh random_star(std::mt19937& rng, std::vector<Eigen::Vector2d>& uv, bool closed) {
   std::uniform_int_distribution<int> count(3, 10);
   std::uniform_real_distribution<double> unit(0, 1);
@@ -243,7 +244,8 @@ TriMesh random_star(std::mt19937& rng, std::vector<Eigen::Vector2d>& uv, bool cl
     for (int i = 0; i < k; ++i) angles.push_back((closed ? 2 * kPi : 0.9 * kPi) * unit(rng));
     std::sort(angles.begin(), angles.end());
     bool ok = true;
-    for (int i = 0; i + 1 < k; ++i) ok = ok && angles[i + 1] - angles[i] < 0.95 * kPi && angles[i + 1] > angles[i];
+    for (int i = 0; i + 1 < k; ++i)
+      ok = ok && angles[i + 1] - angles[i] < 0.95 * kPi && angles[i + 1] > angles[i];
     if (closed) ok = ok && angles[0] + 2 * kPi - angles[k - 1] < 0.95 * kPi;
     if (ok) break;
   }
@@ -256,17 +258,17 @@ TriMesh random_star(std::mt19937& rng, std::vector<Eigen::Vector2d>& uv, bool cl
     if (!closed && i + 1 == k) break;
     m.triangles.push_back({0, 1 + i, 1 + (i + 1) % k});
   }
-  // Move the center to a random point strictly inside the kernel (a random convex combination of the origin and
-  // small steps that keep every triangle counter-clockwise).
+  // Move the center to a random point strictly inside the kernel (a random convex combination of the origin
+  // and small steps that keep every triangle counter-clockwise).
   const Eigen::Vector2d step(0.05 * (unit(rng) - 0.5), 0.05 * (unit(rng) - 0.5));
   uv[0] += step;
   if (count_flipped(m.triangles, uv) != 0) uv[0] -= step;
   return m;
 }
 
-// Property test: from random stars, random 3D targets, random seeds and all three norms, optimize_vertex never
-// flips a ring triangle, never raises the local stretch, writes only uv[v], and returns the local stretch of
-// where it leaves v, which agrees with the per-triangle definition (triangle_stretch).
+// Property test: from random stars, random 3D targets, random seeds and all three norms, optimize_vertex
+// never flips a ring triangle, never raises the local stretch, writes only uv[v], and returns the local
+// stretch of where it leaves v, which agrees with the per-triangle definition (triangle_stretch).
 TEST(OptimizeVertex, NeverFlipsAndNeverRaisesStretch) {
   std::mt19937 shapes(2024);
   int moved = 0, total = 0;
@@ -279,7 +281,9 @@ TEST(OptimizeVertex, NeverFlipsAndNeverRaisesStretch) {
     for (std::size_t f = 0; f < ring.size(); ++f) ring[f] = static_cast<int>(f);
 
     VertexOptimizationOptions options;
-    options.norm = trial % 3 == 0 ? StretchNorm::kL2 : trial % 3 == 1 ? StretchNorm::kLinf : StretchNorm::kBlend;
+    options.norm = trial % 3 == 0   ? StretchNorm::kL2
+                   : trial % 3 == 1 ? StretchNorm::kLinf
+                                    : StretchNorm::kBlend;
     options.linf_weight = 0.3;
     std::mt19937 rng(static_cast<unsigned>(trial));
     double previous = local_stretch(0, ring, m.positions, m.triangles, uv, options);
@@ -329,7 +333,8 @@ TEST(OptimizeVertex, ConvergesToLocalMinimumOfL2Energy) {
     options.tolerance = 1e-6;
     std::mt19937 rng(static_cast<unsigned>(trial));
     double value = 0;
-    for (int call = 0; call < 60; ++call) value = optimize_vertex(0, ring, m.positions, m.triangles, uv, options, rng);
+    for (int call = 0; call < 60; ++call)
+      value = optimize_vertex(0, ring, m.positions, m.triangles, uv, options, rng);
     // Scale of the ring: the shortest uv distance from the center to a neighbour.
     double scale = std::numeric_limits<double>::infinity();
     for (std::size_t i = 1; i < uv.size(); ++i) scale = std::min(scale, (uv[i] - uv[0]).norm());
@@ -338,7 +343,8 @@ TEST(OptimizeVertex, ConvergesToLocalMinimumOfL2Energy) {
       const double h = 1e-3 * scale;
       uv[0] = optimum + h * Eigen::Vector2d(std::cos(k * kPi / 8), std::sin(k * kPi / 8));
       const double nearby = local_stretch(0, ring, m.positions, m.triangles, uv, options);
-      EXPECT_GE(nearby, value * (1 - 1e-7)) << "relative gap " << (value - nearby) / value << ", trial " << trial << " direction " << k;
+      EXPECT_GE(nearby, value * (1 - 1e-7))
+          << "relative gap " << (value - nearby) / value << ", trial " << trial << " direction " << k;
     }
     uv[0] = optimum;
   }
@@ -363,8 +369,8 @@ TEST(OptimizeVertex, FlatRingReturnsToIsometry) {
   }
 }
 
-// Scale: a 101×101 grid (10,201 vertices, 20,000 triangles) on a paraboloid from a distorted start. Reports the
-// time; checks only the properties (the time is machine dependent).
+// Scale: a 101×101 grid (10,201 vertices, 20,000 triangles) on a paraboloid from a distorted start. Reports
+// the time; checks only the properties (the time is machine dependent).
 TEST(OptimizeStretch, TenThousandVertices) {
   const TriMesh m = paraboloid(100, 1.5);
   std::vector<Eigen::Vector2d> uv = pushed_to_corner(xy(m), 0.6);

@@ -1,7 +1,7 @@
 // Properties of the geometric stretch metric (Sander et al. 2001): isometry, scaling, flips, an analytic
 // anisotropic map, normalization invariances and the lower bound 1.
-#include "param/errors.h"
 #include "param/stretch.h"
+#include "param/errors.h"
 #include "tests/param/test_meshes.h"
 
 #include <Eigen/Geometry>
@@ -95,7 +95,8 @@ std::vector<Eigen::Vector2d> xy(const TriMesh& m) {
   return uv;
 }
 
-/// The grid lifted onto a paraboloid z = a (x² + y²) (a curved surface whose xy projection is the unit square).
+/// The grid lifted onto a paraboloid z = a (x² + y²) (a curved surface whose xy projection is the unit
+/// square).
 TriMesh paraboloid(int n, double a) {
   TriMesh m = test::grid(n);
   for (auto& p : m.positions) p.z() = a * ((p.x() - 0.5) * (p.x() - 0.5) + (p.y() - 0.5) * (p.y() - 0.5));
@@ -129,8 +130,8 @@ TEST(MeshStretch, InvariantToScalingUvAnd3d) {
   EXPECT_NEAR(sq.linf, reference.linf, 1e-12);
 }
 
-// The normalized L2 stretch is >= 1 for every embedding (Cauchy–Schwarz over Γγ = A3/A2), with equality for an
-// isometry; L∞ >= L2.
+// The normalized L2 stretch is >= 1 for every embedding (Cauchy–Schwarz over Γγ = A3/A2), with equality for
+// an isometry; L∞ >= L2.
 TEST(MeshStretch, AtLeastOneForRandomEmbeddings) {
   const TriMesh g = test::grid(6);
   std::mt19937 rng(7);
@@ -207,7 +208,8 @@ TEST(TriangleStretch, RotationOfUvDoesNotMatter) {
   const StretchValues base = triangle_stretch(t.q, t.p);
   for (double angle = 0; angle < 2 * kPi; angle += 0.9) {
     Eigen::Vector2d p[3];
-    for (int i = 0; i < 3; ++i) p[i] = Eigen::Rotation2Dd(angle) * Eigen::Vector2d(t.p[i].x() * 2, t.p[i].y());
+    for (int i = 0; i < 3; ++i)
+      p[i] = Eigen::Rotation2Dd(angle) * Eigen::Vector2d(t.p[i].x() * 2, t.p[i].y());
     const Eigen::Vector2d p0[3] = {Eigen::Vector2d(t.p[0].x() * 2, t.p[0].y()),
                                    Eigen::Vector2d(t.p[1].x() * 2, t.p[1].y()),
                                    Eigen::Vector2d(t.p[2].x() * 2, t.p[2].y())};

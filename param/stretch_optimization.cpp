@@ -296,13 +296,26 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
   }
   if (!(options.threshold >= 0)) throw InvalidInput("optimize_stretch: threshold must be >= 0");
   check_vertex_options("optimize_stretch", options.vertex);
-  for (std::size_t i = 0; i < uv.size(); ++i) {
-    if (!uv[i].allFinite())
+  if (uv.size() != nv) {
+    throw InvalidInput("optimize_stretch: " + std::to_string(uv.size()) + " uv coordinates for " +
+                       std::to_string(nv) + " vertices");
+  }
+  for (std::size_t i = 0; i < nv; ++i) {
+    if (!uv[i].allFinite()) {
       throw InvalidInput("optimize_stretch: uv of vertex " + std::to_string(i) + " not finite");
+    }
+  }
+  for (std::size_t f = 0; f < triangles.size(); ++f) {
+    for (int v : triangles[f]) {
+      if (v < 0 || static_cast<std::size_t>(v) >= nv) {
+        throw InvalidInput("optimize_stretch: triangle " + std::to_string(f) + " has vertex index " +
+                           std::to_string(v) + " out of range");
+      }
+    }
   }
 
   StretchOptimizationResult result;
-  result.before = mesh_stretch(positions, triangles, uv);  // checks sizes, indices and area
+  result.before = mesh_stretch(positions, triangles, uv);  // also rejects no triangles and zero 3D area
 
   // Vertex → incident triangles (CSR), and the per-triangle 3D metric, computed once.
   std::vector<int> offsets(nv + 1, 0);

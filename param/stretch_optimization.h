@@ -60,14 +60,23 @@ struct VertexOptimizationOptions {
 };
 
 /// Moves `uv[v]` to lower the local stretch objective E(v) (see the top of this file) of its incident
-/// triangles `ring` (indices into `triangles`, each containing v) by `options.num_directions` line
-/// minimizations (Brent's bracketed parabolic minimization) along random directions drawn from `rng`.
-/// Deterministic for a given rng state. Only uv[v] is written. Never makes any ring triangle flipped or
-/// degenerate: each accepted point is checked with the direct signed-area formula, and it is only accepted if
-/// E decreases. Returns sqrt(E) at the final position (3D units per uv unit; +inf if a ring triangle is
-/// already flipped or degenerate, in which case v is not moved); uv[v] is unchanged if no improvement was
-/// found. \pre uv.size() == positions.size(); every ring triangle contains v. \throw InvalidInput if v or an
-/// index is out of range, a ring triangle does not contain v, or sizes differ.
+/// triangles `ring` by `options.num_directions` line minimizations (Brent's bracketed parabolic minimization)
+/// along random directions drawn from `rng`. Deterministic for a given rng state. Only uv[v] is written.
+///
+/// Never makes any ring triangle flipped or degenerate: each candidate point is checked with the direct
+/// signed-area formula and accepted only if E decreases. Returns sqrt(E) at the final position (3D units per
+/// uv unit); uv[v] is unchanged if no improvement was found. If a ring triangle is already flipped or
+/// degenerate, v is not moved and +inf is returned.
+///
+/// \param v          the vertex to move
+/// \param ring       indices into `triangles` of the triangles around v (each must contain v); the energy
+///                   only sees these, so pass all of v's triangles to keep the whole mesh flip-free
+/// \param positions  #V 3D positions (any units)
+/// \param triangles  #F triangles, counter-clockwise in uv
+/// \param uv         #V parameter coordinates (uv.size() == positions.size()); only uv[v] is written
+/// \param rng        source of the random directions, advanced by one draw per call
+/// \throw InvalidInput if v or an index is out of range, a ring triangle does not contain v, sizes differ,
+///        uv[v] is not finite or the options are invalid.
 double optimize_vertex(int v, const std::vector<int>& ring, const std::vector<Eigen::Vector3d>& positions,
                        const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
                        const VertexOptimizationOptions& options, std::mt19937& rng);
@@ -100,23 +109,30 @@ struct StretchOptimizationResult {
   std::size_t sweeps = 0;
   std::size_t vertex_moves = 0;      ///< accepted vertex displacements over all sweeps
   double last_max_displacement = 0;  ///< largest uv displacement in the last sweep (uv units)
-  std::size_t skipped_vertices =
-      0;  ///< unlocked vertices never moved because their ring was flipped/degenerate
+  /// Unlocked vertices never moved because their ring was flipped or degenerate.
+  std::size_t skipped_vertices = 0;
   std::vector<StretchValues> per_sweep;  ///< mesh stretch after each sweep, if options.record_sweeps
 };
 
-/// Global stretch optimization (paper §3.3.2, Sander 2001 §5): each sweep places all unlocked vertices that
+/// Global stretch optimization (paper §3.3.2, Sander 2001 §5). Each sweep places all unlocked vertices that
 /// belong to a triangle in a priority queue ordered by their local stretch sqrt(E(v)) (largest first) and
-/// optimizes each in turn with optimize_vertex(); sweeps stop when the largest uv displacement in a sweep is
-/// below `options.threshold`, or after `options.max_sweeps`. Guarantees: locked vertices are never written
-/// (bit-identical); no triangle becomes flipped or degenerate; every move lowers its vertex's E. With
-/// StretchNorm::kL2 and a fixed boundary (all boundary vertices locked, so the total uv area Σ A2 is
-/// constant) the normalized mesh L2 stretch therefore never increases from sweep to sweep. Vertices whose
-/// ring contains a triangle that is already flipped or degenerate are left where they are (counted in
-/// skipped_vertices); `before`/`after` are then +inf (see mesh_stretch). `positions` (#V, 3D), `triangles`
-/// (#F, CCW in uv), `uv` (#V, optimized in place), `locked` (#V, nonzero = fixed: boundary, patch corners,
-/// feature points). \throw InvalidInput on size mismatches, out-of-range indices, non-finite uv, no triangles
-/// or zero 3D area.
+/// optimizes each in turn as optimize_vertex() does; sweeps stop when the largest uv displacement in a sweep
+/// is below `options.threshold`, or after `options.max_sweeps`.
+///
+/// Guarantees: locked vertices are never written (bit-identical); no triangle becomes flipped or degenerate;
+/// every move lowers its vertex's E. With StretchNorm::kL2 and a fixed boundary (all boundary vertices
+/// locked, so the total uv area Σ A2 is constant) the normalized mesh L2 stretch therefore never increases
+/// from sweep to sweep. Unlocked boundary vertices drift outward (the un-normalized energy falls as the uv
+/// area grows; each step is bounded by VertexOptimizationOptions::max_step): lock the boundary for a fixed
+/// domain. Vertices whose ring contains a triangle that is already flipped or degenerate are left where they
+/// are (counted in skipped_vertices); `before`/`after` are then +inf (see mesh_stretch).
+///
+/// \param positions  #V 3D positions (any units)
+/// \param triangles  #F triangles, counter-clockwise in uv
+/// \param uv         #V parameter coordinates, optimized in place
+/// \param locked     #V flags, nonzero = fixed (boundary, patch corners, feature points)
+/// \throw InvalidInput on size mismatches, out-of-range indices, non-finite uv, invalid options, no
+///        triangles or zero 3D area.
 StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& positions,
                                            const std::vector<std::array<int, 3>>& triangles,
                                            std::vector<Eigen::Vector2d>& uv, const std::vector<char>& locked,

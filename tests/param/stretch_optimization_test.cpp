@@ -201,6 +201,30 @@ TEST(OptimizeStretch, LeavesExistingFlipsAloneAndAddsNone) {
   EXPECT_LE(count_flipped(g.triangles, uv), flipped_before);
 }
 
+// With only the four corners locked, boundary vertices move too (the energy rewards larger uv area), but no
+// triangle may flip and the corners stay put.
+TEST(OptimizeStretch, UnlockedBoundaryNeverFlips) {
+  const TriMesh m = paraboloid(8, 1.5);
+  std::vector<Eigen::Vector2d> uv = pushed_to_corner(xy(m), 0.5);
+  std::vector<char> locked(m.positions.size(), 0);
+  for (int v : {0, 8, 72, 80}) locked[v] = 1;
+  const std::vector<Eigen::Vector2d> start = uv;
+  StretchOptimizationOptions options;
+  options.max_sweeps = 30;
+  const StretchOptimizationResult r = optimize_stretch(m.positions, m.triangles, uv, locked, options);
+  EXPECT_EQ(count_flipped(m.triangles, uv), 0u);
+  EXPECT_GT(r.vertex_moves, 0u);
+  bool boundary_moved = false;
+  for (std::size_t v = 0; v < uv.size(); ++v) {
+    if (locked[v]) {
+      EXPECT_TRUE(bit_identical(uv[v], start[v])) << v;
+    }
+    const auto& p = m.positions[v];
+    if ((p.x() == 0 || p.y() == 0) && !locked[v]) boundary_moved = boundary_moved || uv[v] != start[v];
+  }
+  EXPECT_TRUE(boundary_moved);
+}
+
 TEST(OptimizeStretch, RejectsBadInput) {
   const TriMesh g = test::grid(3);
   std::vector<Eigen::Vector2d> uv = xy(g);

@@ -91,7 +91,9 @@ struct StretchOptimizationOptions {
   /// Per-vertex line searches.
   VertexOptimizationOptions vertex;
   /// Stop when the largest uv displacement of any vertex during a sweep is below this (uv units; the paper's
-  /// 10⁻³ assumes the unit square; scale it with the domain).
+  /// 10⁻³ assumes the unit square; scale it with the domain). With kLinf or kBlend the max term is not
+  /// smooth, so vertices can keep taking sizeable steps for negligible gains and this criterion may never
+  /// trigger: max_sweeps then bounds the run.
   double threshold = 1e-3;
   /// At most this many sweeps over all unlocked vertices (bounds the running time: one sweep costs
   /// O(#F · num_directions · evaluations)).

@@ -1,5 +1,12 @@
 #include "param/progressive_mesh.h"
 
+// OpenMesh's VectorT is deliberately left uninitialised by its default constructor, and its property vectors
+// push default-constructed values when vertices are added: GCC's -Wmaybe-uninitialized reports that inside
+// OpenMesh's templates. Nothing here reads such a value (every position is set right after add_vertex).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+
 #include "param/errors.h"
 #include "param/mesh_topology.h"
 
@@ -153,10 +160,12 @@ class ModPatchLocksT : public OpenMesh::Decimater::ModBaseT<MeshT> {
   const std::vector<char>* locked_ = nullptr;
 };
 
-/// OpenMesh's decimation framework (module management and the topological legality tests of
-/// BaseDecimaterT) driven by our own loop, which is DecimaterT::decimate_to() with two changes: it records
-/// every collapse for the vertex splits, and it breaks priority ties by vertex id so that the result does not
-/// depend on heap internals. (DecimaterT itself would also pull in libOpenMeshTools for its observer.)
+/// OpenMesh's decimation framework (BaseDecimaterT: the modules and their priorities) driven by our own loop,
+/// which is DecimaterT::decimate_to() with three changes: it records every collapse for the vertex splits; it
+/// breaks priority ties by vertex id so that the result does not depend on heap internals; and its topological
+/// test is BaseDecimaterT::is_collapse_legal() with TriConnectivity::is_collapse_ok() done on a reusable mark
+/// array (OpenMesh 9's allocates on every call, which made it ~60% of the run time). DecimaterT itself would
+/// also pull in libOpenMeshTools for its observer.
 class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
  public:
   using Base = OpenMesh::Decimater::BaseDecimaterT<PmMesh>;
@@ -166,6 +175,7 @@ class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
   void decimate_to(std::size_t target, const std::vector<std::uint8_t>& side_mask, std::vector<HalfEdgeCollapse>& log) {
     std::size_t alive = mesh_.n_vertices();
     stamp_.assign(mesh_.n_vertices(), 0);
+    mark_.assign(mesh_.n_vertices(), 0);
     target_.assign(mesh_.n_vertices(), PmMesh::HalfedgeHandle());
     for (auto v : mesh_.vertices()) push_best(v);
     std::vector<PmMesh::VertexHandle> support;
@@ -175,7 +185,7 @@ class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
       const auto v = PmMesh::VertexHandle(top.vertex);
       if (top.stamp != stamp_[top.vertex] || mesh_.status(v).deleted()) continue;
       CollapseInfo ci(mesh_, target_[top.vertex]);
-      if (!this->is_collapse_legal(ci)) continue;  // as DecimaterT: wait until a neighbour changes
+      if (!legal(ci)) continue;  // as DecimaterT: wait until a neighbour changes
 
       support.clear();
       for (auto w : mesh_.vv_range(ci.v0)) support.push_back(w);
@@ -209,7 +219,7 @@ class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
     PmMesh::HalfedgeHandle best_h;
     for (auto h : mesh_.voh_range(v)) {
       CollapseInfo ci(mesh_, h);
-      if (!this->is_collapse_legal(ci)) continue;
+      if (!legal(ci)) continue;
       const float priority = this->collapse_priority(ci);
       if (priority >= 0.0f && priority < best) {
         best = priority;
@@ -219,6 +229,54 @@ class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
     if (!best_h.is_valid()) return;
     target_[i] = best_h;
     heap_.push({best, i, stamp_[i]});
+  }
+
+  /// TriConnectivity::is_collapse_ok(): the link condition and the boundary cases.
+  bool collapse_ok(const CollapseInfo& ci) {
+    const auto h = ci.v0v1, o = ci.v1v0;
+    if (mesh_.status(mesh_.edge_handle(h)).deleted()) return false;
+    if (mesh_.status(ci.v0).deleted() || mesh_.status(ci.v1).deleted()) return false;
+    PmMesh::VertexHandle vl, vr;
+    if (!mesh_.is_boundary(h)) {
+      const auto h1 = mesh_.next_halfedge_handle(h), h2 = mesh_.next_halfedge_handle(h1);
+      vl = mesh_.to_vertex_handle(h1);
+      if (mesh_.is_boundary(mesh_.opposite_halfedge_handle(h1)) && mesh_.is_boundary(mesh_.opposite_halfedge_handle(h2))) {
+        return false;
+      }
+    }
+    if (!mesh_.is_boundary(o)) {
+      const auto h1 = mesh_.next_halfedge_handle(o), h2 = mesh_.next_halfedge_handle(h1);
+      vr = mesh_.to_vertex_handle(h1);
+      if (mesh_.is_boundary(mesh_.opposite_halfedge_handle(h1)) && mesh_.is_boundary(mesh_.opposite_halfedge_handle(h2))) {
+        return false;
+      }
+    }
+    if (vl == vr) return false;
+    if (++mark_stamp_ == 0) {
+      std::fill(mark_.begin(), mark_.end(), 0);
+      mark_stamp_ = 1;
+    }
+    for (auto w : mesh_.vv_range(ci.v1)) mark_[w.idx()] = mark_stamp_;
+    for (auto w : mesh_.vv_range(ci.v0)) {
+      if (mark_[w.idx()] == mark_stamp_ && w != vl && w != vr) return false;  // a third common neighbour
+    }
+    return !(mesh_.is_boundary(ci.v0) && mesh_.is_boundary(ci.v1) && !mesh_.is_boundary(h) && !mesh_.is_boundary(o));
+  }
+
+  /// BaseDecimaterT::is_collapse_legal() with the fast collapse_ok() (no locked/feature status is used here:
+  /// the locks are ModPatchLocksT's).
+  bool legal(const CollapseInfo& ci) {
+    if (!collapse_ok(ci)) return false;
+    if (ci.vl.is_valid() && ci.vr.is_valid() && mesh_.find_halfedge(ci.vl, ci.vr).is_valid() &&
+        mesh_.valence(ci.vl) == 3 && mesh_.valence(ci.vr) == 3) {
+      return false;
+    }
+    if (mesh_.is_boundary(ci.v0)) {
+      if (!mesh_.is_boundary(ci.v1)) return false;
+      if (ci.vl.is_valid() && ci.vr.is_valid()) return false;
+    }
+    // at least two triangles at v0
+    return mesh_.cw_rotated_halfedge_handle(mesh_.cw_rotated_halfedge_handle(ci.v0v1)) != ci.v0v1;
   }
 
   HalfEdgeCollapse record(const CollapseInfo& ci, const std::vector<std::uint8_t>& side_mask) const {
@@ -246,6 +304,8 @@ class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
   std::priority_queue<Entry> heap_;
   std::vector<std::uint32_t> stamp_;
   std::vector<PmMesh::HalfedgeHandle> target_;
+  std::vector<std::uint32_t> mark_;
+  std::uint32_t mark_stamp_ = 0;
 };
 
 }  // namespace

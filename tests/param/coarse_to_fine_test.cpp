@@ -325,19 +325,31 @@ double run_real_half(const TriMesh& half, const std::string& name) {
   // Corners placed so that no interior edge joins two vertices of one side (progressive_mesh() checks it).
   for (std::size_t offset = 0; offset < 16; ++offset) {
     PatchSides sides = patch_sides(half, loop_corners(half, offset));
-    const auto start = std::chrono::steady_clock::now();
+    using Clock = std::chrono::steady_clock;
+    auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    const auto start = Clock::now();
     Pipeline p;
+    p.patch = half;
+    p.sides = sides;
     try {
-      p = make_pipeline(half, sides, {});
+      p.pm = progressive_mesh(p.patch, p.sides, {});
     } catch (const InvalidInput&) {
       continue;  // a chord between two vertices of one side: try the next placement
     }
+    const double pm_seconds = seconds_since(start);
+    const auto mvc_start = Clock::now();
+    p.base_uv =
+        mean_value_embedding(p.patch.positions, p.pm.base_triangles, square_boundary_uv(p.patch.positions, sides)).uv;
+    const double mvc_seconds = seconds_since(mvc_start);
+    const auto c2f_start = Clock::now();
     const CoarseToFineResult r = coarse_to_fine(p.patch, p.pm, p.base_uv);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double c2f_seconds = seconds_since(c2f_start);
+    const double seconds = seconds_since(start);
     expect_valid_square_parameterization(p, r);
-    std::printf("%s: %zu vertices, %zu triangles, base %zu vertices, %zu boundary vertices off chord, %.3f s\n",
+    std::printf("%s: %zu vertices, %zu triangles, base %zu vertices, %zu boundary vertices off chord; "
+                "PM %.3f s + MVC %.3f s + coarse-to-fine %.3f s = %.3f s\n",
                 name.c_str(), half.num_vertices(), half.num_triangles(), p.pm.base_vertices.size(),
-                r.boundary_off_chord, seconds);
+                r.boundary_off_chord, pm_seconds, mvc_seconds, c2f_seconds, seconds);
     return seconds;
   }
   ADD_FAILURE() << name << ": no corner placement without a one-side chord";

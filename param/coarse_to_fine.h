@@ -49,7 +49,8 @@ struct CoarseToFineResult {
 ///   triangle; otherwise to the point nearest to it that keeps a quarter of the admissible part of the segment
 ///   (where no triangle flips) on either side. Either way the side stays monotone.
 /// Corners and feature vertices are never removed, so they keep their base-mesh parameters throughout.
-/// Every step is local: O(valence²) per split plus the callbacks.
+/// Every step is local: O(valence²) per split plus the callbacks. The object keeps references to `patch` and
+/// `pm`: they must outlive it.
 class CoarseToFine {
  public:
   /// \param patch  the full patch the progressive mesh was built from (its 3D positions are used for the

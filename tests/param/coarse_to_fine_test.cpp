@@ -346,10 +346,24 @@ double run_real_half(const TriMesh& half, const std::string& name) {
     const double c2f_seconds = seconds_since(c2f_start);
     const double seconds = seconds_since(start);
     expect_valid_square_parameterization(p, r);
+    // The progressive mesh of a real patch: corners survive, the base mesh is a disk.
+    const TopologyReport base = analyze_topology(TriMesh{p.patch.positions, p.pm.base_triangles});
+    EXPECT_TRUE(base.manifold && base.components == 1 && base.boundary_loops == 1 && base.genus == 0);
+    EXPECT_EQ(base.vertices, p.pm.base_vertices.size());
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_TRUE(std::binary_search(p.pm.base_vertices.begin(), p.pm.base_vertices.end(), sides[k].front()));
+    }
+    // Floater's theorem on real data: mean value coordinates of the full patch are an embedding too.
+    const auto full_start = Clock::now();
+    const auto full = mean_value_embedding(p.patch.positions, p.patch.triangles,
+                                           square_boundary_uv(p.patch.positions, sides));
+    const double full_seconds = seconds_since(full_start);
+    EXPECT_EQ(count_flipped_triangles(full.uv, p.patch.triangles), 0u);
+    EXPECT_LT(full.residual, 1e-9);
     std::printf("%s: %zu vertices, %zu triangles, base %zu vertices, %zu boundary vertices off chord; "
-                "PM %.3f s + MVC %.3f s + coarse-to-fine %.3f s = %.3f s\n",
+                "PM %.3f s + MVC %.3f s + coarse-to-fine %.3f s = %.3f s (MVC of the full patch: %.3f s)\n",
                 name.c_str(), half.num_vertices(), half.num_triangles(), p.pm.base_vertices.size(),
-                r.boundary_off_chord, pm_seconds, mvc_seconds, c2f_seconds, seconds);
+                r.boundary_off_chord, pm_seconds, mvc_seconds, c2f_seconds, seconds, full_seconds);
     return seconds;
   }
   ADD_FAILURE() << name << ": no corner placement without a one-side chord";

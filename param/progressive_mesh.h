@@ -79,8 +79,8 @@ struct ProgressiveMesh {
 /// \param patch  disk-shaped patch, counter-clockwise triangles, positions in any unit
 /// \param sides  its four sides (see `patch_sides()`)
 /// \param features  vertex ids that must survive (may be empty; corners need not be repeated)
-/// \pre `patch` is a manifold disk without unreferenced vertices or coincident edge endpoints, `sides` covers
-///      its boundary loop, and no interior edge joins two vertices of one side.
+/// \pre `patch` is a manifold disk without unreferenced vertices or zero-area triangles, `sides` covers its
+///      boundary loop, and no interior edge joins two vertices of one side.
 /// \throw InvalidInput if a precondition is violated (the message names it).
 ProgressiveMesh progressive_mesh(const TriMesh& patch, const PatchSides& sides, const std::vector<int>& features,
                                  const ProgressiveMeshOptions& options = {});

@@ -107,9 +107,10 @@ TEST(CoarseToFine, NoFlipAtAnyLevelOnACurvedPatch) {
   CoarseToFine c2f(p.patch, p.pm, p.base_uv, options);
   ASSERT_EQ(c2f.num_splits(), p.pm.collapses.size());
   ASSERT_GT(c2f.num_splits(), 400u);
-  std::size_t alive = p.pm.base_triangles.size();
+  std::size_t alive = p.pm.base_triangles.size(), calls = 0;
+  const VertexOptimizer no_op = [&](int, const std::vector<int>&) { ++calls; };
   while (!c2f.finished()) {
-    const int v = c2f.split_next();
+    const int v = c2f.split_next(no_op);
     ASSERT_GE(v, 0);
     // Independent check of the whole level: every existing triangle counter-clockwise with positive area.
     std::size_t count = 0;
@@ -122,9 +123,30 @@ TEST(CoarseToFine, NoFlipAtAnyLevelOnACurvedPatch) {
     alive += (c.left_triangle >= 0) + (c.right_triangle >= 0);
     ASSERT_EQ(count, alive);
   }
-  EXPECT_EQ(c2f.split_next(), -1);
+  EXPECT_EQ(c2f.split_next(no_op), -1);
+  EXPECT_GT(calls, 3 * c2f.num_splits());  // the new vertex and its free neighbours, each split
   const CoarseToFineResult r = c2f.result();
   expect_valid_square_parameterization(p, r);
+}
+
+TEST(CoarseToFine, ValidOnManyCurvedPatches) {
+  // Several jitters of the saddle-with-bump, and a grid pushed onto a sphere cap (about 140° wide), with
+  // features scattered over the interior.
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const int n = 18 + static_cast<int>(seed) * 3;
+    TriMesh m = curved(n, seed);
+    if (seed % 2 == 0) {
+      for (auto& q : m.positions) q = Eigen::Vector3d(q.x() - 0.5, q.y() - 0.5, 0.18).normalized();
+    }
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> interior(1, n - 1);
+    std::set<int> features;
+    for (int i = 0; i < 5; ++i) features.insert(interior(rng) * (n + 1) + interior(rng));
+    const PatchSides sides = patch_sides(m, grid_corners(n));
+    const Pipeline p = make_pipeline(std::move(m), sides, {features.begin(), features.end()});
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    expect_valid_square_parameterization(p, coarse_to_fine(p.patch, p.pm, p.base_uv));
+  }
 }
 
 TEST(CoarseToFine, FreeFunctionMatchesTheClassAndIsDeterministic) {

@@ -102,6 +102,7 @@ CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm, cons
   }
 
   fixed_.assign(n, 0);
+  off_chord_.assign(n, 0);
   side_of_.assign(n, -1);
   arclength_.assign(n, 0.0);
   for (int k = 0; k < 4; ++k) {
@@ -173,25 +174,17 @@ void CoarseToFine::insert_interior(int v, int kept) {
                       " (the level before was not an embedding)");
 }
 
-void CoarseToFine::insert_boundary(const HalfEdgeCollapse& c) {
-  const int v = c.removed, a = c.kept, b = c.boundary_neighbor;
+bool CoarseToFine::place_on_side(int v) {
   const int side = side_of_[v];
   if (side < 0) throw SolverFailure("CoarseToFine: boundary split of a vertex that is not on a side");
-  const double sa = side_arclength(side, a), sb = side_arclength(side, b), sv = arclength_[v];
-  if (!((sv - sa) * (sb - sv) > 0.0)) {
-    throw SolverFailure("CoarseToFine: boundary vertex " + std::to_string(v) + " is not between its neighbours");
-  }
-  // The chord-length position on the side of the full patch (where square_boundary_uv() puts it), as a
-  // parameter t on the segment between the neighbours' current places.
+  // v = corner + s·dir, s ∈ [0,1]. Each triangle (v, x, y) stays counter-clockwise for s in an open interval
+  // (orient is affine in s); the triangles on v's two boundary edges keep s between its boundary neighbours.
   const Eigen::Vector2d corner = kSquareCorner[side], dir = kSquareCorner[(side + 1) % 4] - corner;
-  const Eigen::Vector2d pa = uv_[a], pb = uv_[b];
-  const Eigen::Vector2d target = corner + (sv / side_length_[side]) * dir;
-  const double t_chord = (target - pa).dot(pb - pa) / (pb - pa).squaredNorm();
-  // Each triangle (v, x, y) stays counter-clockwise for t in an interval: orient is affine along the segment.
+  const double s_chord = arclength_[v] / side_length_[side];
   double lo = 0.0, hi = 1.0;
   for (int id : star_[v]) {
     const auto [x, y] = opposite_edge(triangles_[id], v);
-    const double f0 = orient(pa, uv_[x], uv_[y]), f1 = orient(pb, uv_[x], uv_[y]);
+    const double f0 = orient(corner, uv_[x], uv_[y]), f1 = orient(corner + dir, uv_[x], uv_[y]);
     const double slope = f1 - f0;
     if (slope > 0) {
       lo = std::max(lo, -f0 / slope);
@@ -201,21 +194,49 @@ void CoarseToFine::insert_boundary(const HalfEdgeCollapse& c) {
       hi = lo;
     }
   }
-  if (!(lo < hi)) {
-    throw SolverFailure("CoarseToFine: no place on its side for boundary vertex " + std::to_string(v));
-  }
-  auto place = [&](double t) {
-    uv_[v] = t == t_chord ? target : Eigen::Vector2d(pa + t * (pb - pa));
+  const Eigen::Vector2d before = uv_[v];
+  auto try_at = [&](double s) {
+    uv_[v] = corner + s * dir;
     for (int id : star_[v]) {
-      if (!(signed_uv_area2(uv_, triangles_[id]) > 0.0)) return false;
+      if (!(signed_uv_area2(uv_, triangles_[id]) > 0.0)) {
+        uv_[v] = before;
+        return false;
+      }
     }
     return true;
   };
-  if (t_chord > lo && t_chord < hi && place(t_chord)) return;
-  // As close to the chord-length position as keeps a quarter of the admissible interval on either side.
-  ++boundary_off_chord_;
-  const double margin = 0.25 * (hi - lo);
-  place(std::clamp(t_chord, lo + margin, hi - margin));  // checked by check_star()
+  if (lo < hi) {
+    if (s_chord > lo && s_chord < hi && try_at(s_chord)) return true;
+    // As close to the chord-length position as keeps a quarter of the admissible interval on either side.
+    const double margin = 0.25 * (hi - lo);
+    try_at(std::clamp(s_chord, lo + margin, hi - margin));
+  }
+  return false;
+}
+
+void CoarseToFine::insert_boundary(const HalfEdgeCollapse& c) {
+  const int v = c.removed;
+  const int side = side_of_[v];
+  if (side < 0) throw SolverFailure("CoarseToFine: boundary split of a vertex that is not on a side");
+  const double sa = side_arclength(side, c.kept), sb = side_arclength(side, c.boundary_neighbor);
+  const double sv = arclength_[v];
+  if (!((sv - sa) * (sb - sv) > 0.0)) {
+    throw SolverFailure("CoarseToFine: boundary vertex " + std::to_string(v) + " is not between its neighbours");
+  }
+  if (!place_on_side(v)) {
+    if (!uv_[v].allFinite()) {
+      throw SolverFailure("CoarseToFine: no place on its side for boundary vertex " + std::to_string(v));
+    }
+    off_chord_[v] = 1;
+    ++num_off_chord_;
+  }
+}
+
+void CoarseToFine::retry_off_chord(int v) {
+  if (off_chord_[v] && place_on_side(v)) {
+    off_chord_[v] = 0;
+    --num_off_chord_;
+  }
 }
 
 void CoarseToFine::check_star(int v, const char* when) const {
@@ -264,21 +285,28 @@ int CoarseToFine::split_next(const VertexOptimizer& optimize) {
     }
   }
 
+  std::vector<int> ring;
+  for (int id : star_[c.removed]) {
+    for (int w : triangles_[id]) {
+      if (w != c.removed && !fixed_[w] && std::find(ring.begin(), ring.end(), w) == ring.end()) ring.push_back(w);
+    }
+  }
   if (optimize) {
     optimize(c.removed, star_[c.removed]);
     check_star(c.removed, "by the optimizer");
-    std::vector<int> ring;
-    for (int id : star_[c.removed]) {
-      for (int w : triangles_[id]) {
-        if (w != c.removed && !fixed_[w] && std::find(ring.begin(), ring.end(), w) == ring.end()) ring.push_back(w);
-      }
-    }
     for (int w : ring) {
       optimize(w, star_[w]);
       check_star(w, "by the optimizer");
     }
   }
+  // Boundary vertices left off their chord-length position get another chance when their ring changes.
+  if (num_off_chord_ != 0) {
+    for (int w : ring) retry_off_chord(w);
+  }
   ++done_;
+  if (finished() && num_off_chord_ != 0) {
+    for (int w = 0; w < static_cast<int>(off_chord_.size()); ++w) retry_off_chord(w);
+  }
   return c.removed;
 }
 
@@ -291,7 +319,7 @@ CoarseToFineResult CoarseToFine::result() const {
   CoarseToFineResult r;
   r.uv = uv_;
   r.triangles = patch_.triangles;
-  r.boundary_off_chord = boundary_off_chord_;
+  r.boundary_off_chord = num_off_chord_;
   r.min_area2 = std::numeric_limits<double>::infinity();
   for (std::size_t id = 0; id < patch_.triangles.size(); ++id) {
     // The replay must land on the patch's own triangles (up to a rotation of the corners).

@@ -30,8 +30,8 @@ struct CoarseToFineOptions {
 struct CoarseToFineResult {
   std::vector<Eigen::Vector2d> uv;              ///< (u, v) ∈ [0,1]² for every patch vertex
   std::vector<std::array<int, 3>> triangles;    ///< the full patch's triangles (the input's, in its order)
-  /// Boundary vertices that could not go to their chord-length position (that of `square_boundary_uv()` on
-  /// the full patch) without flipping a triangle, and went elsewhere between their boundary neighbours.
+  /// Boundary vertices that are not at their chord-length position (that of `square_boundary_uv()` on the
+  /// full patch) because every attempt to put them there would have flipped a triangle.
   std::size_t boundary_off_chord = 0;
   double min_area2 = 0.0;                       ///< smallest doubled parameter area over the triangles
 };
@@ -46,8 +46,9 @@ struct CoarseToFineResult {
 ///   closure), so no triangle flips;
 /// - a boundary vertex goes on its side, between its two boundary neighbours, to its chord-length position
 ///   (3D arc length along the side of the full patch, as `square_boundary_uv()` places it) when that flips no
-///   triangle; otherwise to the point nearest to it that keeps a quarter of the admissible part of the segment
-///   (where no triangle flips) on either side. Either way the side stays monotone.
+///   triangle; otherwise to the point nearest to it that keeps a quarter of the admissible part of the side
+///   (where no triangle flips) on either side, and it moves on to its chord-length position as soon as a
+///   later split in its ring (or the last split) allows it. Either way the side stays monotone.
 /// Corners and feature vertices are never removed, so they keep their base-mesh parameters throughout.
 /// Every step is local: O(valence²) per split plus the callbacks. The object keeps references to `patch` and
 /// `pm`: they must outlive it.
@@ -94,6 +95,8 @@ class CoarseToFine {
  private:
   void insert_interior(int v, int kept);
   void insert_boundary(const HalfEdgeCollapse& c);
+  bool place_on_side(int v);
+  void retry_off_chord(int v);
   void check_star(int v, const char* when) const;
   double side_arclength(int side, int v) const;
 
@@ -108,7 +111,8 @@ class CoarseToFine {
   std::vector<double> arclength_;     // 3D arc length from its side's first corner (non-corner boundary)
   std::array<double, 4> side_length_{};
   std::size_t done_ = 0;
-  std::size_t boundary_off_chord_ = 0;
+  std::vector<char> off_chord_;       // boundary vertices not (yet) at their chord-length position
+  std::size_t num_off_chord_ = 0;
 };
 
 /// Convenience: the whole coarse-to-fine pass without an optimizer (pure kernel-centroid insertion).

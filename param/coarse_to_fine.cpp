@@ -17,7 +17,9 @@ constexpr double kOnSideTolerance = 1e-12;
   throw InvalidInput(std::string(function) + ": " + what);
 }
 
-double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 /// Twice the signed area of (p, x, y).
 double orient(const Eigen::Vector2d& p, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
@@ -68,15 +70,16 @@ const Eigen::Vector2d kSquareCorner[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
 
 }  // namespace
 
-CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm, const std::vector<Eigen::Vector2d>& base_uv,
-                           const CoarseToFineOptions& options)
+CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm,
+                           const std::vector<Eigen::Vector2d>& base_uv, const CoarseToFineOptions& options)
     : patch_(patch), pm_(pm), options_(options) {
   constexpr const char* kFn = "CoarseToFine";
   const std::size_t n = patch.positions.size();
   if (pm.num_vertices != n || pm.num_triangles != patch.triangles.size()) {
     fail(kFn, "the progressive mesh was not built from this patch");
   }
-  if (base_uv.size() != n) fail(kFn, "base_uv has " + std::to_string(base_uv.size()) + " entries, not " + std::to_string(n));
+  if (base_uv.size() != n)
+    fail(kFn, "base_uv has " + std::to_string(base_uv.size()) + " entries, not " + std::to_string(n));
   const double kNan = std::numeric_limits<double>::quiet_NaN();
   uv_.assign(n, Eigen::Vector2d(kNan, kNan));
   for (int v : pm.base_vertices) {
@@ -88,7 +91,8 @@ CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm, cons
   star_.assign(n, {});
   for (std::size_t i = 0; i < pm.base_triangles.size(); ++i) {
     const int id = pm.base_triangle_ids[i];
-    if (id < 0 || static_cast<std::size_t>(id) >= triangles_.size()) fail(kFn, "base triangle id out of range");
+    if (id < 0 || static_cast<std::size_t>(id) >= triangles_.size())
+      fail(kFn, "base triangle id out of range");
     triangles_[id] = pm.base_triangles[i];
     for (int v : pm.base_triangles[i]) {
       if (v < 0 || static_cast<std::size_t>(v) >= n || !uv_[v].allFinite()) {
@@ -143,7 +147,8 @@ double CoarseToFine::side_arclength(int side, int v) const {
 
 void CoarseToFine::insert_interior(int v, int kept) {
   // Kernel of the neighbourhood polygon: the unit square clipped to the left of every edge (x, y) opposite v.
-  std::vector<Eigen::Vector2d> kernel = {kSquareCorner[0], kSquareCorner[1], kSquareCorner[2], kSquareCorner[3]};
+  std::vector<Eigen::Vector2d> kernel = {kSquareCorner[0], kSquareCorner[1], kSquareCorner[2],
+                                         kSquareCorner[3]};
   std::vector<Eigen::Vector2d> scratch;
   for (int id : star_[v]) {
     const auto [x, y] = opposite_edge(triangles_[id], v);
@@ -221,7 +226,8 @@ void CoarseToFine::insert_boundary(const HalfEdgeCollapse& c) {
   const double sa = side_arclength(side, c.kept), sb = side_arclength(side, c.boundary_neighbor);
   const double sv = arclength_[v];
   if (!((sv - sa) * (sb - sv) > 0.0)) {
-    throw SolverFailure("CoarseToFine: boundary vertex " + std::to_string(v) + " is not between its neighbours");
+    throw SolverFailure("CoarseToFine: boundary vertex " + std::to_string(v) +
+                        " is not between its neighbours");
   }
   if (!place_on_side(v)) {
     if (!uv_[v].allFinite()) {
@@ -262,7 +268,9 @@ int CoarseToFine::split_next(const VertexOptimizer& optimize) {
   apply_vertex_split(c, triangles_);
   auto& kept_star = star_[c.kept];
   for (int id : c.moved_triangles) {
-    kept_star.erase(std::find(kept_star.begin(), kept_star.end(), id));
+    const auto it = std::find(kept_star.begin(), kept_star.end(), id);
+    if (it == kept_star.end()) throw SolverFailure("CoarseToFine: vertex-triangle adjacency out of sync");
+    kept_star.erase(it);
     star_[c.removed].push_back(id);
   }
   for (int id : {c.left_triangle, c.right_triangle}) {
@@ -288,7 +296,8 @@ int CoarseToFine::split_next(const VertexOptimizer& optimize) {
   std::vector<int> ring;
   for (int id : star_[c.removed]) {
     for (int w : triangles_[id]) {
-      if (w != c.removed && !fixed_[w] && std::find(ring.begin(), ring.end(), w) == ring.end()) ring.push_back(w);
+      if (w != c.removed && !fixed_[w] && std::find(ring.begin(), ring.end(), w) == ring.end())
+        ring.push_back(w);
     }
   }
   if (optimize) {
@@ -326,14 +335,16 @@ CoarseToFineResult CoarseToFine::result() const {
     auto t = triangles_[id], u = patch_.triangles[id];
     std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
     std::rotate(u.begin(), std::min_element(u.begin(), u.end()), u.end());
-    if (t != u) throw SolverFailure("CoarseToFine: the vertex splits did not rebuild triangle " + std::to_string(id));
+    if (t != u)
+      throw SolverFailure("CoarseToFine: the vertex splits did not rebuild triangle " + std::to_string(id));
     r.min_area2 = std::min(r.min_area2, signed_uv_area2(uv_, patch_.triangles[id]));
   }
   return r;
 }
 
 CoarseToFineResult coarse_to_fine(const TriMesh& patch, const ProgressiveMesh& pm,
-                                  const std::vector<Eigen::Vector2d>& base_uv, const CoarseToFineOptions& options) {
+                                  const std::vector<Eigen::Vector2d>& base_uv,
+                                  const CoarseToFineOptions& options) {
   CoarseToFine c2f(patch, pm, base_uv, options);
   c2f.refine_all();
   return c2f.result();

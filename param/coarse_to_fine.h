@@ -15,10 +15,11 @@
 namespace geomip {
 
 /// Called after each vertex insertion, first on the new vertex and then on each of its neighbours that is
-/// neither a corner nor a feature vertex. `ring_triangles` are the ids of the triangles around `vertex` at the
-/// current level (read their corners with `CoarseToFine::triangle()`). The callback may move `vertex`, and only
-/// `vertex`, through `CoarseToFine::uv()`; a boundary vertex must stay on its side. CoarseToFine checks after
-/// every call that no triangle around `vertex` is flipped or degenerate and throws SolverFailure if one is.
+/// neither a corner nor a feature vertex. `ring_triangles` are the ids of the triangles around `vertex` at
+/// the current level (read their corners with `CoarseToFine::triangle()`). The callback may move `vertex`,
+/// and only `vertex`, through `CoarseToFine::uv()`; a boundary vertex must stay on its side. CoarseToFine
+/// checks after every call that no triangle around `vertex` is flipped or degenerate and throws SolverFailure
+/// if one is.
 using VertexOptimizer = std::function<void(int vertex, const std::vector<int>& ring_triangles)>;
 
 struct CoarseToFineOptions {
@@ -28,16 +29,17 @@ struct CoarseToFineOptions {
 };
 
 struct CoarseToFineResult {
-  std::vector<Eigen::Vector2d> uv;              ///< (u, v) ∈ [0,1]² for every patch vertex
-  std::vector<std::array<int, 3>> triangles;    ///< the full patch's triangles (the input's, in its order)
+  std::vector<Eigen::Vector2d> uv;            ///< (u, v) ∈ [0,1]² for every patch vertex
+  std::vector<std::array<int, 3>> triangles;  ///< the full patch's triangles (the input's, in its order)
   /// Boundary vertices that are not at their chord-length position (that of `square_boundary_uv()` on the
   /// full patch) because every attempt to put them there would have flipped a triangle.
   std::size_t boundary_off_chord = 0;
-  double min_area2 = 0.0;                       ///< smallest doubled parameter area over the triangles
+  double min_area2 = 0.0;  ///< smallest doubled parameter area over the triangles
 };
 
-/// The coarse-to-fine state: the current level of a patch's progressive mesh and its parameterization. A class
-/// because the stretch optimizer works on this state between insertions (through `uv()` and `triangle()`).
+/// The coarse-to-fine state: the current level of a patch's progressive mesh and its parameterization. A
+/// class because the stretch optimizer works on this state between insertions (through `uv()` and
+/// `triangle()`).
 ///
 /// Each vertex split re-inserts the removed vertex v2 of one collapse (in reverse collapse order):
 /// - an interior vertex goes to the area centroid of the kernel of its neighbourhood polygon, i.e. of the
@@ -58,10 +60,11 @@ class CoarseToFine {
   ///               chord lengths along the sides)
   /// \param pm     its progressive mesh (`progressive_mesh(patch, ...)`)
   /// \param base_uv  (u, v) per patch vertex; read for `pm.base_vertices` only. The base mesh must be an
-  ///               embedding in the unit square with corner k at (0,0), (1,0), (1,1), (0,1) for k = 0..3 and the
-  ///               base boundary vertices on their sides, e.g. `mean_value_embedding()` of the base triangles
-  ///               with `square_boundary_uv()` of `pm.sides`.
-  /// \throw InvalidInput if sizes disagree, `pm` does not fit `patch`, or the base mesh has a flipped triangle
+  ///               embedding in the unit square with corner k at (0,0), (1,0), (1,1), (0,1) for k = 0..3 and
+  ///               the base boundary vertices on their sides, e.g. `mean_value_embedding()` of the base
+  ///               triangles with `square_boundary_uv()` of `pm.sides`.
+  /// \throw InvalidInput if sizes disagree, `pm` does not fit `patch`, or the base mesh has a flipped
+  /// triangle
   ///        or a corner off its place.
   CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm, const std::vector<Eigen::Vector2d>& base_uv,
                const CoarseToFineOptions& options = {});
@@ -106,18 +109,19 @@ class CoarseToFine {
   std::vector<Eigen::Vector2d> uv_;
   std::vector<std::array<int, 3>> triangles_;
   std::vector<std::vector<int>> star_;
-  std::vector<char> fixed_;           // corners and features: never passed to the optimizer
-  std::vector<int> side_of_;          // side of a non-corner boundary vertex, -1 elsewhere
-  std::vector<double> arclength_;     // 3D arc length from its side's first corner (non-corner boundary)
+  std::vector<char> fixed_;        // corners and features: never passed to the optimizer
+  std::vector<int> side_of_;       // side of a non-corner boundary vertex, -1 elsewhere
+  std::vector<double> arclength_;  // 3D arc length from its side's first corner (non-corner boundary)
   std::array<double, 4> side_length_{};
   std::size_t done_ = 0;
-  std::vector<char> off_chord_;       // boundary vertices not (yet) at their chord-length position
+  std::vector<char> off_chord_;  // boundary vertices not (yet) at their chord-length position
   std::size_t num_off_chord_ = 0;
 };
 
 /// Convenience: the whole coarse-to-fine pass without an optimizer (pure kernel-centroid insertion).
 /// Same arguments and exceptions as `CoarseToFine`.
 CoarseToFineResult coarse_to_fine(const TriMesh& patch, const ProgressiveMesh& pm,
-                                  const std::vector<Eigen::Vector2d>& base_uv, const CoarseToFineOptions& options = {});
+                                  const std::vector<Eigen::Vector2d>& base_uv,
+                                  const CoarseToFineOptions& options = {});
 
 }  // namespace geomip

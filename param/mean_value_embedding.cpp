@@ -42,7 +42,8 @@ std::vector<FixedUv> square_boundary_uv(const std::vector<Eigen::Vector3d>& posi
       if (v < 0 || v >= n) fail(kFn, "vertex id out of range");
     }
     std::vector<double> s(side.size(), 0.0);
-    for (std::size_t i = 1; i < side.size(); ++i) s[i] = s[i - 1] + (positions[side[i]] - positions[side[i - 1]]).norm();
+    for (std::size_t i = 1; i < side.size(); ++i)
+      s[i] = s[i - 1] + (positions[side[i]] - positions[side[i - 1]]).norm();
     const double length = s.back();
     if (!(length > 0.0)) fail(kFn, "side " + std::to_string(k) + " has zero length");
     const Eigen::Vector2d a = kCorner[k], b = kCorner[(k + 1) % 4];
@@ -133,7 +134,8 @@ MeanValueEmbeddingResult mean_value_embedding(const std::vector<Eigen::Vector3d>
     }
   }
   for (int r = 0; r < m; ++r) {
-    if (!(row_sum[r] > 0.0)) throw SolverFailure(std::string(kFn) + ": a vertex has only zero-angle triangles");
+    if (!(row_sum[r] > 0.0))
+      throw SolverFailure(std::string(kFn) + ": a vertex has only zero-angle triangles");
     entries.emplace_back(r, r, row_sum[r]);
   }
   Eigen::SparseMatrix<double> matrix(m, m);
@@ -165,7 +167,7 @@ double signed_uv_area2(const std::vector<Eigen::Vector2d>& uv, const std::array<
 }
 
 std::size_t count_flipped_triangles(const std::vector<Eigen::Vector2d>& uv,
-                                   const std::vector<std::array<int, 3>>& triangles) {
+                                    const std::vector<std::array<int, 3>>& triangles) {
   std::size_t flipped = 0;
   for (const auto& t : triangles) {
     if (t[0] < 0) continue;

@@ -52,8 +52,8 @@ struct MeanValueEmbeddingResult {
 /// \param positions  3D positions (any unit)
 /// \param triangles  counter-clockwise triangles indexing `positions`; need not reference every vertex
 /// \param fixed      fixed parameters; ids not referenced by `triangles` are copied to the result as well
-/// \pre every vertex on a boundary edge of `triangles` is fixed; no triangle has two coincident corners in 3D.
-/// \throw InvalidInput if an id is out of range, a vertex is fixed twice, a boundary vertex is free, or a
+/// \pre every vertex on a boundary edge of `triangles` is fixed; no triangle has two coincident corners in
+/// 3D. \throw InvalidInput if an id is out of range, a vertex is fixed twice, a boundary vertex is free, or a
 ///        triangle has a zero-length edge; SolverFailure if the factorisation fails.
 MeanValueEmbeddingResult mean_value_embedding(const std::vector<Eigen::Vector3d>& positions,
                                               const std::vector<std::array<int, 3>>& triangles,
@@ -66,6 +66,6 @@ double signed_uv_area2(const std::vector<Eigen::Vector2d>& uv, const std::array<
 /// Number of triangles whose parameter area is ≤ 0 (flipped or degenerate); triangles with a negative id
 /// (absent at a level of a progressive mesh) are skipped.
 std::size_t count_flipped_triangles(const std::vector<Eigen::Vector2d>& uv,
-                                   const std::vector<std::array<int, 3>>& triangles);
+                                    const std::vector<std::array<int, 3>>& triangles);
 
 }  // namespace geomip

@@ -68,7 +68,8 @@ void require_disk(const char* function, const TriMesh& patch) {
   if (topo.unreferenced_vertices != 0) {
     fail(function, std::to_string(topo.unreferenced_vertices) + " unreferenced vertices");
   }
-  if (topo.degenerate_faces != 0) fail(function, std::to_string(topo.degenerate_faces) + " degenerate triangles");
+  if (topo.degenerate_faces != 0)
+    fail(function, std::to_string(topo.degenerate_faces) + " degenerate triangles");
 }
 
 /// Checks that `sides` is exactly the boundary loop of `patch` cut at four distinct corners, and that no
@@ -141,7 +142,8 @@ class ModPatchLocksT : public OpenMesh::Decimater::ModBaseT<MeshT> {
       // Boundary straightness, and the vertex stays on its own side.
       if (!m.is_boundary(m.edge_handle(ci.v0v1)) || (m0 & m1) == 0) return Base::ILLEGAL_COLLAPSE;
       for (auto h : m.voh_range(ci.v0)) {
-        if (m.is_boundary(m.edge_handle(h)) && m.to_vertex_handle(h) != ci.v1) other = m.to_vertex_handle(h).idx();
+        if (m.is_boundary(m.edge_handle(h)) && m.to_vertex_handle(h) != ci.v1)
+          other = m.to_vertex_handle(h).idx();
       }
     }
     if (m1 == 0) return Base::LEGAL_COLLAPSE;
@@ -162,17 +164,18 @@ class ModPatchLocksT : public OpenMesh::Decimater::ModBaseT<MeshT> {
 
 /// OpenMesh's decimation framework (BaseDecimaterT: the modules and their priorities) driven by our own loop,
 /// which is DecimaterT::decimate_to() with three changes: it records every collapse for the vertex splits; it
-/// breaks priority ties by vertex id so that the result does not depend on heap internals; and its topological
-/// test is BaseDecimaterT::is_collapse_legal() with TriConnectivity::is_collapse_ok() done on a reusable mark
-/// array (OpenMesh 9's allocates on every call, which made it ~60% of the run time). DecimaterT itself would
-/// also pull in libOpenMeshTools for its observer.
+/// breaks priority ties by vertex id so that the result does not depend on heap internals; and its
+/// topological test is BaseDecimaterT::is_collapse_legal() with TriConnectivity::is_collapse_ok() done on a
+/// reusable mark array (OpenMesh 9's allocates on every call, which made it ~60% of the run time). DecimaterT
+/// itself would also pull in libOpenMeshTools for its observer.
 class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
  public:
   using Base = OpenMesh::Decimater::BaseDecimaterT<PmMesh>;
   explicit RecordingDecimater(PmMesh& mesh) : Base(mesh), mesh_(mesh) {}
 
   /// Collapses until `target` vertices remain or no legal collapse is left; appends to `log`.
-  void decimate_to(std::size_t target, const std::vector<std::uint8_t>& side_mask, std::vector<HalfEdgeCollapse>& log) {
+  void decimate_to(std::size_t target, const std::vector<std::uint8_t>& side_mask,
+                   std::vector<HalfEdgeCollapse>& log) {
     std::size_t alive = mesh_.n_vertices();
     stamp_.assign(mesh_.n_vertices(), 0);
     mark_.assign(mesh_.n_vertices(), 0);
@@ -240,14 +243,16 @@ class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
     if (!mesh_.is_boundary(h)) {
       const auto h1 = mesh_.next_halfedge_handle(h), h2 = mesh_.next_halfedge_handle(h1);
       vl = mesh_.to_vertex_handle(h1);
-      if (mesh_.is_boundary(mesh_.opposite_halfedge_handle(h1)) && mesh_.is_boundary(mesh_.opposite_halfedge_handle(h2))) {
+      if (mesh_.is_boundary(mesh_.opposite_halfedge_handle(h1)) &&
+          mesh_.is_boundary(mesh_.opposite_halfedge_handle(h2))) {
         return false;
       }
     }
     if (!mesh_.is_boundary(o)) {
       const auto h1 = mesh_.next_halfedge_handle(o), h2 = mesh_.next_halfedge_handle(h1);
       vr = mesh_.to_vertex_handle(h1);
-      if (mesh_.is_boundary(mesh_.opposite_halfedge_handle(h1)) && mesh_.is_boundary(mesh_.opposite_halfedge_handle(h2))) {
+      if (mesh_.is_boundary(mesh_.opposite_halfedge_handle(h1)) &&
+          mesh_.is_boundary(mesh_.opposite_halfedge_handle(h2))) {
         return false;
       }
     }
@@ -260,7 +265,8 @@ class RecordingDecimater : public OpenMesh::Decimater::BaseDecimaterT<PmMesh> {
     for (auto w : mesh_.vv_range(ci.v0)) {
       if (mark_[w.idx()] == mark_stamp_ && w != vl && w != vr) return false;  // a third common neighbour
     }
-    return !(mesh_.is_boundary(ci.v0) && mesh_.is_boundary(ci.v1) && !mesh_.is_boundary(h) && !mesh_.is_boundary(o));
+    return !(mesh_.is_boundary(ci.v0) && mesh_.is_boundary(ci.v1) && !mesh_.is_boundary(h) &&
+             !mesh_.is_boundary(o));
   }
 
   /// BaseDecimaterT::is_collapse_legal() with the fast collapse_ok() (no locked/feature status is used here:
@@ -341,8 +347,8 @@ PatchSides patch_sides(const TriMesh& patch, const std::array<int, 4>& corners) 
   return sides;
 }
 
-ProgressiveMesh progressive_mesh(const TriMesh& patch, const PatchSides& sides, const std::vector<int>& features,
-                                 const ProgressiveMeshOptions& options) {
+ProgressiveMesh progressive_mesh(const TriMesh& patch, const PatchSides& sides,
+                                 const std::vector<int>& features, const ProgressiveMeshOptions& options) {
   constexpr const char* kFn = "progressive_mesh";
   require_disk(kFn, patch);
   const int n = static_cast<int>(patch.positions.size());
@@ -357,10 +363,12 @@ ProgressiveMesh progressive_mesh(const TriMesh& patch, const PatchSides& sides, 
   const std::size_t num_locked = static_cast<std::size_t>(std::count(locked.begin(), locked.end(), 1));
 
   PmMesh mesh;
-  mesh.reserve(patch.positions.size(), patch.positions.size() + patch.triangles.size(), patch.triangles.size());
+  mesh.reserve(patch.positions.size(), patch.positions.size() + patch.triangles.size(),
+               patch.triangles.size());
   for (const auto& p : patch.positions) mesh.add_vertex(PmMesh::Point(p.x(), p.y(), p.z()));
   for (const auto& t : patch.triangles) {
-    const auto f = mesh.add_face(PmMesh::VertexHandle(t[0]), PmMesh::VertexHandle(t[1]), PmMesh::VertexHandle(t[2]));
+    const auto f =
+        mesh.add_face(PmMesh::VertexHandle(t[0]), PmMesh::VertexHandle(t[1]), PmMesh::VertexHandle(t[2]));
     if (!f.is_valid()) fail(kFn, "OpenMesh rejected a triangle (complex edge or vertex)");
   }
   // Held across the decimater's lifetime so that the deleted flags survive its destructor.
@@ -391,7 +399,8 @@ ProgressiveMesh progressive_mesh(const TriMesh& patch, const PatchSides& sides, 
       decimater.add(normals);
       decimater.module(normals).set_max_normal_deviation(options.max_normal_deviation_degrees);
     }
-    if (!decimater.initialize()) throw SolverFailure(std::string(kFn) + ": OpenMesh decimater did not initialize");
+    if (!decimater.initialize())
+      throw SolverFailure(std::string(kFn) + ": OpenMesh decimater did not initialize");
     pm.collapses.reserve(pm.num_vertices - target);
     decimater.decimate_to(target, mask, pm.collapses);
   }
@@ -417,7 +426,8 @@ void apply_vertex_split(const HalfEdgeCollapse& c, std::vector<std::array<int, 3
     if (id < 0 || id >= nt) fail(kFn, "triangle id out of range");
     auto& t = triangles[id];
     auto it = std::find(t.begin(), t.end(), c.kept);
-    if (it == t.end()) fail(kFn, "moved triangle " + std::to_string(id) + " does not contain the kept vertex");
+    if (it == t.end())
+      fail(kFn, "moved triangle " + std::to_string(id) + " does not contain the kept vertex");
     *it = c.removed;
   }
   auto revive = [&](int id, std::array<int, 3> t) {

@@ -36,8 +36,9 @@ struct ProgressiveMeshOptions {
 /// One half-edge collapse (v1, v2) → v1 of the paper, read backwards: the vertex split that undoes it.
 /// Vertex ids are the patch's, triangle ids are indices into the patch's `triangles`.
 struct HalfEdgeCollapse {
-  int removed = -1;  ///< v2 in the paper (OpenMesh's v0): the vertex the collapse removes, the split re-inserts
-  int kept = -1;     ///< v1: the vertex `removed` is merged into; it keeps its position (and parameter)
+  int removed =
+      -1;         ///< v2 in the paper (OpenMesh's v0): the vertex the collapse removes, the split re-inserts
+  int kept = -1;  ///< v1: the vertex `removed` is merged into; it keeps its position (and parameter)
   /// Wing vertices. The triangle (removed, kept, left) lies left of the half-edge removed→kept and
   /// (kept, removed, right) right of it, both in counter-clockwise order; the collapse deletes them. -1 where
   /// the half-edge (or its opposite) is a boundary half-edge and has no triangle.
@@ -55,15 +56,15 @@ struct HalfEdgeCollapse {
 
 /// A patch's progressive mesh: the base mesh plus the collapses that lead to it.
 struct ProgressiveMesh {
-  std::size_t num_vertices = 0;              ///< vertices of the full patch
-  std::size_t num_triangles = 0;             ///< triangles of the full patch
-  std::vector<int> base_vertices;            ///< patch vertex ids that survive in the base mesh, ascending
+  std::size_t num_vertices = 0;    ///< vertices of the full patch
+  std::size_t num_triangles = 0;   ///< triangles of the full patch
+  std::vector<int> base_vertices;  ///< patch vertex ids that survive in the base mesh, ascending
   std::vector<std::array<int, 3>> base_triangles;  ///< base mesh triangles, counter-clockwise, patch ids
-  std::vector<int> base_triangle_ids;        ///< base_triangles[i] is what triangle base_triangle_ids[i] became
+  std::vector<int> base_triangle_ids;  ///< base_triangles[i] is what triangle base_triangle_ids[i] became
   /// The collapses in the order they were applied (fine → coarse). Vertex splits undo them in reverse order.
   std::vector<HalfEdgeCollapse> collapses;
-  PatchSides sides;                          ///< of the full patch, as given
-  std::vector<int> features;                 ///< feature vertex ids, as given
+  PatchSides sides;           ///< of the full patch, as given
+  std::vector<int> features;  ///< feature vertex ids, as given
 };
 
 /// Simplifies `patch` by half-edge collapses ordered by the quadric error metric (Garland–Heckbert 1997,
@@ -82,21 +83,22 @@ struct ProgressiveMesh {
 /// \pre `patch` is a manifold disk without unreferenced vertices or zero-area triangles, `sides` covers its
 ///      boundary loop, and no interior edge joins two vertices of one side.
 /// \throw InvalidInput if a precondition is violated (the message names it).
-ProgressiveMesh progressive_mesh(const TriMesh& patch, const PatchSides& sides, const std::vector<int>& features,
+ProgressiveMesh progressive_mesh(const TriMesh& patch, const PatchSides& sides,
+                                 const std::vector<int>& features,
                                  const ProgressiveMeshOptions& options = {});
 
 /// Applies the vertex split that undoes `collapse` to `triangles` (indexed by triangle id, {-1,-1,-1} for a
-/// triangle that does not exist at the current level): `kept` becomes `removed` in the moved triangles and the
-/// wing triangles reappear. O(number of triangles around `removed`).
-/// \throw InvalidInput if `triangles` is not at the level right after `collapse` (a moved triangle lacks
+/// triangle that does not exist at the current level): `kept` becomes `removed` in the moved triangles and
+/// the wing triangles reappear. O(number of triangles around `removed`). \throw InvalidInput if `triangles`
+/// is not at the level right after `collapse` (a moved triangle lacks
 ///        `kept`, a wing triangle already exists, or an id is out of range).
 void apply_vertex_split(const HalfEdgeCollapse& collapse, std::vector<std::array<int, 3>>& triangles);
 
 /// The triangles of the progressive mesh after the first `num_splits` vertex splits (undoing the last
 /// `num_splits` collapses), indexed by triangle id: entry i is triangle i at that level, or {-1,-1,-1} where
-/// triangle i does not exist yet. `num_splits` = pm.collapses.size() gives the full patch (each triangle up to
-/// a rotation of its corners). O(F + number of splits).
-/// \throw InvalidInput if `num_splits` exceeds the number of collapses or `pm` is inconsistent.
+/// triangle i does not exist yet. `num_splits` = pm.collapses.size() gives the full patch (each triangle up
+/// to a rotation of its corners). O(F + number of splits). \throw InvalidInput if `num_splits` exceeds the
+/// number of collapses or `pm` is inconsistent.
 std::vector<std::array<int, 3>> triangles_after_splits(const ProgressiveMesh& pm, std::size_t num_splits);
 
 }  // namespace geomip

@@ -12,9 +12,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <functional>
-#include <cmath>
 #include <map>
 #include <numeric>
 #include <random>
@@ -23,7 +23,9 @@
 namespace geomip {
 namespace {
 
-std::array<int, 4> grid_corners(int n) { return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)}; }
+std::array<int, 4> grid_corners(int n) {
+  return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)};
+}
 
 /// Jittered grid lifted onto a saddle with a narrow bump: a strongly curved disk.
 TriMesh curved(int n, unsigned seed = 5) {
@@ -54,8 +56,9 @@ Pipeline make_pipeline(TriMesh patch, const PatchSides& sides, std::vector<int> 
   p.sides = sides;
   p.features = std::move(features);
   p.pm = progressive_mesh(p.patch, p.sides, p.features);
-  p.base_uv =
-      mean_value_embedding(p.patch.positions, p.pm.base_triangles, square_boundary_uv(p.patch.positions, p.sides)).uv;
+  p.base_uv = mean_value_embedding(p.patch.positions, p.pm.base_triangles,
+                                   square_boundary_uv(p.patch.positions, p.sides))
+                  .uv;
   return p;
 }
 
@@ -255,10 +258,12 @@ TEST(CoarseToFine, RejectsABaseEmbeddingThatDoesNotFit) {
   EXPECT_THROW(c2f.result(), InvalidInput);  // not finished
 }
 
-// ---- real meshes ----------------------------------------------------------------------------------------------
+// ---- real meshes
+// ----------------------------------------------------------------------------------------------
 
-/// Faces of `mesh` whose centroid lies below (`lower`) or above the median along `axis`, cleaned into a disk: the largest edge-connected piece,
-/// without triangles whose three corners are all on the boundary (ears of the cut), repeated until stable.
+/// Faces of `mesh` whose centroid lies below (`lower`) or above the median along `axis`, cleaned into a disk:
+/// the largest edge-connected piece, without triangles whose three corners are all on the boundary (ears of
+/// the cut), repeated until stable.
 TriMesh half_disk(const TriMesh& mesh, int axis, bool lower) {
   std::vector<double> xs;
   for (const auto& t : mesh.triangles) {
@@ -348,7 +353,9 @@ double run_real_half(const TriMesh& half, const std::string& name) {
   for (std::size_t offset = 0; offset < 16; ++offset) {
     PatchSides sides = patch_sides(half, loop_corners(half, offset));
     using Clock = std::chrono::steady_clock;
-    auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    auto seconds_since = [](Clock::time_point t) {
+      return std::chrono::duration<double>(Clock::now() - t).count();
+    };
     const auto start = Clock::now();
     Pipeline p;
     p.patch = half;
@@ -360,8 +367,9 @@ double run_real_half(const TriMesh& half, const std::string& name) {
     }
     const double pm_seconds = seconds_since(start);
     const auto mvc_start = Clock::now();
-    p.base_uv =
-        mean_value_embedding(p.patch.positions, p.pm.base_triangles, square_boundary_uv(p.patch.positions, sides)).uv;
+    p.base_uv = mean_value_embedding(p.patch.positions, p.pm.base_triangles,
+                                     square_boundary_uv(p.patch.positions, sides))
+                    .uv;
     const double mvc_seconds = seconds_since(mvc_start);
     const auto c2f_start = Clock::now();
     const CoarseToFineResult r = coarse_to_fine(p.patch, p.pm, p.base_uv);
@@ -382,10 +390,11 @@ double run_real_half(const TriMesh& half, const std::string& name) {
     const double full_seconds = seconds_since(full_start);
     EXPECT_EQ(count_flipped_triangles(full.uv, p.patch.triangles), 0u);
     EXPECT_LT(full.residual, 1e-9);
-    std::printf("%s: %zu vertices, %zu triangles, base %zu vertices, %zu boundary vertices off chord; "
-                "PM %.3f s + MVC %.3f s + coarse-to-fine %.3f s = %.3f s (MVC of the full patch: %.3f s)\n",
-                name.c_str(), half.num_vertices(), half.num_triangles(), p.pm.base_vertices.size(),
-                r.boundary_off_chord, pm_seconds, mvc_seconds, c2f_seconds, seconds, full_seconds);
+    std::printf(
+        "%s: %zu vertices, %zu triangles, base %zu vertices, %zu boundary vertices off chord; "
+        "PM %.3f s + MVC %.3f s + coarse-to-fine %.3f s = %.3f s (MVC of the full patch: %.3f s)\n",
+        name.c_str(), half.num_vertices(), half.num_triangles(), p.pm.base_vertices.size(),
+        r.boundary_off_chord, pm_seconds, mvc_seconds, c2f_seconds, seconds, full_seconds);
     return seconds;
   }
   ADD_FAILURE() << name << ": no corner placement without a one-side chord";
@@ -411,13 +420,15 @@ TEST(CoarseToFineReal, BunnyHalvesInACoupleOfSeconds) {
     return t.manifold && t.components == 1 && t.boundary_loops == 1 && t.genus == 0;
   };
   int axis = 0;
-  while (axis < 3 && !(is_disk(half_disk(bunny, axis, true)) && is_disk(half_disk(bunny, axis, false)))) ++axis;
+  while (axis < 3 && !(is_disk(half_disk(bunny, axis, true)) && is_disk(half_disk(bunny, axis, false))))
+    ++axis;
   ASSERT_LT(axis, 3) << "no median plane cuts the bunny into two disks";
   double seconds = 0;
   for (bool lower : {true, false}) {
     const TriMesh half = half_disk(bunny, axis, lower);
     EXPECT_GE(half.num_triangles(), 30000u);
-    seconds += run_real_half(half, std::string("bunny, axis ") + "xyz"[axis] + (lower ? " lower half" : " upper half"));
+    seconds += run_real_half(
+        half, std::string("bunny, axis ") + "xyz"[axis] + (lower ? " lower half" : " upper half"));
   }
   EXPECT_LT(seconds, 3.0);  // PM + MVC + insertion for both; generous for a loaded machine
 }

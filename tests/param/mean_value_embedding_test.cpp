@@ -13,7 +13,9 @@
 namespace geomip {
 namespace {
 
-std::array<int, 4> grid_corners(int n) { return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)}; }
+std::array<int, 4> grid_corners(int n) {
+  return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)};
+}
 
 /// The grid with its interior vertices moved randomly in the plane (still a valid planar triangulation).
 TriMesh jittered_grid(int n, unsigned seed) {
@@ -60,7 +62,8 @@ TEST(MeanValueEmbedding, ReproducesAPlanarTriangulationOfTheSquare) {
   // is its own parameterization, however irregular.
   for (const TriMesh& g : {test::grid(20), jittered_grid(20, 3)}) {
     const PatchSides sides = patch_sides(g, grid_corners(20));
-    const auto result = mean_value_embedding(g.positions, g.triangles, square_boundary_uv(g.positions, sides));
+    const auto result =
+        mean_value_embedding(g.positions, g.triangles, square_boundary_uv(g.positions, sides));
     EXPECT_EQ(result.free_vertices, 19u * 19u);
     EXPECT_LT(result.residual, 1e-12);
     for (std::size_t v = 0; v < g.positions.size(); ++v) {
@@ -102,7 +105,8 @@ TEST(MeanValueEmbedding, EmbedsABaseMeshInThePatchIdSpace) {
   const TriMesh m = curved(n);
   const PatchSides sides = patch_sides(m, grid_corners(n));
   const ProgressiveMesh pm = progressive_mesh(m, sides, {});
-  const auto result = mean_value_embedding(m.positions, pm.base_triangles, square_boundary_uv(m.positions, sides));
+  const auto result =
+      mean_value_embedding(m.positions, pm.base_triangles, square_boundary_uv(m.positions, sides));
   EXPECT_EQ(count_flipped_triangles(result.uv, pm.base_triangles), 0u);
   const std::set<int> base(pm.base_vertices.begin(), pm.base_vertices.end());
   std::size_t interior = 0;

@@ -32,7 +32,9 @@ TriMesh bump(int n, double height, unsigned seed = 1) {
   return m;
 }
 
-std::array<int, 4> grid_corners(int n) { return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)}; }
+std::array<int, 4> grid_corners(int n) {
+  return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)};
+}
 
 std::array<int, 3> canonical(std::array<int, 3> t) {
   std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
@@ -91,9 +93,9 @@ TEST(PatchSides, GridSidesFollowTheBoundaryCounterClockwise) {
 
 TEST(PatchSides, RejectsCornersOutOfLoopOrderOrInside) {
   const int n = 4;
-  EXPECT_THROW(patch_sides(test::grid(n), {0, 24, 4, 20}), InvalidInput);   // clockwise
-  EXPECT_THROW(patch_sides(test::grid(n), {0, 4, 24, 12}), InvalidInput);   // 12 is interior
-  EXPECT_THROW(patch_sides(test::grid(n), {0, 4, 24, 4}), InvalidInput);    // repeated
+  EXPECT_THROW(patch_sides(test::grid(n), {0, 24, 4, 20}), InvalidInput);            // clockwise
+  EXPECT_THROW(patch_sides(test::grid(n), {0, 4, 24, 12}), InvalidInput);            // 12 is interior
+  EXPECT_THROW(patch_sides(test::grid(n), {0, 4, 24, 4}), InvalidInput);             // repeated
   EXPECT_THROW(patch_sides(test::open_cylinder(8, 3), {0, 2, 4, 6}), InvalidInput);  // not a disk
 }
 
@@ -162,7 +164,8 @@ TEST(ProgressiveMesh, BaseMeshIsADiskWithoutFlatTriangles) {
   EXPECT_EQ(topo.components, 1u);
   EXPECT_EQ(topo.boundary_loops, 1u);
   EXPECT_EQ(topo.vertices, f.pm.base_vertices.size());
-  EXPECT_EQ(static_cast<long>(topo.vertices) - static_cast<long>(topo.edges) + static_cast<long>(topo.faces), 1);
+  EXPECT_EQ(static_cast<long>(topo.vertices) - static_cast<long>(topo.edges) + static_cast<long>(topo.faces),
+            1);
   // No interior edge between two vertices of one side (it would be flat on the square's side).
   const std::vector<int> mask = side_masks(f.patch.num_vertices(), f.sides);
   const std::map<int, int> next = boundary_next(f.pm.base_triangles);

@@ -49,6 +49,122 @@ Eigen::Vector3d face_normal(const TriMesh& m, int f) {  // length = 2 × area
 
 // ---------------------------------------------------------------------------------------------- genus 0
 
+// The longest closed curve where the plane {x·n = offset} cuts the mesh, as the ordered crossing edges
+// (one half-edge each), oriented CCW around n. Vertices with x·n <= offset count as below the plane.
+struct Outline {
+  std::vector<int> vertex;            // per crossing edge: its endpoint nearer to the plane
+  std::vector<Eigen::Vector3d> point;  // per crossing edge: where it crosses the plane
+  std::vector<double> arc;            // arc length from entry 0 to entry k
+  double length = 0.0;
+};
+
+Outline longest_outline(const TriMesh& m, const std::vector<int>& opp, const Eigen::Vector3d& n,
+                        const Eigen::Vector3d& a, const Eigen::Vector3d& b, double offset) {
+  const int nh = static_cast<int>(opp.size());
+  auto height = [&](int v) { return m.positions[v].dot(n) - offset; };
+  auto crosses = [&](int h) { return (height(he_from(m, h)) <= 0.0) != (height(he_to(m, h)) <= 0.0); };
+  std::vector<char> visited(nh, 0);
+  Outline best;
+  for (int h0 = 0; h0 < nh; ++h0) {
+    if (visited[h0] || !crosses(h0)) continue;
+    Outline o;
+    int h = h0;
+    do {  // enter the face of h through h, leave through its other crossing edge
+      visited[h] = visited[opp[h]] = 1;
+      const int u = he_from(m, h), v = he_to(m, h);
+      const double su = height(u), sv = height(v);
+      o.vertex.push_back(std::abs(su) <= std::abs(sv) ? u : v);
+      o.point.push_back(m.positions[u] + su / (su - sv) * (m.positions[v] - m.positions[u]));
+      int next = -1;
+      for (int k = 0; k < 3; ++k) {
+        const int g = 3 * (h / 3) + k;
+        if (g != h && crosses(g)) next = g;
+      }
+      h = opp[next];
+    } while (h != h0);
+    double area2 = 0.0;
+    for (std::size_t k = 0; k < o.point.size(); ++k) {
+      const Eigen::Vector3d& p = o.point[k];
+      const Eigen::Vector3d& q = o.point[(k + 1) % o.point.size()];
+      o.length += (q - p).norm();
+      area2 += p.dot(a) * q.dot(b) - q.dot(a) * p.dot(b);
+    }
+    if (o.length <= best.length) continue;
+    if (area2 < 0.0) {
+      std::reverse(o.vertex.begin(), o.vertex.end());
+      std::reverse(o.point.begin(), o.point.end());
+    }
+    best = std::move(o);
+  }
+  best.arc.assign(best.point.size(), 0.0);
+  for (std::size_t k = 1; k < best.point.size(); ++k) {
+    best.arc[k] = best.arc[k - 1] + (best.point[k] - best.point[k - 1]).norm();
+  }
+  return best;
+}
+
+// Corners at the outline's extremes in +a, +b, −a, −b (or, if those are not in that order along it, at
+// quarters of its length from the +a extreme), auxiliary points half way along the outline between them.
+PartitionPoints outline_points(const TriMesh& m, const std::vector<int>& opp, const Eigen::Vector3d& n,
+                               const Eigen::Vector3d& a, const Eigen::Vector3d& b, double offset) {
+  const Outline o = longest_outline(m, opp, n, a, b, offset);
+  const int count = static_cast<int>(o.vertex.size());
+  PartitionPoints pts;
+  if (count < 8) return pts;
+  std::array<int, 4> at;  // outline entries of the corners
+  const std::array<Eigen::Vector3d, 4> dirs = {a, b, -a, -b};
+  for (int k = 0; k < 4; ++k) {
+    at[k] = 0;
+    for (int i = 1; i < count; ++i) {
+      if (m.positions[o.vertex[i]].dot(dirs[k]) > m.positions[o.vertex[at[k]]].dot(dirs[k])) at[k] = i;
+    }
+  }
+  auto ahead = [&](int from, int to) { return (to - from + count) % count; };
+  if (!(ahead(at[0], at[1]) < ahead(at[0], at[2]) && ahead(at[0], at[2]) < ahead(at[0], at[3]) &&
+        ahead(at[0], at[1]) > 0)) {
+    for (int k = 1; k < 4; ++k) {  // quarters of the length from the +a extreme
+      const double target = std::fmod(o.arc[at[0]] + k * o.length / 4.0, o.length);
+      at[k] = static_cast<int>(std::lower_bound(o.arc.begin(), o.arc.end(), target) - o.arc.begin()) % count;
+    }
+  }
+  auto distinct = [&](int v) {
+    return std::find(pts.partition_points.begin(), pts.partition_points.end(), v) == pts.partition_points.end() &&
+           std::find(pts.auxiliary_points.begin(), pts.auxiliary_points.end(), v) == pts.auxiliary_points.end();
+  };
+  for (int k = 0; k < 4; ++k) {
+    if (!distinct(o.vertex[at[k]])) return {};
+    pts.partition_points.push_back(o.vertex[at[k]]);
+  }
+  for (int k = 0; k < 4; ++k) {
+    // Entry half way (by arc length) from corner k to corner k+1, or the nearest entry between them whose
+    // vertex is still free.
+    const int first = at[k], span = ahead(first, at[(k + 1) % 4]);
+    const double start = o.arc[first];
+    double len = o.arc[at[(k + 1) % 4]] - start;
+    if (len <= 0.0) len += o.length;
+    int mid = 0;
+    for (int i = 1; i < span; ++i) {
+      const double along = std::fmod(o.arc[(first + i) % count] - start + o.length, o.length);
+      if (along <= 0.5 * len) mid = i;
+    }
+    int chosen = -1;
+    for (int d = 0; d < span && chosen < 0; ++d) {
+      for (int i : {mid + d, mid - d}) {
+        if (i > 0 && i < span && distinct(o.vertex[(first + i) % count])) {
+          chosen = o.vertex[(first + i) % count];
+          break;
+        }
+      }
+    }
+    if (chosen < 0) {  // too short an arc for a guide: let the paths go freely
+      pts.auxiliary_points.clear();
+      return pts;
+    }
+    pts.auxiliary_points.push_back(chosen);
+  }
+  return pts;
+}
+
 PartitionPoints genus0_points(const TriMesh& m) {
   const int nf = static_cast<int>(m.triangles.size());
   std::vector<double> area(nf);
@@ -82,6 +198,7 @@ PartitionPoints genus0_points(const TriMesh& m) {
   // (normal, a, b) with a × b = normal: thinnest direction first.
   const std::array<std::array<Eigen::Vector3d, 3>, 3> planes = {{{e3, e1, e2}, {e2, e3, e1}, {e1, e2, e3}}};
 
+  const std::vector<int> opp = opposite_halfedges(m);
   std::vector<int> order(nf);
   std::string failures;
   for (const auto& [n, a, b] : planes) {
@@ -96,30 +213,10 @@ PartitionPoints genus0_points(const TriMesh& m) {
         break;
       }
     }
-    // Section vertices: of each edge crossing the plane, the endpoint nearer to it.
-    std::vector<int> section;
-    for (int h = 0; h < 3 * nf; ++h) {
-      const int u = he_from(m, h), v = he_to(m, h);
-      if (u > v) continue;  // each edge of a closed mesh has both directions: take one
-      const double su = m.positions[u].dot(n) - offset, sv = m.positions[v].dot(n) - offset;
-      if ((su <= 0.0) != (sv <= 0.0)) section.push_back(std::abs(su) <= std::abs(sv) ? u : v);
-    }
-    std::sort(section.begin(), section.end());
-    section.erase(std::unique(section.begin(), section.end()), section.end());
-    PartitionPoints pts;
-    for (const Eigen::Vector3d& dir : {a, b, Eigen::Vector3d(-a), Eigen::Vector3d(-b)}) {
-      int best = -1;
-      for (int v : section) {
-        if (std::find(pts.partition_points.begin(), pts.partition_points.end(), v) != pts.partition_points.end()) {
-          continue;
-        }
-        if (best < 0 || m.positions[v].dot(dir) > m.positions[best].dot(dir)) best = v;
-      }
-      if (best >= 0) pts.partition_points.push_back(best);
-    }
+    const PartitionPoints pts = outline_points(m, opp, n, a, b, offset);
     if (pts.partition_points.size() != 4) continue;
     try {
-      partition_mesh(m, pts.partition_points, {});
+      partition_mesh(m, pts.partition_points, pts.auxiliary_points);
       return pts;
     } catch (const Error& e) {
       failures += std::string(" ") + e.what() + ";";
@@ -278,6 +375,74 @@ FlatTorus flat_torus(const TriMesh& m) {
 PartitionPoints genus1_points(const TriMesh& m, const PartitionPointsOptions& options) {
   const FlatTorus torus = flat_torus(m);
   const int nv = static_cast<int>(m.positions.size());
+  const int nf = static_cast<int>(m.triangles.size());
+  auto wrap = [](double x) { return x - std::floor(x); };
+
+  // Area and flat coordinates (mod 1) of each triangle's centroid.
+  std::vector<double> area(nf);
+  std::vector<Eigen::Vector2d> centre(nf);
+  double total = 0.0;
+  for (int f = 0; f < nf; ++f) {
+    const auto& t = m.triangles[f];
+    area[f] = 0.5 * face_normal(m, f).norm();
+    total += area[f];
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (int k = 1; k < 3; ++k) {
+      Eigen::Vector2d d = torus.theta[t[k]] - torus.theta[t[0]];
+      for (int i = 0; i < 2; ++i) d[i] -= std::round(d[i]);
+      sum += d;
+    }
+    const Eigen::Vector2d c = torus.theta[t[0]] + sum / 3.0;
+    centre[f] = Eigen::Vector2d(wrap(c.x()), wrap(c.y()));
+  }
+  // Per direction: triangles sorted by coordinate, with cumulative areas, to find area-halving bands.
+  std::array<std::vector<double>, 2> coord, cumulative;
+  for (int i = 0; i < 2; ++i) {
+    std::vector<int> order(nf);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int f, int g) { return centre[f][i] < centre[g][i]; });
+    double acc = 0.0;
+    for (int f : order) {
+      coord[i].push_back(centre[f][i]);
+      acc += area[f];
+      cumulative[i].push_back(acc);
+    }
+  }
+  // Width s of the band [o, o+s) (mod 1) that holds half of the area.
+  auto half_band = [&](int i, double o) {
+    const std::size_t k0 = std::lower_bound(coord[i].begin(), coord[i].end(), o) - coord[i].begin();
+    double target = (k0 > 0 ? cumulative[i][k0 - 1] : 0.0) + 0.5 * total;
+    if (target > total) target -= total;
+    const std::size_t k = std::min<std::size_t>(
+        std::lower_bound(cumulative[i].begin(), cumulative[i].end(), target) - cumulative[i].begin(),
+        coord[i].size() - 1);
+    const double s = wrap(coord[i][k] - o);
+    return std::clamp(s, 0.05, 0.95);
+  };
+
+  // Candidate grids: offsets o on a steps × steps lattice, band widths s halving the area in each direction;
+  // predicted balance from the triangles' flat coordinates.
+  struct Candidate {
+    double predicted;
+    Eigen::Vector2d o, s;
+  };
+  std::vector<Candidate> candidates;
+  const int steps = std::max(1, options.offset_steps);
+  for (int a = 0; a < steps; ++a) {
+    for (int b = 0; b < steps; ++b) {
+      const Eigen::Vector2d o(double(a) / steps, double(b) / steps);
+      const Eigen::Vector2d s(half_band(0, o.x()), half_band(1, o.y()));
+      std::array<double, 4> quad = {0, 0, 0, 0};
+      for (int f = 0; f < nf; ++f) {
+        quad[2 * (wrap(centre[f].x() - o.x()) >= s.x()) + (wrap(centre[f].y() - o.y()) >= s.y())] += area[f];
+      }
+      const auto [lo, hi] = std::minmax_element(quad.begin(), quad.end());
+      candidates.push_back({*lo / *hi, o, s});
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& x, const Candidate& y) { return x.predicted > y.predicted; });
+
   auto nearest = [&](const Eigen::Vector2d& target) {
     int best = -1;
     double best_d = std::numeric_limits<double>::infinity();
@@ -293,32 +458,33 @@ PartitionPoints genus1_points(const TriMesh& m, const PartitionPointsOptions& op
     }
     return best;
   };
-  // Corners P0..P3, then the midpoints of edges e0..e7 (partition_mesh()'s order), in grid units of ¼.
-  const std::array<std::array<int, 2>, 12> targets = {{{0, 0}, {2, 0}, {0, 2}, {2, 2},  // P0..P3
-                                                       {1, 0}, {3, 0}, {1, 2}, {3, 2},  // e0..e3
-                                                       {0, 1}, {0, 3}, {2, 1}, {2, 3}}};  // e4..e7
-  const int steps = std::max(1, options.offsets);
   PartitionPoints best;
   double best_balance = -1.0;
+  int successes = 0;
   std::string last_failure;
-  for (int i = 0; i < steps; ++i) {
-    for (int j = 0; j < steps; ++j) {
-      const Eigen::Vector2d offset(0.5 * i / steps, 0.5 * j / steps);
-      std::vector<int> ids;
-      for (const auto& t : targets) ids.push_back(nearest(offset + 0.25 * Eigen::Vector2d(t[0], t[1])));
-      PartitionPoints pts;
-      pts.partition_points.assign(ids.begin(), ids.begin() + 4);
-      pts.auxiliary_points.assign(ids.begin() + 4, ids.end());
-      try {
-        const double balance = partition_stats(partition_mesh(m, pts.partition_points, pts.auxiliary_points))
-                                   .area_balance;
-        if (balance > best_balance) {
-          best_balance = balance;
-          best = pts;
-        }
-      } catch (const Error& e) {
-        last_failure = e.what();
+  for (const Candidate& c : candidates) {
+    if (successes >= std::max(1, options.tries)) break;
+    // Corners at o + {0, s} per direction; auxiliary points at the middle of each grid edge, in
+    // partition_mesh()'s order e0..e7.
+    const double x0 = c.o.x(), x1 = x0 + c.s.x(), y0 = c.o.y(), y1 = y0 + c.s.y();
+    const double xm0 = x0 + 0.5 * c.s.x(), xm1 = x1 + 0.5 * (1.0 - c.s.x());
+    const double ym0 = y0 + 0.5 * c.s.y(), ym1 = y1 + 0.5 * (1.0 - c.s.y());
+    const std::array<Eigen::Vector2d, 12> targets = {
+        Eigen::Vector2d(x0, y0),  Eigen::Vector2d(x1, y0),  Eigen::Vector2d(x0, y1),  Eigen::Vector2d(x1, y1),
+        Eigen::Vector2d(xm0, y0), Eigen::Vector2d(xm1, y0), Eigen::Vector2d(xm0, y1), Eigen::Vector2d(xm1, y1),
+        Eigen::Vector2d(x0, ym0), Eigen::Vector2d(x0, ym1), Eigen::Vector2d(x1, ym0), Eigen::Vector2d(x1, ym1)};
+    PartitionPoints pts;
+    for (int k = 0; k < 12; ++k) (k < 4 ? pts.partition_points : pts.auxiliary_points).push_back(nearest(targets[k]));
+    try {
+      const double balance =
+          partition_stats(partition_mesh(m, pts.partition_points, pts.auxiliary_points)).area_balance;
+      ++successes;
+      if (balance > best_balance) {
+        best_balance = balance;
+        best = pts;
       }
+    } catch (const Error& e) {
+      last_failure = e.what();
     }
   }
   if (best_balance < 0.0) {

@@ -13,13 +13,18 @@ namespace geomip {
 /// Points to pass to partition_mesh().
 struct PartitionPoints {
   std::vector<int> partition_points;  ///< 4 vertex ids, P0..P3
-  std::vector<int> auxiliary_points;  ///< genus 0: empty; genus 1: 8 vertex ids in partition_mesh()'s order
+  /// genus 0: 4 vertex ids guiding the 4 paths (empty when the outline is too short for them); genus 1: 8.
+  /// In partition_mesh()'s order.
+  std::vector<int> auxiliary_points;
 };
 
 struct PartitionPointsOptions {
-  /// Genus 1 only: the grid of corner offsets tried is offsets × offsets (see choose_partition_points()).
-  /// 4 tries 16 placements; more gives better balance at a proportional cost.
-  int offsets = 4;
+  /// Genus 1 only: grid offsets are tried on an offset_steps × offset_steps lattice of the flat torus
+  /// (cheap: one pass over the triangles each).
+  int offset_steps = 16;
+  /// Genus 1 only: how many placements, best predicted balance first, are actually partitioned
+  /// (partition_mesh() each); the best measured one is returned.
+  int tries = 4;
 };
 
 /// Chooses partition points for `closed_manifold` (same preconditions as partition_mesh()) such that the
@@ -30,9 +35,14 @@ struct PartitionPointsOptions {
 /// 1. principal axes e1, e2, e3 (largest to smallest variance, e3 = e1 × e2) of the surface with area
 ///    weights (exact second moments of the triangles about the area centroid);
 /// 2. the cutting plane has normal e3 and passes through the area median along e3 (half the triangle area,
-///    counted at triangle centroids, on each side);
-/// 3. among "section vertices" (the endpoint nearer the plane of each edge crossing it) P0..P3 are the
-///    extremes in the directions +e1, +e2, −e1, −e2: CCW around e3, so patch 0 is the +e3 half.
+///    counted at triangle centroids, on each side); the longest closed curve where it cuts the mesh is the
+///    outline;
+/// 3. P0..P3 are the outline's vertices (of each crossing edge, the endpoint nearer the plane) extreme in the
+///    directions +e1, +e2, −e1, −e2: CCW around e3, so patch 0 is the +e3 half. If the extremes do not come
+///    in that order along the outline, P1..P3 are at quarters of its length from P0 instead;
+/// 4. auxiliary point k is the outline vertex half way (by length) from P_k to P_{k+1}, so that the
+///    shortest paths follow the outline instead of cutting across the surface (for a cow, the path from
+///    the tail tip to the belly would otherwise run up the tail and diagonally across one flank).
 ///   Why: the two halves are the front and back of the shape seen along e3, the direction in which it is
 ///   thinnest, so each half is close to a height field over the (e1,e2) plane: it flattens onto a square with
 ///   little stretch (a cut across the longest axis would instead make two deep caps, tubes closed at one end,
@@ -47,12 +57,15 @@ struct PartitionPointsOptions {
 ///    (Gu & Yau 2003; for genus 1 this map is conformal);
 /// 2. the basis is Gauss-reduced with the forms' Dirichlet Gram matrix so grid lines θ1 = c and θ2 = c cross
 ///    as close to right angles as the torus's conformal shape allows;
-/// 3. for an offset o, corners are the vertices nearest (in the flat metric) to o + {(0,0), (½,0), (0,½),
-///    (½,½)} and the auxiliary points those nearest to the midpoints of the grid edges between them, in
-///    partition_mesh()'s order: e0 at (¼,0), e1 (¾,0), e2 (¼,½), e3 (¾,½), e4 (0,¼), e5 (0,¾), e6 (½,¼),
-///    e7 (½,¾);
-/// 4. of the offsets o ∈ {0, ½/n, …}² (n = options.offsets) whose points partition successfully, the one with
-///    the best area balance (smallest / largest patch) is returned.
+/// 3. a placement is an offset o and band widths s = (s1, s2): corners at o + {0, s1} × {0, s2} (P0 at o,
+///    P1 at o + (s1,0), P2 at o + (0,s2), P3 at o + s), auxiliary points at the middles of the grid edges in
+///    partition_mesh()'s order (e0 at o + (s1/2, 0), e1 at o + (s1 + (1−s1)/2, 0), e2, e3 likewise at height
+///    s2, e4 at o + (0, s2/2), e5 at o + (0, s2 + (1−s2)/2), e6, e7 likewise at s1), each the vertex nearest
+///    to its target in the flat metric. For each offset on an offset_steps² lattice, s1 and s2 are chosen so
+///    each band of the grid holds half of the area (counted at triangle centroids), which makes diagonally
+///    opposite patches equal in area; the 4 patch areas predicted from the triangles' coordinates rank the placements;
+///    the first `tries` that partition are measured and the one with the best area balance (smallest /
+///    largest patch) is returned.
 ///
 /// \throw InvalidInput for a mesh partition_mesh() rejects, or genus ≥ 2.
 /// \throw SolverFailure when no candidate partitions (a degenerate mesh, or a limitation of this method).

@@ -244,8 +244,8 @@ TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {
   for (auto& q : m.positions) q = Eigen::Vector3d(3 * q.x() + 0.2 * q.y(), 2 * q.y(), 0.7 * q.z());
   const PartitionPoints pts = choose_partition_points(m);
   ASSERT_EQ(pts.partition_points.size(), 4u);
-  EXPECT_TRUE(pts.auxiliary_points.empty());
-  const PartitionResult r = partition_mesh(m, pts.partition_points, {});
+  EXPECT_EQ(pts.auxiliary_points.size(), 4u);
+  const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
   EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
   const PartitionStats s = partition_stats(r);
   EXPECT_GT(s.area_balance, 0.9);

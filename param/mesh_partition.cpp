@@ -200,7 +200,8 @@ class Partitioner {
         throw InvalidInput(std::string(kFn) + "cannot trace path " + std::to_string(k) + " from " +
                            vertex_name(specs[k].from) + " to " + vertex_name(specs[k].to) +
                            (specs[k].via >= 0 ? " through " + vertex_name(specs[k].via) : std::string()) +
-                           " without touching earlier paths; move the points further apart");
+                           " without touching earlier paths; move the points further apart" +
+                           (options_.split_degenerate ? "" : " or enable split_degenerate"));
       }
       for (std::size_t i = 1; i + 1 < path.size(); ++i) blocked_[path[i]] = 1;
       paths_.push_back(std::move(path));

@@ -195,28 +195,63 @@ TEST(PartitionGenus0, CubeFaceLoopSplitsItsDiagonal) {
   EXPECT_EQ(kept, 10);
 }
 
-TEST(PartitionGenus0, EveryOrderedQuadrupleOnCoarseMeshesIsValidOrCleanlyRejected) {
-  for (const TriMesh& m : {test::tetrahedron(), test::cube(), subdivide(test::cube(), 1)}) {
+TEST(PartitionGenus0, EveryOrderedQuadrupleOnTetrahedronAndCubePartitions) {
+  // The coarsest closed meshes: paths are single edges, chords everywhere, corners walled in by earlier paths.
+  for (const TriMesh& m : {test::tetrahedron(), test::cube()}) {
     const int nv = static_cast<int>(m.positions.size());
-    int valid = 0, rejected = 0;
-    std::mt19937 rng(7);
-    for (int trial = 0; trial < 400; ++trial) {
-      std::vector<int> ids(nv);
-      std::iota(ids.begin(), ids.end(), 0);
-      std::shuffle(ids.begin(), ids.end(), rng);
-      const std::vector<int> p(ids.begin(), ids.begin() + 4);
-      try {
-        const PartitionResult r = partition_mesh(m, p, {});
-        const std::string problems = test::check_partition(m, p, r);
-        EXPECT_EQ(problems, "") << "points " << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
-        ++valid;
-      } catch (const InvalidInput& e) {
-        EXPECT_NE(std::string(e.what()).find("cannot trace path"), std::string::npos) << e.what();
-        ++rejected;
+    int count = 0;
+    std::vector<int> p(4);
+    for (p[0] = 0; p[0] < nv; ++p[0]) {
+      for (p[1] = 0; p[1] < nv; ++p[1]) {
+        for (p[2] = 0; p[2] < nv; ++p[2]) {
+          for (p[3] = 0; p[3] < nv; ++p[3]) {
+            if (std::set<int>(p.begin(), p.end()).size() != 4) continue;
+            ++count;
+            try {
+              const PartitionResult r = partition_mesh(m, p, {});
+              ASSERT_EQ(test::check_partition(m, p, r), "") << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+            } catch (const Error& e) {
+              ADD_FAILURE() << p[0] << "," << p[1] << "," << p[2] << "," << p[3] << ": " << e.what();
+            }
+          }
+        }
       }
     }
-    EXPECT_GT(valid, rejected) << nv << " vertices";
+    EXPECT_EQ(count, nv * (nv - 1) * (nv - 2) * (nv - 3));
   }
+}
+
+TEST(PartitionGenus0, WalledInCornerIsFreedBySplittingChords) {
+  // On the cube, paths 0-6 and 6-3 leave vertex 3's free neighbours cut off from 1 by chords.
+  const TriMesh m = test::cube();
+  const std::vector<int> p = {0, 6, 3, 1};
+  PartitionOptions strict;
+  strict.split_degenerate = false;
+  expect_invalid(m, p, {}, "cannot trace path 2 from vertex 3 to vertex 1", strict);
+  const PartitionResult r = partition_mesh(m, p, {});
+  EXPECT_GT(r.split_vertices, 0u);
+  EXPECT_EQ(test::check_partition(m, p, r), "");
+}
+
+TEST(PartitionGenus0, RandomQuadruplesOnASubdividedCubeAreValidOrCleanlyRejected) {
+  const TriMesh m = subdivide(test::cube(), 1);
+  const int nv = static_cast<int>(m.positions.size());
+  std::mt19937 rng(7);
+  int valid = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    std::vector<int> ids(nv);
+    std::iota(ids.begin(), ids.end(), 0);
+    std::shuffle(ids.begin(), ids.end(), rng);
+    const std::vector<int> p(ids.begin(), ids.begin() + 4);
+    try {
+      const PartitionResult r = partition_mesh(m, p, {});
+      EXPECT_EQ(test::check_partition(m, p, r), "") << "points " << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+      ++valid;
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("cannot trace path"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GT(valid, 360);
 }
 
 TEST(PartitionGenus0, RandomPointsOnAFineSphereAlwaysPartition) {
@@ -229,14 +264,61 @@ TEST(PartitionGenus0, RandomPointsOnAFineSphereAlwaysPartition) {
       const int v = pick(rng);
       if (std::find(p.begin(), p.end(), v) == p.end()) p.push_back(v);
     }
-    try {
-      const PartitionResult r = partition_mesh(m, p, {});
-      EXPECT_EQ(test::check_partition(m, p, r), "") << "trial " << trial;
-    } catch (const InvalidInput& e) {
-      // Shortest paths may wall a corner in; that must be the only reason to refuse.
-      EXPECT_NE(std::string(e.what()).find("cannot trace path"), std::string::npos) << e.what();
-    }
+    const PartitionResult r = partition_mesh(m, p, {});
+    EXPECT_EQ(test::check_partition(m, p, r), "") << "trial " << trial;
   }
+}
+
+TEST(PartitionChecks, TheCheckerCatchesBrokenResults) {
+  // check_partition() is what the other tests rely on: it must see each kind of damage.
+  const TriMesh m = sphere(3);
+  const std::vector<int> p = {nearest_vertex(m, {1, 0, 0}), nearest_vertex(m, {0, 1, 0}),
+                              nearest_vertex(m, {-1, 0, 0}), nearest_vertex(m, {0, -1, 0})};
+  const PartitionResult good = partition_mesh(m, p, {});
+  ASSERT_EQ(test::check_partition(m, p, good), "");
+  std::vector<std::pair<std::string, PartitionResult>> broken;
+  broken.emplace_back("face moved to the other patch", good);
+  {
+    auto& r = broken.back().second;
+    const int f = r.patches[0].faces.back();
+    r.patches[0].faces.pop_back();
+    r.patches[1].faces.push_back(f);
+    r.face_patch[f] = 1;
+  }
+  broken.emplace_back("face dropped", good);
+  broken.back().second.patches[1].faces.pop_back();
+  broken.emplace_back("side reversed", good);
+  {
+    auto& v = broken.back().second.patches[0].sides[1].vertices;
+    std::reverse(v.begin(), v.end());
+  }
+  broken.emplace_back("corners rotated", good);
+  {
+    auto& patch = broken.back().second.patches[1];
+    std::rotate(patch.corners.begin(), patch.corners.begin() + 1, patch.corners.end());
+    std::rotate(patch.sides.begin(), patch.sides.begin() + 1, patch.sides.end());
+  }
+  broken.emplace_back("wrong gluing", good);
+  broken.back().second.adjacency[0].other_side = 2;
+  broken.emplace_back("vertex moved", good);
+  broken.back().second.mesh.positions[p[2]].z() += 0.01;
+  for (const auto& [what, r] : broken) EXPECT_NE(test::check_partition(m, p, r), "") << what;
+
+  // The cube's bottom loop with its chord 0-2 put back (the split undone): only that defect is reported.
+  const TriMesh cube = test::cube();
+  const std::vector<int> q = {0, 1, 2, 3};
+  PartitionResult unsplit = partition_mesh(cube, q, {});
+  ASSERT_EQ(unsplit.split_vertices, 1u);
+  unsplit.mesh = cube;
+  unsplit.split_vertices = 0;
+  unsplit.face_patch.resize(cube.triangles.size());
+  for (auto& patch : unsplit.patches) {
+    patch.faces.erase(std::remove_if(patch.faces.begin(), patch.faces.end(), [](int f) { return f >= 12; }),
+                      patch.faces.end());
+  }
+  const std::string problems = test::check_partition(cube, q, unsplit);
+  EXPECT_NE(problems.find("all vertices on the cut"), std::string::npos) << problems;
+  EXPECT_EQ(problems.find(';'), problems.rfind(';')) << "only one problem expected: " << problems;
 }
 
 TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {

@@ -1,0 +1,663 @@
+#include "param/mesh_partition.h"
+
+#include "param/errors.h"
+#include "param/mesh_topology.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <string>
+#include <unordered_map>
+#include <utility>
+
+namespace geomip {
+namespace {
+
+const char* const kFn = "partition_mesh: ";
+
+// Half-edge h = 3·f + k of triangle f runs from triangles[f][k] to triangles[f][(k+1)%3].
+int he_from(const TriMesh& m, int h) { return m.triangles[h / 3][h % 3]; }
+int he_to(const TriMesh& m, int h) { return m.triangles[h / 3][(h + 1) % 3]; }
+
+// Connectivity of a closed, consistently oriented triangle mesh: each half-edge's opposite, and each vertex's
+// outgoing half-edges (CSR). On such a mesh the outgoing half-edges of v reach every neighbour of v once.
+struct Connectivity {
+  std::vector<int> opposite;
+  std::vector<int> out_begin;  // #V + 1
+  std::vector<int> out;
+
+  int find(const TriMesh& m, int a, int b) const {  // half-edge a→b or -1
+    for (int i = out_begin[a]; i < out_begin[a + 1]; ++i) {
+      if (he_to(m, out[i]) == b) return out[i];
+    }
+    return -1;
+  }
+};
+
+// \throw InvalidInput when an edge is not shared by exactly two oppositely oriented triangles.
+Connectivity build_connectivity(const TriMesh& m) {
+  const int nv = static_cast<int>(m.positions.size());
+  const int nh = static_cast<int>(3 * m.triangles.size());
+  Connectivity c;
+  c.out_begin.assign(nv + 1, 0);
+  for (int h = 0; h < nh; ++h) ++c.out_begin[he_from(m, h) + 1];
+  for (int v = 0; v < nv; ++v) c.out_begin[v + 1] += c.out_begin[v];
+  c.out.resize(nh);
+  std::vector<int> fill(c.out_begin.begin(), c.out_begin.end() - 1);
+  for (int h = 0; h < nh; ++h) c.out[fill[he_from(m, h)]++] = h;
+  c.opposite.assign(nh, -1);
+  for (int h = 0; h < nh; ++h) {
+    const int a = he_from(m, h), b = he_to(m, h);
+    int found = -1, same_direction = 0;
+    for (int i = c.out_begin[b]; i < c.out_begin[b + 1]; ++i) {
+      if (he_to(m, c.out[i]) == a) {
+        if (found >= 0) same_direction = 1;
+        found = c.out[i];
+      }
+    }
+    for (int i = c.out_begin[a]; i < c.out_begin[a + 1]; ++i) {
+      if (c.out[i] != h && he_to(m, c.out[i]) == b) same_direction = 1;
+    }
+    if (found < 0 || same_direction) {
+      throw InvalidInput(std::string(kFn) + "edge (" + std::to_string(a) + "," + std::to_string(b) +
+                         ") is not shared by exactly two oppositely oriented triangles: the triangles must be "
+                         "consistently oriented");
+    }
+    c.opposite[h] = found;
+  }
+  return c;
+}
+
+std::uint64_t edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+}
+
+// Splits every listed edge at its midpoint; returns the number of vertices appended. Triangles keep their id for
+// their first piece (other pieces appended) and their orientation; untouched triangles stay as they are.
+std::size_t split_edges(TriMesh& m, const std::vector<std::pair<int, int>>& edges) {
+  std::unordered_map<std::uint64_t, int> mid;
+  for (const auto& [a, b] : edges) {
+    if (mid.count(edge_key(a, b))) continue;
+    mid[edge_key(a, b)] = static_cast<int>(m.positions.size());
+    m.positions.push_back(0.5 * (m.positions[a] + m.positions[b]));
+  }
+  const std::size_t nf = m.triangles.size();
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto t = m.triangles[f];
+    std::array<int, 3> mids;  // mids[k]: midpoint of edge t[k]→t[k+1], or -1
+    int count = 0;
+    for (int k = 0; k < 3; ++k) {
+      const auto it = mid.find(edge_key(t[k], t[(k + 1) % 3]));
+      mids[k] = it == mid.end() ? -1 : it->second;
+      count += mids[k] >= 0;
+    }
+    if (count == 0) continue;
+    std::vector<std::array<int, 3>> pieces;
+    if (count == 3) {
+      pieces = {{t[0], mids[0], mids[2]}, {mids[0], t[1], mids[1]}, {mids[2], mids[1], t[2]},
+                {mids[0], mids[1], mids[2]}};
+    } else {
+      // Rotate so that: one split edge is edge 0 (a→b); two split edges leave edge 2 (c→a) whole.
+      int r = 0;
+      while (count == 1 ? mids[r] < 0 : mids[(r + 2) % 3] >= 0) ++r;
+      const int a = t[r], b = t[(r + 1) % 3], c = t[(r + 2) % 3];
+      const int m0 = mids[r], m1 = mids[(r + 1) % 3];
+      if (count == 1) {
+        pieces = {{a, m0, c}, {m0, b, c}};
+      } else {
+        pieces = {{a, m0, m1}, {m0, b, m1}, {a, m1, c}};
+      }
+    }
+    m.triangles[f] = pieces[0];
+    m.triangles.insert(m.triangles.end(), pieces.begin() + 1, pieces.end());
+  }
+  return mid.size();
+}
+
+// Dijkstra on the edge graph with Euclidean lengths, reusing its arrays between queries.
+class PathTracer {
+ public:
+  std::vector<int> shortest_path(const TriMesh& m, const Connectivity& c, int source, int target,
+                                 const std::vector<char>& blocked) {
+    const std::size_t nv = m.positions.size();
+    if (dist_.size() != nv) {
+      dist_.assign(nv, std::numeric_limits<double>::infinity());
+      prev_.assign(nv, -1);
+    }
+    for (int v : touched_) {
+      dist_[v] = std::numeric_limits<double>::infinity();
+      prev_[v] = -1;
+    }
+    touched_.clear();
+    using Item = std::pair<double, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+    dist_[source] = 0.0;
+    touched_.push_back(source);
+    heap.push({0.0, source});
+    while (!heap.empty()) {
+      const auto [d, v] = heap.top();
+      heap.pop();
+      if (d > dist_[v]) continue;
+      if (v == target) break;
+      for (int i = c.out_begin[v]; i < c.out_begin[v + 1]; ++i) {
+        const int u = he_to(m, c.out[i]);
+        if (blocked[u] && u != target) continue;
+        const double du = d + (m.positions[u] - m.positions[v]).norm();
+        if (du < dist_[u]) {
+          if (prev_[u] < 0 && u != source) touched_.push_back(u);
+          dist_[u] = du;
+          prev_[u] = v;
+          heap.push({du, u});
+        }
+      }
+    }
+    std::vector<int> path;
+    if (!std::isfinite(dist_[target])) return path;
+    for (int v = target; v != source; v = prev_[v]) path.push_back(v);
+    path.push_back(source);
+    std::reverse(path.begin(), path.end());
+    return path;
+  }
+
+ private:
+  std::vector<double> dist_;
+  std::vector<int> prev_;
+  std::vector<int> touched_;
+};
+
+// One path to trace: from corner `from` to corner `to`, through `via` when >= 0.
+struct PathSpec {
+  int from, to, via;
+};
+
+std::string vertex_name(int v) { return "vertex " + std::to_string(v); }
+
+// The working state of one partition: the mesh being cut (split as needed), its connectivity, and the cut.
+class Partitioner {
+ public:
+  Partitioner(const TriMesh& mesh, const PartitionOptions& options) : options_(options) {
+    result_.mesh = mesh;
+    conn_ = build_connectivity(result_.mesh);
+  }
+
+  // Traces `specs` in order; every path avoids all special points but its own and the interior vertices of
+  // earlier paths. `special` lists every partition and auxiliary point.
+  void trace(const std::vector<PathSpec>& specs, const std::vector<int>& special) {
+    blocked_.assign(result_.mesh.positions.size(), 0);
+    for (int v : special) blocked_[v] = 1;
+    for (std::size_t k = 0; k < specs.size(); ++k) {
+      std::vector<int> path = trace_one(specs[k]);
+      if (path.empty() && options_.split_degenerate) {
+        // Earlier paths and chords between them may enclose the corners: opening the chords frees a way.
+        split_chords();
+        path = trace_one(specs[k]);
+      }
+      if (path.empty()) {
+        throw InvalidInput(std::string(kFn) + "cannot trace path " + std::to_string(k) + " from " +
+                           vertex_name(specs[k].from) + " to " + vertex_name(specs[k].to) +
+                           (specs[k].via >= 0 ? " through " + vertex_name(specs[k].via) : std::string()) +
+                           " without touching earlier paths; move the points further apart" +
+                           (options_.split_degenerate ? "" : " or enable split_degenerate"));
+      }
+      for (std::size_t i = 1; i + 1 < path.size(); ++i) blocked_[path[i]] = 1;
+      paths_.push_back(std::move(path));
+    }
+    mark_cut();
+    if (!chords().empty()) {
+      if (!options_.split_degenerate) {
+        throw InvalidInput(std::string(kFn) + "degenerate configuration: " + std::to_string(chords().size()) +
+                           " edge(s) join two cut vertices without being on the cut (a triangle with all "
+                           "three vertices on the cut); enable split_degenerate");
+      }
+      split_chords();
+    }
+  }
+
+  // Flood-fills the triangles into the regions between cut edges; returns their number.
+  int label_regions() {
+    const int nf = static_cast<int>(result_.mesh.triangles.size());
+    result_.face_patch.assign(nf, -1);
+    int regions = 0;
+    std::vector<int> stack;
+    for (int f = 0; f < nf; ++f) {
+      if (result_.face_patch[f] >= 0) continue;
+      result_.face_patch[f] = regions;
+      stack.push_back(f);
+      while (!stack.empty()) {
+        const int g = stack.back();
+        stack.pop_back();
+        for (int k = 0; k < 3; ++k) {
+          const int h = 3 * g + k;
+          if (cut_[h]) continue;
+          const int o = conn_.opposite[h] / 3;
+          if (result_.face_patch[o] < 0) {
+            result_.face_patch[o] = regions;
+            stack.push_back(o);
+          }
+        }
+      }
+      ++regions;
+    }
+    return regions;
+  }
+
+  // The CCW boundary cycle (vertices, first = `start`, not repeated at the end) of region `region`, after
+  // checking the region is a disk whose boundary is one simple loop through `start`. On failure returns an
+  // empty cycle and sets `why`.
+  std::vector<int> disk_boundary(int region, int start, std::string& why) const {
+    const TriMesh& m = result_.mesh;
+    const int nh = static_cast<int>(cut_.size());
+    std::unordered_map<int, int> next;  // boundary vertex → its outgoing boundary half-edge in the region
+    std::vector<int> vertices;
+    std::size_t faces = 0, boundary = 0;
+    for (int h = 0; h < nh; ++h) {
+      if (result_.face_patch[h / 3] != region) continue;
+      if (h % 3 == 0) {
+        ++faces;
+        for (int k = 0; k < 3; ++k) vertices.push_back(m.triangles[h / 3][k]);
+      }
+      if (!cut_[h]) continue;
+      ++boundary;
+      if (result_.face_patch[conn_.opposite[h] / 3] == region) {
+        why = "the cut edge (" + std::to_string(he_from(m, h)) + "," + std::to_string(he_to(m, h)) +
+              ") has the same patch on both sides";
+        return {};
+      }
+      if (!next.emplace(he_from(m, h), h).second) {
+        why = "its boundary touches itself at " + vertex_name(he_from(m, h));
+        return {};
+      }
+    }
+    std::sort(vertices.begin(), vertices.end());
+    const std::size_t nverts = std::unique(vertices.begin(), vertices.end()) - vertices.begin();
+    const long long euler = static_cast<long long>(nverts) - static_cast<long long>((3 * faces + boundary) / 2) +
+                            static_cast<long long>(faces);
+    if (euler != 1) {
+      why = "it is not a disk (V-E+F = " + std::to_string(euler) + ")";
+      return {};
+    }
+    std::vector<int> cycle;
+    if (!next.count(start)) {
+      why = "its boundary does not pass through " + vertex_name(start);
+      return {};
+    }
+    int v = start;
+    do {
+      cycle.push_back(v);
+      v = he_to(m, next.at(v));
+    } while (v != start && cycle.size() <= next.size());
+    if (cycle.size() != next.size()) {
+      why = "its boundary has more than one loop";
+      return {};
+    }
+    return cycle;
+  }
+
+  // Cuts `cycle` (CCW, starting at corners[0]) into the 4 sides between `corners`, which must appear once each
+  // in that order; other partition points must not appear at all.
+  static bool make_sides(const std::vector<int>& cycle, const std::array<int, 4>& corners, Patch& patch) {
+    patch.corners = corners;
+    std::size_t pos = 0;
+    for (int s = 0; s < 4; ++s) {
+      const int end = corners[(s + 1) % 4];
+      auto& side = patch.sides[s].vertices;
+      side.clear();
+      side.push_back(cycle[pos]);
+      do {
+        pos = (pos + 1) % cycle.size();
+        side.push_back(cycle[pos]);
+      } while (cycle[pos] != end && pos != 0);
+      if (cycle[pos] != end || (s < 3 && pos == 0)) return false;
+      for (std::size_t i = 1; i + 1 < side.size(); ++i) {
+        if (std::find(corners.begin(), corners.end(), side[i]) != corners.end()) return false;
+      }
+    }
+    return pos == 0;
+  }
+
+  PartitionResult& result() { return result_; }
+  const std::vector<std::vector<int>>& paths() const { return paths_; }
+  const Connectivity& connectivity() const { return conn_; }
+
+ private:
+  std::vector<int> trace_one(const PathSpec& s) {
+    blocked_[s.from] = blocked_[s.to] = 0;
+    if (s.via >= 0) blocked_[s.via] = 0;
+    std::vector<int> path;
+    if (s.via < 0) {
+      path = tracer_.shortest_path(result_.mesh, conn_, s.from, s.to, blocked_);
+    } else {
+      blocked_[s.to] = 1;  // the first leg must not pass through the end corner
+      path = tracer_.shortest_path(result_.mesh, conn_, s.from, s.via, blocked_);
+      blocked_[s.to] = 0;
+      if (!path.empty()) {
+        for (int v : path) blocked_[v] = 1;
+        blocked_[s.via] = 0;
+        std::vector<int> second = tracer_.shortest_path(result_.mesh, conn_, s.via, s.to, blocked_);
+        for (int v : path) blocked_[v] = 0;
+        if (second.empty()) {
+          path.clear();
+        } else {
+          path.insert(path.end(), second.begin() + 1, second.end());
+        }
+      }
+    }
+    blocked_[s.from] = blocked_[s.to] = 1;
+    if (s.via >= 0) blocked_[s.via] = 1;
+    return path;
+  }
+
+  // Marks the half-edges of all traced paths (both directions) as cut.
+  void mark_cut() {
+    cut_.assign(3 * result_.mesh.triangles.size(), 0);
+    on_cut_.assign(result_.mesh.positions.size(), 0);
+    for (const auto& path : paths_) {
+      for (std::size_t i = 0; i < path.size(); ++i) on_cut_[path[i]] = 1;
+      for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+        const int h = conn_.find(result_.mesh, path[i], path[i + 1]);
+        cut_[h] = cut_[conn_.opposite[h]] = 1;
+      }
+    }
+  }
+
+  // Edges that join two cut vertices without being cut edges.
+  std::vector<std::pair<int, int>> chords() const {
+    std::vector<std::pair<int, int>> list;
+    const TriMesh& m = result_.mesh;
+    for (int h = 0; h < static_cast<int>(cut_.size()); ++h) {
+      const int a = he_from(m, h), b = he_to(m, h);
+      if (a < b && !cut_[h] && on_cut_[a] && on_cut_[b]) list.emplace_back(a, b);
+    }
+    return list;
+  }
+
+  void split_chords() {
+    mark_cut();
+    const auto list = chords();
+    if (list.empty()) return;
+    result_.split_vertices += split_edges(result_.mesh, list);
+    conn_ = build_connectivity(result_.mesh);
+    blocked_.resize(result_.mesh.positions.size(), 0);
+    mark_cut();
+  }
+
+  PartitionOptions options_;
+  PartitionResult result_;
+  Connectivity conn_;
+  PathTracer tracer_;
+  std::vector<char> blocked_;
+  std::vector<char> cut_;     // per half-edge
+  std::vector<char> on_cut_;  // per vertex
+  std::vector<std::vector<int>> paths_;
+};
+
+// Fills each patch's face list (ascending) from face_patch.
+void collect_faces(PartitionResult& r) {
+  for (Patch& patch : r.patches) patch.faces.clear();
+  for (int f = 0; f < static_cast<int>(r.face_patch.size()); ++f) r.patches[r.face_patch[f]].faces.push_back(f);
+}
+
+// Fills `adjacency` by matching every side with the side that walks the same vertices the other way.
+// Returns false (and sets `why`) when a side has no partner.
+bool link_sides(PartitionResult& r, std::string& why) {
+  std::unordered_map<std::uint64_t, std::pair<int, int>> by_start;  // (first, second vertex) → (patch, side)
+  auto key = [](int a, int b) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+  };
+  for (int p = 0; p < static_cast<int>(r.patches.size()); ++p) {
+    for (int s = 0; s < 4; ++s) {
+      const auto& v = r.patches[p].sides[s].vertices;
+      by_start[key(v[0], v[1])] = {p, s};
+    }
+  }
+  r.adjacency.clear();
+  for (int p = 0; p < static_cast<int>(r.patches.size()); ++p) {
+    for (int s = 0; s < 4; ++s) {
+      const auto& v = r.patches[p].sides[s].vertices;
+      const auto it = by_start.find(key(v.back(), v[v.size() - 2]));
+      bool ok = it != by_start.end() && it->second.first != p;
+      if (ok) {
+        const auto& w = r.patches[it->second.first].sides[it->second.second].vertices;
+        ok = std::equal(v.begin(), v.end(), w.rbegin(), w.rend());
+      }
+      if (!ok) {
+        why = "side " + std::to_string(s) + " of patch " + std::to_string(p) +
+              " is not shared with another patch";
+        return false;
+      }
+      r.adjacency.push_back({p, s, it->second.first, it->second.second, true});
+    }
+  }
+  return true;
+}
+
+void check_points(const TriMesh& mesh, const std::vector<int>& points, const std::vector<int>& aux) {
+  const int nv = static_cast<int>(mesh.positions.size());
+  std::vector<char> referenced(nv, 0);
+  for (const auto& t : mesh.triangles) {
+    for (int v : t) {
+      if (v < 0 || v >= nv) throw InvalidInput(std::string(kFn) + "a triangle has a vertex index out of range");
+      referenced[v] = 1;
+    }
+  }
+  std::vector<int> all = points;
+  all.insert(all.end(), aux.begin(), aux.end());
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const std::string what = i < points.size() ? "partition point " + std::to_string(i)
+                                                : "auxiliary point " + std::to_string(i - points.size());
+    if (all[i] < 0 || all[i] >= nv) {
+      throw InvalidInput(std::string(kFn) + what + " = " + std::to_string(all[i]) + " is out of range [0," +
+                         std::to_string(nv) + ")");
+    }
+    if (!referenced[all[i]]) {
+      throw InvalidInput(std::string(kFn) + what + " = " + std::to_string(all[i]) +
+                         " is not a vertex of any triangle");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (all[j] == all[i]) {
+        throw InvalidInput(std::string(kFn) + what + " repeats " + vertex_name(all[i]) +
+                           ": partition and auxiliary points must be distinct");
+      }
+    }
+  }
+}
+
+PartitionResult partition_genus0(const TriMesh& mesh, const std::vector<int>& p, const std::vector<int>& aux,
+                                 const PartitionOptions& options) {
+  Partitioner part(mesh, options);
+  std::vector<PathSpec> specs;
+  for (int k = 0; k < 4; ++k) specs.push_back({p[k], p[(k + 1) % 4], aux.empty() ? -1 : aux[k]});
+  std::vector<int> special = p;
+  special.insert(special.end(), aux.begin(), aux.end());
+  part.trace(specs, special);
+
+  PartitionResult& r = part.result();
+  auto fail = [&](const std::string& why) {
+    throw SolverFailure(std::string(kFn) + "genus-0 partition failed validation: " + why);
+  };
+  const int regions = part.label_regions();
+  if (regions != 2) fail("the loop cuts the surface into " + std::to_string(regions) + " parts, not 2");
+  // Patch 0 is on the left of P0→P1, i.e. owns the half-edge P0→(next loop vertex).
+  const auto& path0 = part.paths()[0];
+  const int h0 = part.connectivity().find(r.mesh, path0[0], path0[1]);
+  const int left = r.face_patch[h0 / 3];
+  if (left == 1) {
+    for (int& f : r.face_patch) f = 1 - f;
+  }
+  const std::array<std::array<int, 4>, 2> corners = {{{p[0], p[1], p[2], p[3]}, {p[0], p[3], p[2], p[1]}}};
+  r.patches.assign(2, Patch());
+  for (int k = 0; k < 2; ++k) {
+    std::string why;
+    const auto cycle = part.disk_boundary(k, p[0], why);
+    if (cycle.empty()) fail("patch " + std::to_string(k) + ": " + why);
+    if (!Partitioner::make_sides(cycle, corners[k], r.patches[k])) {
+      fail("patch " + std::to_string(k) + " does not have the 4 corners in loop order");
+    }
+  }
+  std::string why;
+  if (!link_sides(r, why)) fail(why);
+  collect_faces(r);
+  return std::move(r);
+}
+
+PartitionResult partition_genus1(const TriMesh& mesh, const std::vector<int>& p, const std::vector<int>& a,
+                                 const PartitionOptions& options) {
+  Partitioner part(mesh, options);
+  // Edge k: from → to, guided by a[k] (see the header's picture).
+  const std::array<std::array<int, 2>, 8> ends = {
+      {{0, 1}, {1, 0}, {2, 3}, {3, 2}, {0, 2}, {2, 0}, {1, 3}, {3, 1}}};
+  std::vector<PathSpec> specs;
+  for (int k = 0; k < 8; ++k) specs.push_back({p[ends[k][0]], p[ends[k][1]], a[k]});
+  std::vector<int> special = p;
+  special.insert(special.end(), a.begin(), a.end());
+  part.trace(specs, special);
+
+  PartitionResult& r = part.result();
+  auto fail = [&](const std::string& why) {
+    throw InvalidInput(std::string(kFn) + "the genus-1 points do not cut the torus into a 2x2 grid of quads (" +
+                       why + "); check the order of the auxiliary points (see mesh_partition.h)");
+  };
+  const int regions = part.label_regions();
+  if (regions != 4) fail(std::to_string(regions) + " patches instead of 4");
+
+  // Which traced edge starts with (corner, next vertex), in either direction.
+  std::unordered_map<std::uint64_t, int> edge_by_start;
+  auto key = [](int u, int v) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(v);
+  };
+  for (int k = 0; k < 8; ++k) {
+    const auto& path = part.paths()[k];
+    edge_by_start[key(path[0], path[1])] = k;
+    edge_by_start[key(path.back(), path[path.size() - 2])] = k;
+  }
+  std::vector<Patch> patches(4);
+  std::vector<char> taken(4, 0);
+  std::vector<int> renumber(4, -1);
+  for (int region = 0; region < 4; ++region) {
+    std::string why;
+    const auto cycle = part.disk_boundary(region, p[0], why);
+    if (cycle.empty()) fail("patch " + std::to_string(region) + ": " + why);
+    std::array<int, 4> corners = {p[0], -1, p[3], -1};
+    std::vector<int> found;
+    for (int v : cycle) {
+      if (std::find(p.begin(), p.end(), v) != p.end()) found.push_back(v);
+    }
+    if (found.size() != 4 || found[2] != p[3] || (found[1] != p[1] && found[1] != p[2])) {
+      fail("a patch has " + std::to_string(found.size()) + " corners, or not P0,P1,P3,P2 in cyclic order");
+    }
+    corners[1] = found[1];
+    corners[3] = found[3];
+    Patch patch;
+    if (!Partitioner::make_sides(cycle, corners, patch)) fail("a patch's corners are out of order");
+    int a01 = -1, a02 = -1;
+    for (int s = 0; s < 4; ++s) {
+      const auto& v = patch.sides[s].vertices;
+      const auto it = edge_by_start.find(key(v[0], v[1]));
+      if (it == edge_by_start.end()) fail("a patch side is not one traced edge");
+      const int k = it->second;
+      if (k < 2) a01 = k;
+      if (k == 4 || k == 5) a02 = k - 4;
+    }
+    if (a01 < 0 || a02 < 0) fail("a patch does not have one P0-P1 and one P0-P2 side");
+    const int index = 2 * a01 + a02;
+    if (taken[index]) fail("two patches lie between the same P0-P1 and P0-P2 edges");
+    // Corner 0 is P_{a+2b}: the patch's lower-left corner in the cover picture.
+    const int first = static_cast<int>(std::find(corners.begin(), corners.end(), p[a01 + 2 * a02]) - corners.begin());
+    std::rotate(patch.corners.begin(), patch.corners.begin() + first, patch.corners.end());
+    std::rotate(patch.sides.begin(), patch.sides.begin() + first, patch.sides.end());
+    taken[index] = 1;
+    renumber[region] = index;
+    patches[index] = std::move(patch);
+  }
+  for (int& f : r.face_patch) f = renumber[f];
+  r.patches = std::move(patches);
+  std::string why;
+  if (!link_sides(r, why)) fail(why);
+  collect_faces(r);
+  return std::move(r);
+}
+
+}  // namespace
+
+PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector<int>& partition_points,
+                               const std::vector<int>& auxiliary_points, const PartitionOptions& options) {
+  const TriMesh& mesh = closed_manifold;
+  if (partition_points.size() != 4) {
+    throw InvalidInput(std::string(kFn) + "expected 4 partition points, got " +
+                       std::to_string(partition_points.size()));
+  }
+  check_points(mesh, partition_points, auxiliary_points);
+  const TopologyReport topo = analyze_topology(mesh);
+  if (!topo.manifold) {
+    throw InvalidInput(std::string(kFn) + "the mesh is not manifold (" + std::to_string(topo.non_manifold_edges) +
+                       " non-manifold edges, " + std::to_string(topo.non_manifold_vertices) +
+                       " non-manifold vertices); run repair_mesh first");
+  }
+  if (topo.boundary_edges > 0) {
+    throw InvalidInput(std::string(kFn) + "the mesh is not closed (" + std::to_string(topo.boundary_loops) +
+                       " boundary loops); run repair_mesh first");
+  }
+  if (topo.components != 1) {
+    throw InvalidInput(std::string(kFn) + "the mesh has " + std::to_string(topo.components) +
+                       " connected components; partition each one separately");
+  }
+  if (topo.degenerate_faces > 0) {
+    throw InvalidInput(std::string(kFn) + "the mesh has " + std::to_string(topo.degenerate_faces) +
+                       " degenerate triangles; run repair_mesh first");
+  }
+  if (!topo.genus) throw InvalidInput(std::string(kFn) + "the mesh is not orientable");
+  const int genus = *topo.genus;
+  if (genus == 0) {
+    if (!auxiliary_points.empty() && auxiliary_points.size() != 4) {
+      throw InvalidInput(std::string(kFn) + "a genus-0 mesh takes 0 or 4 auxiliary points, got " +
+                         std::to_string(auxiliary_points.size()));
+    }
+    return partition_genus0(mesh, partition_points, auxiliary_points, options);
+  }
+  if (genus == 1) {
+    if (auxiliary_points.size() != 8) {
+      throw InvalidInput(std::string(kFn) + "a genus-1 mesh takes 8 auxiliary points (one per patch edge), got " +
+                         std::to_string(auxiliary_points.size()));
+    }
+    return partition_genus1(mesh, partition_points, auxiliary_points, options);
+  }
+  throw InvalidInput(std::string(kFn) + "the mesh has genus " + std::to_string(genus) +
+                     "; only genus 0 (4 partition points) and genus 1 (4 partition + 8 auxiliary points) "
+                     "are supported");
+}
+
+PartitionStats partition_stats(const PartitionResult& r) {
+  PartitionStats stats;
+  const TriMesh& m = r.mesh;
+  auto polyline = [&](const std::vector<int>& v) {
+    double len = 0.0;
+    for (std::size_t i = 0; i + 1 < v.size(); ++i) len += (m.positions[v[i + 1]] - m.positions[v[i]]).norm();
+    return len;
+  };
+  double smallest = std::numeric_limits<double>::infinity(), largest = 0.0;
+  for (const Patch& patch : r.patches) {
+    PatchStats ps;
+    Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+    for (int f : patch.faces) {
+      const auto& t = m.triangles[f];
+      const Eigen::Vector3d n =
+          0.5 * (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]);
+      normal_sum += n;
+      ps.area += n.norm();
+    }
+    ps.flatness = ps.area > 0.0 ? normal_sum.norm() / ps.area : 0.0;
+    for (const PatchSide& side : patch.sides) ps.boundary_length += polyline(side.vertices);
+    smallest = std::min(smallest, ps.area);
+    largest = std::max(largest, ps.area);
+    stats.cut_length += 0.5 * ps.boundary_length;
+    stats.patches.push_back(ps);
+  }
+  stats.area_balance = largest > 0.0 ? smallest / largest : 0.0;
+  return stats;
+}
+
+}  // namespace geomip

@@ -1,0 +1,477 @@
+// Properties of partition_mesh() and choose_partition_points() on synthetic meshes (label unit).
+#include "param/mesh_partition.h"
+
+#include "param/errors.h"
+#include "param/mesh_topology.h"
+#include "param/partition_points.h"
+#include "tests/param/partition_checks.h"
+#include "tests/param/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+#include <string>
+
+namespace geomip {
+namespace {
+
+// 1-to-4 midpoint subdivision; with `radius` > 0 the vertices are projected on the sphere of that radius
+// around `center`.
+TriMesh subdivide(const TriMesh& in, int levels, const Eigen::Vector3d& center = Eigen::Vector3d::Zero(),
+                  double radius = 0.0) {
+  TriMesh m = in;
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<int, int>, int> mid;
+    auto midpoint = [&](int a, int b) {
+      const auto k = std::minmax(a, b);
+      const auto it = mid.find(k);
+      if (it != mid.end()) return it->second;
+      m.positions.push_back(0.5 * (m.positions[a] + m.positions[b]));
+      return mid[k] = static_cast<int>(m.positions.size()) - 1;
+    };
+    std::vector<std::array<int, 3>> tris;
+    for (const auto& t : m.triangles) {
+      const int a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), c = midpoint(t[2], t[0]);
+      tris.push_back({t[0], a, c});
+      tris.push_back({a, t[1], b});
+      tris.push_back({c, b, t[2]});
+      tris.push_back({a, b, c});
+    }
+    m.triangles = tris;
+  }
+  if (radius > 0.0) {
+    for (auto& p : m.positions) p = center + radius * (p - center).normalized();
+  }
+  return m;
+}
+
+// Unit sphere around the origin from a subdivided cube: 12·4^levels triangles.
+TriMesh sphere(int levels) {
+  TriMesh c = test::cube();
+  for (auto& p : c.positions) p -= Eigen::Vector3d::Constant(0.5);
+  return subdivide(c, levels, Eigen::Vector3d::Zero(), 1.0);
+}
+
+int nearest_vertex(const TriMesh& m, const Eigen::Vector3d& p) {
+  int best = 0;
+  for (int v = 1; v < static_cast<int>(m.positions.size()); ++v) {
+    if ((m.positions[v] - p).squaredNorm() < (m.positions[best] - p).squaredNorm()) best = v;
+  }
+  return best;
+}
+
+// Two tori joined by a tube: genus 2. The tube's winding and matching are searched so that the result is a
+// consistently oriented closed manifold.
+TriMesh double_torus() {
+  const int n = 16, mm = 8;
+  const TriMesh a = test::torus(n, mm);
+  TriMesh b = test::torus(n, mm);
+  for (auto& p : b.positions) p.x() += 3.0;
+  auto id = [&](int i, int j) { return ((i + n) % n) * mm + (j + mm) % mm; };
+  // Remove the quad (i=0, j=0) of A (facing +x) and (i=n/2, j=0) of B (facing -x).
+  const std::array<int, 4> ha = {id(0, 0), id(1, 0), id(1, 1), id(0, 1)};
+  const std::array<int, 4> hb = {id(n / 2, 0), id(n / 2 + 1, 0), id(n / 2 + 1, 1), id(n / 2, 1)};
+  auto without = [&](const TriMesh& t, int i) {
+    TriMesh r = t;
+    r.triangles.erase(r.triangles.begin() + 2 * (i * mm));  // the two triangles of quad (i, 0)
+    r.triangles.erase(r.triangles.begin() + 2 * (i * mm));
+    return r;
+  };
+  const TriMesh base = test::join(without(a, 0), without(b, n / 2));
+  const int off = static_cast<int>(a.positions.size());
+  for (int shift = 0; shift < 4; ++shift) {
+    for (int dir = -1; dir <= 1; dir += 2) {
+      for (int flip = 0; flip < 2; ++flip) {
+        TriMesh m = base;
+        for (int k = 0; k < 4; ++k) {
+          const int a0 = ha[k], a1 = ha[(k + 1) % 4];
+          const int b0 = hb[(shift + dir * k + 8) % 4] + off, b1 = hb[(shift + dir * (k + 1) + 8) % 4] + off;
+          std::array<int, 3> t1 = {a1, a0, b0}, t2 = {a1, b0, b1};
+          if (flip) {
+            std::swap(t1[1], t1[2]);
+            std::swap(t2[1], t2[2]);
+          }
+          m.triangles.push_back(t1);
+          m.triangles.push_back(t2);
+        }
+        const TopologyReport r = analyze_topology(m);
+        std::set<std::pair<int, int>> directed;
+        bool consistent = true;
+        for (const auto& t : m.triangles) {
+          for (int k = 0; k < 3; ++k) consistent &= directed.insert({t[k], t[(k + 1) % 3]}).second;
+        }
+        if (consistent && r.manifold && r.boundary_edges == 0 && r.genus == 2) return m;
+      }
+    }
+  }
+  ADD_FAILURE() << "could not build a double torus";
+  return base;
+}
+
+void expect_invalid(const TriMesh& m, const std::vector<int>& p, const std::vector<int>& aux,
+                    const std::string& fragment, const PartitionOptions& options = {}) {
+  try {
+    partition_mesh(m, p, aux, options);
+    ADD_FAILURE() << "no exception; expected one mentioning '" << fragment << "'";
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("partition_mesh:"), std::string::npos) << what;
+    EXPECT_NE(what.find(fragment), std::string::npos) << what;
+  }
+}
+
+// ------------------------------------------------------------------------------------------- genus 0
+
+TEST(PartitionGenus0, SphereEquatorLoopMakesNorthPatch0) {
+  const TriMesh m = sphere(4);  // 3072 triangles
+  const std::vector<int> p = {nearest_vertex(m, {1, 0, 0}), nearest_vertex(m, {0, 1, 0}),
+                              nearest_vertex(m, {-1, 0, 0}), nearest_vertex(m, {0, -1, 0})};
+  const PartitionResult r = partition_mesh(m, p, {});
+  EXPECT_EQ(test::check_partition(m, p, r), "");
+  // The loop runs CCW seen from +z, so patch 0 (left of the loop, outside) is the northern half.
+  for (int k = 0; k < 2; ++k) {
+    double z = 0.0;
+    for (int f : r.patches[k].faces) {
+      for (int v : r.mesh.triangles[f]) z += r.mesh.positions[v].z();
+    }
+    EXPECT_GT(k == 0 ? z : -z, 0.0) << "patch " << k;
+  }
+  const PartitionStats s = partition_stats(r);
+  EXPECT_GT(s.area_balance, 0.9);
+  EXPECT_NEAR(s.cut_length, 2 * 3.14159265, 0.6);  // about the equator
+  // Patch 1 is patch 0 mirrored across its diagonal P0-P2: side s of patch 0 is side 3-s of patch 1.
+  for (int s2 = 0; s2 < 4; ++s2) {
+    EXPECT_EQ(r.adjacency[s2].other_patch, 1);
+    EXPECT_EQ(r.adjacency[s2].other_side, 3 - s2);
+  }
+}
+
+TEST(PartitionGenus0, AuxiliaryPointsGuideThePaths) {
+  const TriMesh m = sphere(4);
+  const std::vector<int> p = {nearest_vertex(m, {1, 0, 0}), nearest_vertex(m, {0, 1, 0}),
+                              nearest_vertex(m, {-1, 0, 0}), nearest_vertex(m, {0, -1, 0})};
+  // Path 0 (P0→P1) is forced over the north pole.
+  const Eigen::Vector3d over = Eigen::Vector3d(0.5, 0.5, 1).normalized();
+  const std::vector<int> aux = {nearest_vertex(m, over), nearest_vertex(m, {-0.7, 0.7, -0.1}),
+                                nearest_vertex(m, {-0.7, -0.7, -0.1}), nearest_vertex(m, {0.7, -0.7, -0.1})};
+  const PartitionResult r = partition_mesh(m, p, aux);
+  EXPECT_EQ(test::check_partition(m, p, r), "");
+  for (int k = 0; k < 4; ++k) {
+    const auto& side = r.patches[0].sides[k].vertices;
+    EXPECT_NE(std::find(side.begin(), side.end(), aux[k]), side.end()) << "side " << k;
+  }
+  // The northern detour makes patch 0 (left of the loop) the smaller one.
+  const PartitionStats s = partition_stats(r);
+  EXPECT_LT(s.patches[0].area, s.patches[1].area);
+}
+
+TEST(PartitionGenus0, TetrahedronChordsAreSplit) {
+  const TriMesh m = test::tetrahedron();
+  const std::vector<int> p = {0, 1, 2, 3};
+  // The loop 0-1-2-3 leaves the chords 0-2 and 1-3: every triangle has 3 loop vertices.
+  const PartitionResult r = partition_mesh(m, p, {});
+  EXPECT_EQ(r.split_vertices, 2u);
+  EXPECT_EQ(r.mesh.num_vertices(), 6u);
+  EXPECT_EQ(r.mesh.num_triangles(), 8u);
+  EXPECT_EQ(test::check_partition(m, p, r), "");
+  PartitionOptions strict;
+  strict.split_degenerate = false;
+  expect_invalid(m, p, {}, "degenerate configuration", strict);
+}
+
+TEST(PartitionGenus0, CubeFaceLoopSplitsItsDiagonal) {
+  const TriMesh m = test::cube();
+  const std::vector<int> p = {0, 1, 2, 3};  // the bottom face; its diagonal 0-2 is a chord
+  const PartitionResult r = partition_mesh(m, p, {});
+  EXPECT_EQ(r.split_vertices, 1u);
+  EXPECT_EQ(test::check_partition(m, p, r), "");
+  // Untouched triangles keep their ids and corners.
+  int kept = 0;
+  for (std::size_t f = 0; f < m.triangles.size(); ++f) kept += r.mesh.triangles[f] == m.triangles[f];
+  EXPECT_EQ(kept, 10);
+}
+
+TEST(PartitionGenus0, EveryOrderedQuadrupleOnTetrahedronAndCubePartitions) {
+  // The coarsest closed meshes: paths are single edges, chords everywhere, corners walled in by earlier paths.
+  for (const TriMesh& m : {test::tetrahedron(), test::cube()}) {
+    const int nv = static_cast<int>(m.positions.size());
+    int count = 0;
+    std::vector<int> p(4);
+    for (p[0] = 0; p[0] < nv; ++p[0]) {
+      for (p[1] = 0; p[1] < nv; ++p[1]) {
+        for (p[2] = 0; p[2] < nv; ++p[2]) {
+          for (p[3] = 0; p[3] < nv; ++p[3]) {
+            if (std::set<int>(p.begin(), p.end()).size() != 4) continue;
+            ++count;
+            try {
+              const PartitionResult r = partition_mesh(m, p, {});
+              ASSERT_EQ(test::check_partition(m, p, r), "") << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+            } catch (const Error& e) {
+              ADD_FAILURE() << p[0] << "," << p[1] << "," << p[2] << "," << p[3] << ": " << e.what();
+            }
+          }
+        }
+      }
+    }
+    EXPECT_EQ(count, nv * (nv - 1) * (nv - 2) * (nv - 3));
+  }
+}
+
+TEST(PartitionGenus0, WalledInCornerIsFreedBySplittingChords) {
+  // On the cube, paths 0-6 and 6-3 leave vertex 3's free neighbours cut off from 1 by chords.
+  const TriMesh m = test::cube();
+  const std::vector<int> p = {0, 6, 3, 1};
+  PartitionOptions strict;
+  strict.split_degenerate = false;
+  expect_invalid(m, p, {}, "cannot trace path 2 from vertex 3 to vertex 1", strict);
+  const PartitionResult r = partition_mesh(m, p, {});
+  EXPECT_GT(r.split_vertices, 0u);
+  EXPECT_EQ(test::check_partition(m, p, r), "");
+}
+
+TEST(PartitionGenus0, RandomQuadruplesOnASubdividedCubeAreValidOrCleanlyRejected) {
+  const TriMesh m = subdivide(test::cube(), 1);
+  const int nv = static_cast<int>(m.positions.size());
+  std::mt19937 rng(7);
+  int valid = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    std::vector<int> ids(nv);
+    std::iota(ids.begin(), ids.end(), 0);
+    std::shuffle(ids.begin(), ids.end(), rng);
+    const std::vector<int> p(ids.begin(), ids.begin() + 4);
+    try {
+      const PartitionResult r = partition_mesh(m, p, {});
+      EXPECT_EQ(test::check_partition(m, p, r), "") << "points " << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+      ++valid;
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("cannot trace path"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GT(valid, 360);
+}
+
+TEST(PartitionGenus0, RandomPointsOnAFineSphereAlwaysPartition) {
+  const TriMesh m = sphere(3);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(m.positions.size()) - 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<int> p;
+    while (p.size() < 4) {
+      const int v = pick(rng);
+      if (std::find(p.begin(), p.end(), v) == p.end()) p.push_back(v);
+    }
+    const PartitionResult r = partition_mesh(m, p, {});
+    EXPECT_EQ(test::check_partition(m, p, r), "") << "trial " << trial;
+  }
+}
+
+TEST(PartitionChecks, TheCheckerCatchesBrokenResults) {
+  // check_partition() is what the other tests rely on: it must see each kind of damage.
+  const TriMesh m = sphere(3);
+  const std::vector<int> p = {nearest_vertex(m, {1, 0, 0}), nearest_vertex(m, {0, 1, 0}),
+                              nearest_vertex(m, {-1, 0, 0}), nearest_vertex(m, {0, -1, 0})};
+  const PartitionResult good = partition_mesh(m, p, {});
+  ASSERT_EQ(test::check_partition(m, p, good), "");
+  std::vector<std::pair<std::string, PartitionResult>> broken;
+  broken.emplace_back("face moved to the other patch", good);
+  {
+    auto& r = broken.back().second;
+    const int f = r.patches[0].faces.back();
+    r.patches[0].faces.pop_back();
+    r.patches[1].faces.push_back(f);
+    r.face_patch[f] = 1;
+  }
+  broken.emplace_back("face dropped", good);
+  broken.back().second.patches[1].faces.pop_back();
+  broken.emplace_back("side reversed", good);
+  {
+    auto& v = broken.back().second.patches[0].sides[1].vertices;
+    std::reverse(v.begin(), v.end());
+  }
+  broken.emplace_back("corners rotated", good);
+  {
+    auto& patch = broken.back().second.patches[1];
+    std::rotate(patch.corners.begin(), patch.corners.begin() + 1, patch.corners.end());
+    std::rotate(patch.sides.begin(), patch.sides.begin() + 1, patch.sides.end());
+  }
+  broken.emplace_back("wrong gluing", good);
+  broken.back().second.adjacency[0].other_side = 2;
+  broken.emplace_back("vertex moved", good);
+  broken.back().second.mesh.positions[p[2]].z() += 0.01;
+  for (const auto& [what, r] : broken) EXPECT_NE(test::check_partition(m, p, r), "") << what;
+
+  // The cube's bottom loop with its chord 0-2 put back (the split undone): only that defect is reported.
+  const TriMesh cube = test::cube();
+  const std::vector<int> q = {0, 1, 2, 3};
+  PartitionResult unsplit = partition_mesh(cube, q, {});
+  ASSERT_EQ(unsplit.split_vertices, 1u);
+  unsplit.mesh = cube;
+  unsplit.split_vertices = 0;
+  unsplit.face_patch.resize(cube.triangles.size());
+  for (auto& patch : unsplit.patches) {
+    patch.faces.erase(std::remove_if(patch.faces.begin(), patch.faces.end(), [](int f) { return f >= 12; }),
+                      patch.faces.end());
+  }
+  const std::string problems = test::check_partition(cube, q, unsplit);
+  EXPECT_NE(problems.find("all vertices on the cut"), std::string::npos) << problems;
+  EXPECT_EQ(problems.find(';'), problems.rfind(';')) << "only one problem expected: " << problems;
+}
+
+TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {
+  TriMesh m = sphere(4);
+  for (auto& q : m.positions) q = Eigen::Vector3d(3 * q.x() + 0.2 * q.y(), 2 * q.y(), 0.7 * q.z());
+  const PartitionPoints pts = choose_partition_points(m);
+  ASSERT_EQ(pts.partition_points.size(), 4u);
+  EXPECT_EQ(pts.auxiliary_points.size(), 4u);
+  const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
+  EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
+  const PartitionStats s = partition_stats(r);
+  EXPECT_GT(s.area_balance, 0.9);
+  // Each half is the top or the bottom (z) of the flat ellipsoid: nearly a height field.
+  for (const auto& ps : s.patches) EXPECT_GT(ps.flatness, 0.6);
+  // Corners are the x and y extremes of the outline.
+  double max_abs_x = 0.0;
+  for (int v : pts.partition_points) max_abs_x = std::max(max_abs_x, std::abs(m.positions[v].x()));
+  EXPECT_GT(max_abs_x, 2.9);
+}
+
+// ------------------------------------------------------------------------------------------- genus 1
+
+struct TorusSetup {
+  TriMesh mesh;
+  std::vector<int> p, aux;
+};
+
+// Torus grid (i around the big circle, j around the tube) with the corners and auxiliary points on grid lines.
+TorusSetup torus_setup(int n, int m) {
+  TorusSetup t{test::torus(n, m), {}, {}};
+  auto id = [&](int i, int j) { return ((i + n) % n) * m + (j + m) % m; };
+  t.p = {id(0, 0), id(n / 2, 0), id(0, m / 2), id(n / 2, m / 2)};
+  t.aux = {id(n / 4, 0),     id(3 * n / 4, 0),     id(n / 4, m / 2), id(3 * n / 4, m / 2),
+           id(0, m / 4),     id(0, 3 * m / 4),     id(n / 2, m / 4), id(n / 2, 3 * m / 4)};
+  return t;
+}
+
+TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
+  const TorusSetup t = torus_setup(24, 12);
+  const PartitionResult r = partition_mesh(t.mesh, t.p, t.aux);
+  EXPECT_EQ(test::check_partition(t.mesh, t.p, r), "");
+  ASSERT_EQ(r.patches.size(), 4u);
+  auto side_between = [](const Patch& patch, int a, int b) -> const std::vector<int>* {
+    for (int s = 0; s < 4; ++s) {
+      const auto& v = patch.sides[s].vertices;
+      if ((v.front() == a && v.back() == b) || (v.front() == b && v.back() == a)) return &v;
+    }
+    return nullptr;
+  };
+  auto contains = [](const std::vector<int>* v, int x) {
+    return v && std::find(v->begin(), v->end(), x) != v->end();
+  };
+  for (int index = 0; index < 4; ++index) {
+    const Patch& patch = r.patches[index];
+    const int a = index / 2, b = index % 2;
+    EXPECT_TRUE(contains(side_between(patch, t.p[0], t.p[1]), t.aux[a])) << "patch " << index;
+    EXPECT_TRUE(contains(side_between(patch, t.p[0], t.p[2]), t.aux[4 + b])) << "patch " << index;
+    EXPECT_TRUE(contains(side_between(patch, t.p[2], t.p[3]), t.aux[2]) ||
+                contains(side_between(patch, t.p[2], t.p[3]), t.aux[3]));
+    // Corner 0 is the patch's lower-left corner P_{a+2b}; corners P0, P1, P3, P2 in cyclic order.
+    const auto& c = patch.corners;
+    EXPECT_EQ(c[0], t.p[a + 2 * b]) << "patch " << index;
+    EXPECT_EQ(c[2], t.p[3 - (a + 2 * b)]) << "patch " << index;
+  }
+  // Side 0 is of the same kind (P0-P1/P2-P3 "horizontal" or P0-P2/P1-P3 "vertical") in all patches, so the
+  // 4 squares tile a 2x2 periodic grid with translations. Here: sides 0 and 2 of patch 0 vs 1 and 3 of patch 1.
+  auto horizontal = [&](const PatchSide& s) {
+    const std::set<int> ends = {s.vertices.front(), s.vertices.back()};
+    return ends == std::set<int>{t.p[0], t.p[1]} || ends == std::set<int>{t.p[2], t.p[3]};
+  };
+  for (int index = 0; index < 4; ++index) {
+    for (int s = 0; s < 4; ++s) {
+      EXPECT_EQ(horizontal(r.patches[index].sides[s]), horizontal(r.patches[0].sides[s % 2]));
+    }
+  }
+  // Translational gluing in the 2x2 grid: the right side (1) of cell (a,b) is the left side (3) of cell
+  // (a+1,b), the top (2) of (a,b) the bottom (0) of (a,b+1), periodically; cells are (a,b) or (b,a).
+  const bool transposed = !horizontal(r.patches[0].sides[0]);
+  for (int index = 0; index < 4; ++index) {
+    int x = index / 2, y = index % 2;
+    if (transposed) std::swap(x, y);
+    auto cell = [&](int cx, int cy) {
+      cx = (cx + 2) % 2;
+      cy = (cy + 2) % 2;
+      return transposed ? 2 * cy + cx : 2 * cx + cy;
+    };
+    EXPECT_EQ(r.adjacency[4 * index + 1].other_patch, cell(x + 1, y));
+    EXPECT_EQ(r.adjacency[4 * index + 1].other_side, 3);
+    EXPECT_EQ(r.adjacency[4 * index + 2].other_patch, cell(x, y + 1));
+    EXPECT_EQ(r.adjacency[4 * index + 2].other_side, 0);
+  }
+  // Each corner has the grid diagonal across 2 of its 4 corner triangles: 4 × 2 chords split.
+  EXPECT_EQ(r.split_vertices, 8u);
+  // Symmetric torus, symmetric grid: equal areas.
+  EXPECT_GT(partition_stats(r).area_balance, 0.999);
+}
+
+TEST(PartitionGenus1, CoarseTorusStillValid) {
+  const TorusSetup t = torus_setup(8, 8);
+  const PartitionResult r = partition_mesh(t.mesh, t.p, t.aux);
+  EXPECT_EQ(test::check_partition(t.mesh, t.p, r), "");
+}
+
+TEST(PartitionGenus1, ContractibleEdgePairIsRejected) {
+  TorusSetup t = torus_setup(24, 12);
+  // e1 guided next to e0 instead of the other way round the torus: e0 and e1 bound a thin disk (2 sides).
+  t.aux[1] = ((24 / 4) % 24) * 12 + 1;
+  expect_invalid(t.mesh, t.p, t.aux, "2x2 grid");
+}
+
+TEST(PartitionGenus1, ChosenPointsPartitionATorus) {
+  const TriMesh m = test::torus(40, 16);
+  const PartitionPoints pts = choose_partition_points(m);
+  ASSERT_EQ(pts.partition_points.size(), 4u);
+  ASSERT_EQ(pts.auxiliary_points.size(), 8u);
+  const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
+  EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
+  EXPECT_GT(partition_stats(r).area_balance, 0.6);
+}
+
+// ------------------------------------------------------------------------------------------- bad input
+
+TEST(PartitionErrors, BadPointsAreRejectedWithAClearMessage) {
+  const TriMesh m = sphere(2);
+  const int nv = static_cast<int>(m.positions.size());
+  expect_invalid(m, {0, 1, 2}, {}, "expected 4 partition points, got 3");
+  expect_invalid(m, {0, 1, 2, 3, 4}, {}, "expected 4 partition points, got 5");
+  expect_invalid(m, {0, 5, 9, 5}, {}, "must be distinct");
+  expect_invalid(m, {0, 5, 9, nv}, {}, "out of range");
+  expect_invalid(m, {-1, 5, 9, 20}, {}, "out of range");
+  expect_invalid(m, {0, 5, 9, 20}, {1, 2, 3}, "0 or 4 auxiliary points");
+  expect_invalid(m, {0, 5, 9, 20}, {1, 2, 3, 9}, "must be distinct");
+  TriMesh with_unused = m;
+  with_unused.positions.emplace_back(5, 5, 5);
+  expect_invalid(with_unused, {0, 5, 9, nv}, {}, "not a vertex of any triangle");
+}
+
+TEST(PartitionErrors, BadMeshesAreRejectedWithAClearMessage) {
+  expect_invalid(test::grid(6), {0, 3, 20, 30}, {}, "not closed");
+  const TriMesh two = test::join(sphere(1), sphere(1));
+  expect_invalid(two, {0, 3, 20, 30}, {}, "2 connected components");
+  TriMesh flipped = sphere(2);
+  std::swap(flipped.triangles[5][0], flipped.triangles[5][1]);
+  EXPECT_THROW(partition_mesh(flipped, {0, 3, 20, 30}, {}), InvalidInput);
+  const TriMesh dt = double_torus();
+  expect_invalid(dt, {0, 3, 20, 30}, {}, "genus 2");
+  EXPECT_THROW(choose_partition_points(dt), InvalidInput);
+  const TorusSetup t = torus_setup(16, 8);
+  expect_invalid(t.mesh, t.p, {}, "8 auxiliary points");
+  std::vector<int> aux = t.aux;
+  aux[7] = t.p[2];
+  expect_invalid(t.mesh, t.p, aux, "must be distinct");
+}
+
+}  // namespace
+}  // namespace geomip

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   auto add = [&](CommandRunner run) { commands.push_back({app.get_subcommands({}).back(), std::move(run)}); };
   add(add_info_command(app));
   add(add_repair_command(app));
+  add(add_param_command(app));
 
   try {
     app.parse(argc, argv);

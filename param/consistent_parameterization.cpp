@@ -1,0 +1,318 @@
+#include "param/consistent_parameterization.h"
+
+#include "param/coarse_to_fine.h"
+#include "param/errors.h"
+#include "param/feature_warp.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace geomip {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// A patch cut out of the partitioned mesh with local vertex ids, and everything the later stages need.
+struct PatchWork {
+  TriMesh local;                   // positions and CCW triangles in local ids
+  std::vector<int> to_mesh;        // local id → mesh id
+  std::array<int, 4> corners{};    // local ids
+  PatchSides sides;                // local ids
+  std::vector<int> features;       // local ids, in the order of `feature_index`
+  std::vector<int> feature_index;  // index of each of `features` in the model's feature list
+  ProgressiveMesh pm;
+  std::vector<Eigen::Vector2d> uv;  // per local vertex (base vertices valid after the base embedding)
+};
+
+struct ModelWork {
+  PartitionResult partition;
+  std::vector<PatchWork> patches;
+  std::vector<int> feature_patch;  // patch of each feature
+};
+
+void report(const ParameterizationOptions& o, const char* stage, double f) {
+  if (o.progress) o.progress(stage, f);
+}
+
+PatchWork extract_patch(const PartitionResult& partition, const Patch& patch) {
+  PatchWork w;
+  std::vector<int> to_local(partition.mesh.positions.size(), -1);
+  for (int f : patch.faces) {
+    for (int v : partition.mesh.triangles[f]) {
+      if (to_local[v] < 0) {
+        to_local[v] = 0;  // mark; ids assigned in ascending mesh order below
+      }
+    }
+  }
+  for (std::size_t v = 0; v < to_local.size(); ++v) {
+    if (to_local[v] == 0) {
+      to_local[v] = static_cast<int>(w.to_mesh.size());
+      w.to_mesh.push_back(static_cast<int>(v));
+      w.local.positions.push_back(partition.mesh.positions[v]);
+    }
+  }
+  for (int f : patch.faces) {
+    const auto& t = partition.mesh.triangles[f];
+    w.local.triangles.push_back({to_local[t[0]], to_local[t[1]], to_local[t[2]]});
+  }
+  for (int k = 0; k < 4; ++k) {
+    w.corners[k] = to_local[patch.corners[k]];
+    for (int v : patch.sides[k].vertices) w.sides[k].push_back(to_local[v]);
+  }
+  return w;
+}
+
+std::vector<char> boundary_mask(const PatchWork& w) {
+  std::vector<char> mask(w.local.positions.size(), 0);
+  for (const auto& side : w.sides) {
+    for (int v : side) mask[v] = 1;
+  }
+  return mask;
+}
+
+// Compact copy of the base mesh (only base vertices) for the optimizer and the warp, which want every
+// vertex referenced and every uv finite.
+struct BaseMesh {
+  std::vector<int> to_patch;  // base id → local patch id
+  std::vector<int> to_base;   // local patch id → base id or -1
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<Eigen::Vector2d> uv;
+};
+
+BaseMesh base_mesh(const PatchWork& w) {
+  BaseMesh b;
+  b.to_base.assign(w.local.positions.size(), -1);
+  for (int v : w.pm.base_vertices) {
+    b.to_base[v] = static_cast<int>(b.to_patch.size());
+    b.to_patch.push_back(v);
+    b.positions.push_back(w.local.positions[v]);
+    b.uv.push_back(w.uv[v]);
+  }
+  for (const auto& t : w.pm.base_triangles) b.triangles.push_back({b.to_base[t[0]], b.to_base[t[1]], b.to_base[t[2]]});
+  return b;
+}
+
+void store_base(const BaseMesh& b, PatchWork& w) {
+  for (std::size_t i = 0; i < b.to_patch.size(); ++i) w.uv[b.to_patch[i]] = b.uv[i];
+}
+
+}  // namespace
+
+std::vector<ModelParameterization> parameterize_consistently(const std::vector<ParameterizationInput>& models,
+                                                             const ParameterizationOptions& options) {
+  if (models.empty()) throw InvalidInput("parameterize_consistently: no model");
+  const std::size_t num_features = models[0].features.size();
+  for (const auto& m : models) {
+    if (m.features.size() != num_features) {
+      throw InvalidInput("parameterize_consistently: model '" + m.name + "' has " + std::to_string(m.features.size()) +
+                         " features, model '" + models[0].name + "' has " + std::to_string(num_features) +
+                         " (features correspond by order: the counts must agree)");
+    }
+  }
+
+  std::vector<ModelWork> work(models.size());
+  std::vector<ModelParameterization> out(models.size());
+  const double total_steps = 3.0 * models.size();
+
+  // Phase A, per model: partition, patches, progressive meshes, base embeddings.
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    const auto& in = models[i];
+    auto& w = work[i];
+    auto& o = out[i];
+    report(options, "partition", i / total_steps);
+    auto t0 = Clock::now();
+    w.partition = partition_mesh(in.mesh, in.partition_points, in.auxiliary_points);
+    o.seconds.partition = seconds_since(t0);
+    if (i > 0 && w.partition.patches.size() != work[0].partition.patches.size()) {
+      throw InvalidInput("parameterize_consistently: model '" + in.name + "' has " +
+                         std::to_string(w.partition.patches.size()) + " patches, model '" + models[0].name +
+                         "' has " + std::to_string(work[0].partition.patches.size()) + " (different genus)");
+    }
+
+    // Features: interior vertices of a patch, in the same patch in every model.
+    std::vector<int> vertex_feature(w.partition.mesh.positions.size(), -1);
+    for (std::size_t k = 0; k < in.features.size(); ++k) {
+      const int v = in.features[k];
+      if (v < 0 || static_cast<std::size_t>(v) >= in.mesh.positions.size()) {
+        throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " of model '" + in.name +
+                           "' is vertex " + std::to_string(v) + ", out of range");
+      }
+      if (vertex_feature[v] >= 0) {
+        throw InvalidInput("parameterize_consistently: features " + std::to_string(vertex_feature[v]) + " and " +
+                           std::to_string(k) + " of model '" + in.name + "' are the same vertex");
+      }
+      vertex_feature[v] = static_cast<int>(k);
+    }
+    w.feature_patch.assign(in.features.size(), -1);
+
+    for (std::size_t p = 0; p < w.partition.patches.size(); ++p) {
+      PatchWork pw = extract_patch(w.partition, w.partition.patches[p]);
+      const std::vector<char> on_boundary = boundary_mask(pw);
+      for (std::size_t v = 0; v < pw.to_mesh.size(); ++v) {
+        const int k = vertex_feature[pw.to_mesh[v]];
+        if (k < 0) continue;
+        if (on_boundary[v]) {
+          throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " of model '" + in.name +
+                             "' (vertex " + std::to_string(in.features[k]) +
+                             ") lies on the partition cut; features must be inside a patch");
+        }
+        w.feature_patch[k] = static_cast<int>(p);
+        pw.features.push_back(static_cast<int>(v));
+        pw.feature_index.push_back(k);
+      }
+      t0 = Clock::now();
+      pw.pm = progressive_mesh(pw.local, pw.sides, pw.features, options.progressive_mesh);
+      o.seconds.progressive_mesh += seconds_since(t0);
+
+      t0 = Clock::now();
+      const std::vector<FixedUv> boundary = square_boundary_uv(pw.local.positions, pw.pm.sides);
+      pw.uv = mean_value_embedding(pw.local.positions, pw.pm.base_triangles, boundary).uv;
+      BaseMesh base = base_mesh(pw);
+      std::vector<char> locked(base.to_patch.size(), 0);
+      for (std::size_t b = 0; b < locked.size(); ++b) locked[b] = on_boundary[base.to_patch[b]];
+      StretchOptimizationOptions base_options = options.base_optimization;
+      base_options.seed = options.seed + static_cast<unsigned>(p);
+      optimize_stretch(base.positions, base.triangles, base.uv, locked, base_options);
+      store_base(base, pw);
+      o.seconds.base_embedding += seconds_since(t0);
+      w.patches.push_back(std::move(pw));
+    }
+    if (i > 0) {
+      for (std::size_t k = 0; k < num_features; ++k) {
+        if (w.feature_patch[k] != work[0].feature_patch[k]) {
+          throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " is in patch " +
+                             std::to_string(w.feature_patch[k]) + " of model '" + in.name + "' but in patch " +
+                             std::to_string(work[0].feature_patch[k]) + " of model '" + models[0].name +
+                             "': corresponding features must lie on corresponding sides of the partition loop");
+        }
+      }
+    }
+  }
+
+  // Phase B, per patch: align corresponding features at their average (u,v) (§3.4).
+  report(options, "feature alignment", models.size() / total_steps);
+  if (num_features > 0) {
+    const std::size_t num_patches = work[0].patches.size();
+    for (std::size_t p = 0; p < num_patches; ++p) {
+      if (work[0].patches[p].features.empty()) continue;
+      std::vector<std::vector<Eigen::Vector2d>> per_model;
+      for (const auto& w : work) {
+        std::vector<Eigen::Vector2d> f;
+        for (int v : w.patches[p].features) f.push_back(w.patches[p].uv[v]);
+        per_model.push_back(std::move(f));
+      }
+      // Features of a patch are in the same order in every model (ascending local id in model 0 would not
+      // be): reorder each model's list by feature index.
+      std::vector<std::vector<Eigen::Vector2d>> ordered(work.size());
+      for (std::size_t i = 0; i < work.size(); ++i) {
+        const auto& pw = work[i].patches[p];
+        std::vector<std::pair<int, Eigen::Vector2d>> by_index;
+        for (std::size_t j = 0; j < pw.features.size(); ++j) by_index.emplace_back(pw.feature_index[j], per_model[i][j]);
+        std::sort(by_index.begin(), by_index.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+        for (const auto& e : by_index) ordered[i].push_back(e.second);
+      }
+      const std::vector<Eigen::Vector2d> targets = average_feature_targets(ordered);
+      for (std::size_t i = 0; i < work.size(); ++i) {
+        auto& pw = work[i].patches[p];
+        const auto t0 = Clock::now();
+        BaseMesh base = base_mesh(pw);
+        std::vector<std::pair<int, int>> index_and_base;
+        for (std::size_t j = 0; j < pw.features.size(); ++j) {
+          index_and_base.emplace_back(pw.feature_index[j], base.to_base[pw.features[j]]);
+        }
+        std::sort(index_and_base.begin(), index_and_base.end());
+        std::vector<int> features;
+        for (const auto& e : index_and_base) features.push_back(e.second);
+        const FeatureWarpResult r = warp_features(base.triangles, base.uv, features, targets);
+        if (!r.unreached.empty()) {
+          throw SolverFailure("parameterize_consistently: the feature warp could not move " +
+                              std::to_string(r.unreached.size()) + " feature(s) of model '" + models[i].name +
+                              "' to their common position without folding");
+        }
+        // Exact targets: the warp reaches them to rounding; store the common value itself.
+        for (std::size_t j = 0; j < features.size(); ++j) base.uv[features[j]] = targets[j];
+        store_base(base, pw);
+        out[i].warp_events += r.events;
+        out[i].seconds.feature_warp += seconds_since(t0);
+      }
+    }
+  }
+
+  // Phase C, per model and patch: coarse-to-fine with local stretch optimization, final sweeps.
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    auto& w = work[i];
+    auto& o = out[i];
+    report(options, "coarse-to-fine", (models.size() + 2.0 * i) / total_steps);
+    o.mesh = w.partition.mesh;
+    o.adjacency = w.partition.adjacency;
+    o.split_vertices = w.partition.split_vertices;
+    o.features.assign(num_features, FeatureLocation{});
+    for (std::size_t p = 0; p < w.patches.size(); ++p) {
+      PatchWork& pw = w.patches[p];
+      const std::vector<char> on_boundary = boundary_mask(pw);
+      std::vector<char> locked = on_boundary;
+      for (int v : pw.features) locked[v] = 1;
+
+      auto t0 = Clock::now();
+      CoarseToFine c2f(pw.local, pw.pm, pw.uv);
+      std::mt19937 rng(options.seed * 7919u + static_cast<unsigned>(p));
+      const VertexOptimizer optimize = [&](int v, const std::vector<int>& ring) {
+        if (locked[v]) return;
+        optimize_vertex(v, ring, pw.local.positions, c2f.current_triangles(), c2f.uv(), options.local_optimization,
+                        rng);
+      };
+      c2f.refine_all(optimize);
+      CoarseToFineResult r = c2f.result();
+      o.seconds.coarse_to_fine += seconds_since(t0);
+
+      t0 = Clock::now();
+      if (options.final_sweeps > 0) {
+        StretchOptimizationOptions final_options = options.base_optimization;
+        final_options.max_sweeps = options.final_sweeps;
+        final_options.seed = options.seed + 101u * static_cast<unsigned>(p + 1);
+        optimize_stretch(pw.local.positions, r.triangles, r.uv, locked, final_options);
+      }
+      o.seconds.final_optimization += seconds_since(t0);
+
+      PatchParameterization pp;
+      pp.vertices = pw.to_mesh;
+      pp.triangles = r.triangles;
+      pp.uv = r.uv;
+      for (int k = 0; k < 4; ++k) {
+        pp.corners[k] = pw.to_mesh[pw.corners[k]];
+        for (int v : pw.pm.sides[k]) pp.sides[k].push_back(pw.to_mesh[v]);
+      }
+      pp.base_vertices = pw.pm.base_vertices.size();
+      pp.stretch = mesh_stretch(pw.local.positions, pp.triangles, pp.uv);
+      pp.flipped = count_flipped(pp.triangles, pp.uv);
+      pp.boundary_off_chord = r.boundary_off_chord;
+      if (pp.flipped != 0) {
+        throw SolverFailure("parameterize_consistently: patch " + std::to_string(p) + " of model '" +
+                            models[i].name + "' has " + std::to_string(pp.flipped) + " flipped triangles");
+      }
+      if (options.measure_mvc_baseline) {
+        t0 = Clock::now();
+        const auto mvc = mean_value_embedding(pw.local.positions, pw.local.triangles,
+                                              square_boundary_uv(pw.local.positions, pw.pm.sides));
+        pp.mvc_stretch = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
+        o.seconds.mvc_baseline += seconds_since(t0);
+      }
+      for (std::size_t j = 0; j < pw.features.size(); ++j) {
+        FeatureLocation& f = o.features[pw.feature_index[j]];
+        f.vertex = pw.to_mesh[pw.features[j]];
+        f.patch = static_cast<int>(p);
+        f.uv = pp.uv[pw.features[j]];
+      }
+      o.patches.push_back(std::move(pp));
+    }
+  }
+  report(options, "done", 1.0);
+  return out;
+}
+
+}  // namespace geomip

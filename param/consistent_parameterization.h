@@ -1,0 +1,97 @@
+// Consistent parameterization of one or several meshes over a common quad-patch base domain: the whole of
+// §3 of ../shared/seed/consistent-mesh-parameterizations.txt, wired from its steps:
+//   partition (mesh_partition.h) → per patch progressive mesh (progressive_mesh.h) → mean-value embedding of
+//   the base mesh (mean_value_embedding.h) → stretch optimization (stretch_optimization.h) → feature alignment
+//   across models (feature_warp.h) → coarse-to-fine vertex insertion with local stretch optimization
+//   (coarse_to_fine.h) → a few global stretch sweeps.
+#pragma once
+
+#include "param/mean_value_embedding.h"
+#include "param/mesh.h"
+#include "param/mesh_partition.h"
+#include "param/progressive_mesh.h"
+#include "param/stretch.h"
+#include "param/stretch_optimization.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace geomip {
+
+/// One model to parameterize.
+struct ParameterizationInput {
+  TriMesh mesh;                        ///< closed, manifold, consistently oriented, one component
+  std::vector<int> partition_points;   ///< 4 vertex ids, in loop order; corresponding across models
+  std::vector<int> auxiliary_points;   ///< genus 0: none or 4 path guides; genus 1: 8 (see partition_mesh())
+  std::vector<int> features;           ///< feature vertex ids; same count and order in every model
+  std::string name;                    ///< for messages
+};
+
+struct ParameterizationOptions {
+  ProgressiveMeshOptions progressive_mesh;
+  /// Stretch optimization of each base mesh's MVC embedding (boundary locked, features free).
+  StretchOptimizationOptions base_optimization;
+  /// Local optimization of each inserted vertex and its neighbours during coarse-to-fine.
+  VertexOptimizationOptions local_optimization;
+  /// Global sweeps over each full patch after coarse-to-fine (boundary and features locked); 0 = none.
+  std::size_t final_sweeps = 10;
+  /// Also compute the mean-value embedding of each full patch, the baseline the stretch figures are
+  /// reported against (one sparse solve per patch).
+  bool measure_mvc_baseline = true;
+  /// Seed of the random search directions (results are deterministic for a given seed).
+  unsigned seed = 1;
+  ProgressCallback progress;
+};
+
+/// One patch's parameterization, in the unit square.
+struct PatchParameterization {
+  std::vector<int> vertices;                  ///< local id → vertex id in ModelParameterization::mesh
+  std::vector<std::array<int, 3>> triangles;  ///< local ids, counter-clockwise in uv and on the surface
+  std::vector<Eigen::Vector2d> uv;            ///< per local vertex, in [0,1]²
+  std::array<int, 4> corners{};               ///< mesh vertex ids at (0,0), (1,0), (1,1), (0,1)
+  std::array<std::vector<int>, 4> sides;      ///< mesh vertex ids, side k from corner k to corner k+1
+  std::size_t base_vertices = 0;              ///< vertices of the progressive mesh's base mesh
+  StretchValues mvc_stretch;                  ///< of the full patch's MVC embedding (if measured)
+  StretchValues stretch;                      ///< of the final parameterization
+  std::size_t flipped = 0;                    ///< triangles with uv area <= 0 in the final result (0)
+  std::size_t boundary_off_chord = 0;         ///< boundary vertices not at their chord-length position
+};
+
+/// Where a feature ended.
+struct FeatureLocation {
+  int vertex = -1;
+  int patch = -1;
+  Eigen::Vector2d uv{0, 0};
+};
+
+/// Seconds spent in each stage (summed over the patches of the model; the warp is shared by all models and
+/// counted in each).
+struct StageSeconds {
+  double partition = 0, progressive_mesh = 0, base_embedding = 0, feature_warp = 0, coarse_to_fine = 0,
+         final_optimization = 0, mvc_baseline = 0;
+};
+
+struct ModelParameterization {
+  TriMesh mesh;  ///< the input mesh with partition split vertices appended (originals keep ids)
+  std::vector<PatchParameterization> patches;
+  std::vector<SideLink> adjacency;  ///< from partition_mesh(): adjacency[4·p + s] is side s of patch p
+  std::vector<FeatureLocation> features;
+  std::size_t split_vertices = 0;
+  std::size_t warp_events = 0;  ///< Delaunay flips of the feature warp, over this model's patches
+  StageSeconds seconds;
+};
+
+/// Parameterizes `models` consistently: corresponding patches over the same unit squares, corresponding
+/// features at identical (u,v). One model is a plain (non-consistent) parameterization.
+///
+/// \throw InvalidInput when the models disagree (genus, feature counts), a point is invalid (see
+///   partition_mesh()), a feature lies on the partition cut, corresponding features fall in different
+///   patches, or a mesh is not closed and manifold.
+/// \throw SolverFailure when a stage breaks its guarantees (a bug: never the input's fault).
+std::vector<ModelParameterization> parameterize_consistently(const std::vector<ParameterizationInput>& models,
+                                                             const ParameterizationOptions& options = {});
+
+}  // namespace geomip

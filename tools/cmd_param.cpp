@@ -1,0 +1,268 @@
+// geomip param MESH... -o DIR [--points CORR.json]: consistent parameterization (paper §3), written as
+// DIR/<stem>.param.obj (per-patch texture coordinates) and DIR/<stem>.param.json (layout and figures).
+#include "param/consistent_parameterization.h"
+#include "param/errors.h"
+#include "param/mesh_io.h"
+#include "param/mesh_repair.h"
+#include "param/mesh_topology.h"
+#include "param/partition_points.h"
+#include "tools/atomic_file.h"
+#include "tools/commands.h"
+#include "tools/correspondence.h"
+#include "tools/progress.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <memory>
+
+namespace geomip::tools {
+namespace {
+
+struct ParamArgs {
+  std::vector<std::string> meshes;
+  std::string points;
+  std::string output;
+  bool json = false;
+  bool quiet = false;
+  bool no_baseline = false;
+};
+
+// The mesh ready for partitioning: repaired when open, non-manifold or degenerate (with a note on stderr).
+TriMesh prepare_mesh(const std::string& path, const TriMesh& input, bool quiet) {
+  const TopologyReport r = analyze_topology(input);
+  if (r.boundary_loops == 0 && r.manifold && r.degenerate_faces == 0) return input;
+  const RepairResult repaired = repair_mesh(input);
+  if (!quiet) {
+    std::cerr << "geomip param: " << path << ": " << (r.boundary_loops ? "open" : "non-manifold or degenerate")
+              << " mesh repaired first (as `geomip repair`): " << repaired.filled_holes << " holes filled, "
+              << repaired.split_non_manifold_vertices << " vertices split, " << repaired.removed_degenerate_faces
+              << " degenerate faces removed\n";
+  }
+  return repaired.mesh;
+}
+
+// A point of CORR.json as a position of the input file, then the nearest vertex of the prepared mesh (the
+// same vertex when the mesh was not repaired, its surviving copy when it was).
+int resolve_point(const PointSpec& p, const TriMesh& input, const TriMesh& mesh, const std::string& what,
+                  const std::string& file) {
+  Eigen::Vector3d target = p.position;
+  if (p.index >= 0) {
+    if (p.index >= static_cast<long long>(input.positions.size())) {
+      throw InvalidInput(file + ": " + what + " is vertex " + std::to_string(p.index) + ", but the mesh has " +
+                         std::to_string(input.positions.size()) + " vertices");
+    }
+    if (&input == &mesh) return static_cast<int>(p.index);
+    target = input.positions[p.index];
+  }
+  std::vector<char> referenced(mesh.positions.size(), 0);
+  for (const auto& t : mesh.triangles) referenced[t[0]] = referenced[t[1]] = referenced[t[2]] = 1;
+  int best = -1;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (!referenced[v]) continue;
+    const double d = (mesh.positions[v] - target).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      best = static_cast<int>(v);
+    }
+  }
+  return best;
+}
+
+std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMesh& input, const TriMesh& mesh,
+                                const std::string& what, const std::string& file) {
+  std::vector<int> ids;
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    ids.push_back(resolve_point(specs[i], input, mesh, what + "[" + std::to_string(i) + "]", file));
+  }
+  return ids;
+}
+
+nlohmann::json stretch_json(const StretchValues& s) { return {{"l2", s.l2}, {"linf", s.linf}}; }
+
+void write_param_obj(std::ostream& out, const ModelParameterization& m, const std::string& name) {
+  out << "# geomip consistent parameterization of " << name << "\n"
+      << "# " << m.patches.size() << " patches; v: the (repaired) mesh's vertices in order";
+  if (m.split_vertices) out << ", the last " << m.split_vertices << " added by the partition";
+  out << "; vt: per-patch (u,v) in the unit square\n";
+  char line[128];
+  for (const auto& p : m.mesh.positions) {
+    std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", p.x(), p.y(), p.z());
+    out << line;
+  }
+  std::size_t vt_base = 1;
+  for (std::size_t k = 0; k < m.patches.size(); ++k) {
+    const auto& patch = m.patches[k];
+    out << "g patch" << k << "\n";
+    for (const auto& uv : patch.uv) {
+      std::snprintf(line, sizeof line, "vt %.17g %.17g\n", uv.x(), uv.y());
+      out << line;
+    }
+    for (const auto& t : patch.triangles) {
+      out << "f";
+      for (int c : t) out << ' ' << patch.vertices[c] + 1 << '/' << vt_base + c;
+      out << "\n";
+    }
+    vt_base += patch.uv.size();
+  }
+}
+
+nlohmann::json param_json(const ModelParameterization& m, const std::string& mesh_path,
+                          const std::vector<int>& partition_points, const std::vector<int>& auxiliary_points) {
+  nlohmann::json j;
+  j["mesh"] = mesh_path;
+  j["vertices"] = m.mesh.positions.size();
+  j["triangles"] = m.mesh.triangles.size();
+  j["split_vertices"] = m.split_vertices;
+  j["partition_points"] = partition_points;
+  j["auxiliary_points"] = auxiliary_points;
+  static const double kCorner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  nlohmann::json patches = nlohmann::json::array();
+  std::size_t flipped = 0;
+  for (std::size_t k = 0; k < m.patches.size(); ++k) {
+    const auto& p = m.patches[k];
+    nlohmann::json corners = nlohmann::json::array();
+    for (int c = 0; c < 4; ++c) corners.push_back({{"vertex", p.corners[c]}, {"u", kCorner[c][0]}, {"v", kCorner[c][1]}});
+    nlohmann::json sides = nlohmann::json::array();
+    for (int s = 0; s < 4; ++s) sides.push_back(p.sides[s]);
+    patches.push_back({{"patch", k},
+                       {"vertices", p.vertices.size()},
+                       {"triangles", p.triangles.size()},
+                       {"base_vertices", p.base_vertices},
+                       {"corners", corners},
+                       {"sides", sides},
+                       {"stretch_mvc", stretch_json(p.mvc_stretch)},
+                       {"stretch", stretch_json(p.stretch)},
+                       {"flipped", p.flipped},
+                       {"boundary_off_chord", p.boundary_off_chord}});
+    flipped += p.flipped;
+  }
+  j["patches"] = patches;
+  nlohmann::json adjacency = nlohmann::json::array();
+  for (const auto& a : m.adjacency) {
+    adjacency.push_back({{"patch", a.patch},
+                         {"side", a.side},
+                         {"other_patch", a.other_patch},
+                         {"other_side", a.other_side},
+                         {"reversed", a.reversed}});
+  }
+  j["adjacency"] = adjacency;
+  nlohmann::json features = nlohmann::json::array();
+  for (const auto& f : m.features) features.push_back({{"vertex", f.vertex}, {"patch", f.patch}, {"u", f.uv.x()}, {"v", f.uv.y()}});
+  j["features"] = features;
+  j["flipped_triangles"] = flipped;
+  j["warp_events"] = m.warp_events;
+  const StageSeconds& s = m.seconds;
+  j["seconds"] = {{"partition", s.partition},
+                  {"progressive_mesh", s.progressive_mesh},
+                  {"base_embedding", s.base_embedding},
+                  {"feature_warp", s.feature_warp},
+                  {"coarse_to_fine", s.coarse_to_fine},
+                  {"final_optimization", s.final_optimization},
+                  {"mvc_baseline", s.mvc_baseline}};
+  return j;
+}
+
+int run_param(const ParamArgs& args) {
+  std::vector<ModelSpec> specs;
+  std::string points_file = args.points;
+  if (!args.points.empty()) {
+    if (!args.meshes.empty()) {
+      throw InvalidInput("give either meshes or --points CORR.json (which names the meshes), not both");
+    }
+    specs = read_correspondence(args.points);
+  } else {
+    if (args.meshes.size() > 1) {
+      throw InvalidInput("several meshes need --points CORR.json: their partition points must correspond");
+    }
+    if (args.meshes.empty()) throw InvalidInput("no mesh given (a MESH or --points CORR.json)");
+    specs.push_back(ModelSpec{args.meshes[0], {}, {}, {}});
+  }
+  std::filesystem::create_directories(args.output);
+
+  std::vector<ParameterizationInput> inputs;
+  std::vector<std::string> paths;
+  for (const auto& spec : specs) {
+    const TriMesh input = read_mesh(spec.mesh);
+    ParameterizationInput in;
+    in.mesh = prepare_mesh(spec.mesh, input, args.quiet || args.json);
+    in.name = std::filesystem::path(spec.mesh).stem().string();
+    // Point indices refer to the file as written; after a repair they are matched by position.
+    const bool repaired = in.mesh.positions.size() != input.positions.size() || in.mesh.triangles != input.triangles;
+    const TriMesh& source = repaired ? input : in.mesh;
+    const std::string where = points_file.empty() ? spec.mesh : points_file;
+    if (spec.partition_points.empty()) {
+      const PartitionPoints chosen = choose_partition_points(in.mesh);
+      in.partition_points = chosen.partition_points;
+      in.auxiliary_points = chosen.auxiliary_points;
+    } else {
+      in.partition_points = resolve_points(spec.partition_points, source, in.mesh, "partition_points", where);
+      in.auxiliary_points = resolve_points(spec.auxiliary_points, source, in.mesh, "auxiliary_points", where);
+      in.features = resolve_points(spec.features, source, in.mesh, "features", where);
+    }
+    inputs.push_back(std::move(in));
+    paths.push_back(spec.mesh);
+  }
+
+  ParameterizationOptions options;
+  options.measure_mvc_baseline = !args.no_baseline;
+  ProgressBar bar("param", !args.quiet && !args.json);
+  options.progress = bar.callback();
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<ModelParameterization> result = parameterize_consistently(inputs, options);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  bar.finish();
+
+  nlohmann::json summary = nlohmann::json::array();
+  for (std::size_t i = 0; i < result.size(); ++i) {
+    const std::string stem = (std::filesystem::path(args.output) / inputs[i].name).string();
+    write_file_atomically(stem + ".param.obj",
+                          [&](std::ostream& out) { write_param_obj(out, result[i], paths[i]); });
+    nlohmann::json j = param_json(result[i], paths[i], inputs[i].partition_points, inputs[i].auxiliary_points);
+    j["seconds"]["total_all_models"] = seconds;
+    write_file_atomically(stem + ".param.json", [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+    if (args.json) {
+      summary.push_back({{"mesh", paths[i]}, {"obj", stem + ".param.obj"}, {"json", stem + ".param.json"},
+                         {"patches", j["patches"].size()}, {"flipped_triangles", j["flipped_triangles"]}});
+    } else if (!args.quiet) {
+      std::cout << "param " << paths[i] << " → " << stem << ".param.obj\n";
+      for (const auto& p : result[i].patches) {
+        std::printf("  patch: %zu vertices, L2 stretch %.4f (MVC %.4f), Linf %.3f (MVC %.3f), %zu flipped\n",
+                    p.vertices.size(), p.stretch.l2, p.mvc_stretch.l2, p.stretch.linf, p.mvc_stretch.linf,
+                    p.flipped);
+      }
+    }
+  }
+  if (args.json) {
+    std::cout << nlohmann::json{{"models", summary}, {"seconds", seconds}}.dump(2) << "\n";
+  } else if (!args.quiet) {
+    std::printf("%.2f s\n", seconds);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+CommandRunner add_param_command(CLI::App& app) {
+  auto args = std::make_shared<ParamArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "param",
+      "Consistent parameterization (paper §3): partition into quad patches, progressive mesh, mean-value "
+      "embedding, stretch optimization, feature alignment, coarse-to-fine. Writes DIR/<stem>.param.obj and "
+      "DIR/<stem>.param.json per model. Open or non-manifold meshes are repaired first.");
+  cmd->add_option("mesh", args->meshes, "One mesh (partition points chosen automatically)");
+  cmd->add_option("--points", args->points,
+                  "Correspondence file naming the meshes, their partition/auxiliary points and features");
+  cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
+  cmd->add_flag("--no-baseline", args->no_baseline, "Skip the full-patch MVC embedding used as stretch baseline");
+  cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress bar, no report");
+  return [args] { return run_param(*args); };
+}
+
+}  // namespace geomip::tools

@@ -1,0 +1,78 @@
+#include "tools/correspondence.h"
+
+#include "param/errors.h"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+namespace geomip::tools {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) { throw InvalidInput(path + ": " + what); }
+
+std::vector<PointSpec> points(const std::string& path, const nlohmann::json& model, const char* key, std::size_t m) {
+  std::vector<PointSpec> out;
+  if (!model.contains(key)) return out;
+  const auto& list = model.at(key);
+  const std::string where = "models[" + std::to_string(m) + "]." + key;
+  if (!list.is_array()) fail(path, where + " must be an array");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const auto& p = list[i];
+    PointSpec s;
+    if (p.is_number_integer() && p.get<long long>() >= 0) {
+      s.index = p.get<long long>();
+    } else if (p.is_array() && p.size() == 3 && p[0].is_number() && p[1].is_number() && p[2].is_number()) {
+      s.position = {p[0].get<double>(), p[1].get<double>(), p[2].get<double>()};
+      if (!s.position.allFinite()) fail(path, where + "[" + std::to_string(i) + "] is not finite");
+    } else {
+      fail(path, where + "[" + std::to_string(i) + "] must be a vertex index >= 0 or [x,y,z]");
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<ModelSpec> read_correspondence(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) fail(path, std::filesystem::exists(path) ? "cannot open for reading" : "no such file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    fail(path, std::string("not valid JSON: ") + e.what());
+  }
+  if (!j.is_object() || !j.contains("models") || !j["models"].is_array() || j["models"].empty()) {
+    fail(path, "expected {\"models\": [ ... ]} with at least one model");
+  }
+  const std::filesystem::path base = std::filesystem::path(path).parent_path();
+  std::vector<ModelSpec> models;
+  for (std::size_t m = 0; m < j["models"].size(); ++m) {
+    const auto& model = j["models"][m];
+    if (!model.is_object() || !model.contains("mesh") || !model["mesh"].is_string()) {
+      fail(path, "models[" + std::to_string(m) + "] needs a \"mesh\" path");
+    }
+    ModelSpec s;
+    const std::filesystem::path mesh = model["mesh"].get<std::string>();
+    s.mesh = (mesh.is_absolute() ? mesh : base / mesh).string();
+    s.partition_points = points(path, model, "partition_points", m);
+    s.auxiliary_points = points(path, model, "auxiliary_points", m);
+    s.features = points(path, model, "features", m);
+    if (s.partition_points.size() != 4) {
+      fail(path, "models[" + std::to_string(m) + "].partition_points must list 4 points, it lists " +
+                     std::to_string(s.partition_points.size()));
+    }
+    if (!models.empty() && s.features.size() != models[0].features.size()) {
+      fail(path, "models[" + std::to_string(m) + "] has " + std::to_string(s.features.size()) +
+                     " features, models[0] has " + std::to_string(models[0].features.size()) +
+                     " (features correspond by order)");
+    }
+    models.push_back(std::move(s));
+  }
+  return models;
+}
+
+}  // namespace geomip::tools

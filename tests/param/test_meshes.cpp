@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <random>
 
 namespace geomip::test {
@@ -73,6 +74,40 @@ TriMesh grid(int n) {
     }
   }
   return g;
+}
+
+TriMesh sphere(int levels) {
+  TriMesh m = cube();
+  for (auto& p : m.positions) p -= Eigen::Vector3d::Constant(0.5);
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<int, int>, int> mid;
+    auto midpoint = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      const auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      m.positions.push_back(0.5 * (m.positions[a] + m.positions[b]));
+      return mid[key] = static_cast<int>(m.positions.size()) - 1;
+    };
+    std::vector<std::array<int, 3>> finer;
+    for (const auto& t : m.triangles) {
+      const int a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), c = midpoint(t[2], t[0]);
+      finer.push_back({t[0], a, c});
+      finer.push_back({a, t[1], b});
+      finer.push_back({c, b, t[2]});
+      finer.push_back({a, b, c});
+    }
+    m.triangles = std::move(finer);
+  }
+  for (auto& p : m.positions) p.normalize();
+  return m;
+}
+
+int nearest_vertex(const TriMesh& mesh, const Eigen::Vector3d& p) {
+  int best = 0;
+  for (int v = 1; v < static_cast<int>(mesh.positions.size()); ++v) {
+    if ((mesh.positions[v] - p).squaredNorm() < (mesh.positions[best] - p).squaredNorm()) best = v;
+  }
+  return best;
 }
 
 TriMesh join(const TriMesh& a, const TriMesh& b) {

@@ -17,6 +17,10 @@ TriMesh torus(int n, int m);
 TriMesh open_cylinder(int n, int m);
 /// Flat (n+1)×(n+1) grid on the unit square in z = 0: a disk with one boundary loop.
 TriMesh grid(int n);
+/// Unit sphere around the origin: a cube subdivided `levels` times (1-to-4) and projected, 12·4^levels triangles.
+TriMesh sphere(int levels);
+/// Index of the vertex nearest to `p` (brute force).
+int nearest_vertex(const TriMesh& mesh, const Eigen::Vector3d& p);
 /// Concatenation of two meshes (indices of `b` shifted).
 TriMesh join(const TriMesh& a, const TriMesh& b);
 

@@ -1,0 +1,203 @@
+// Properties of the whole parameterization (issue #3's "done means"): valid square embeddings, seams that
+// agree, stretch below the MVC baseline, aligned features across models, clean errors.
+#include "param/consistent_parameterization.h"
+#include "param/errors.h"
+#include "param/mesh_io.h"
+#include "param/mesh_repair.h"
+#include "param/mesh_topology.h"
+#include "param/partition_points.h"
+#include "tests/param/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+namespace geomip {
+namespace {
+
+const Eigen::Vector2d kCorner[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+
+// Position of a side's vertex along the side, measured from corner k (0 at corner k, 1 at corner k+1).
+double along_side(const Eigen::Vector2d& uv, int side) {
+  switch (side) {
+    case 0: return uv.x();
+    case 1: return uv.y();
+    case 2: return 1.0 - uv.x();
+    default: return 1.0 - uv.y();
+  }
+}
+
+// Every property a patch must have, whatever the model.
+void expect_valid_patch(const PatchParameterization& p, const std::string& what) {
+  SCOPED_TRACE(what);
+  EXPECT_EQ(count_flipped(p.triangles, p.uv), 0u);
+  std::map<int, int> local;  // mesh id → local id
+  for (std::size_t i = 0; i < p.vertices.size(); ++i) local[p.vertices[i]] = static_cast<int>(i);
+  std::vector<char> on_boundary(p.vertices.size(), 0);
+  for (int k = 0; k < 4; ++k) {
+    ASSERT_EQ(p.uv[local.at(p.corners[k])], kCorner[k]) << "corner " << k;
+    double last = -1.0;
+    for (std::size_t j = 0; j < p.sides[k].size(); ++j) {
+      const int v = local.at(p.sides[k][j]);
+      on_boundary[v] = 1;
+      const Eigen::Vector2d& uv = p.uv[v];
+      // On the side: the fixed coordinate exactly 0 or 1.
+      const double fixed = (k == 0) ? uv.y() : (k == 1) ? uv.x() : (k == 2) ? uv.y() : uv.x();
+      EXPECT_EQ(fixed, (k == 0 || k == 3) ? 0.0 : 1.0) << "side " << k << " vertex " << j;
+      const double s = along_side(uv, k);
+      EXPECT_GT(s, last) << "side " << k << " not monotone at vertex " << j;
+      last = s;
+    }
+  }
+  for (std::size_t v = 0; v < p.uv.size(); ++v) {
+    if (on_boundary[v]) continue;
+    const Eigen::Vector2d& uv = p.uv[v];
+    EXPECT_TRUE(uv.x() > 0 && uv.x() < 1 && uv.y() > 0 && uv.y() < 1) << "interior vertex " << v << " at " << uv.transpose();
+  }
+}
+
+// A vertex on a shared side sits at the same distance from the shared corner in both patches.
+void expect_seams_agree(const ModelParameterization& m) {
+  std::vector<std::map<int, int>> local(m.patches.size());
+  for (std::size_t p = 0; p < m.patches.size(); ++p) {
+    for (std::size_t i = 0; i < m.patches[p].vertices.size(); ++i) local[p][m.patches[p].vertices[i]] = static_cast<int>(i);
+  }
+  for (const SideLink& link : m.adjacency) {
+    const auto& a = m.patches[link.patch];
+    const auto& b = m.patches[link.other_patch];
+    const auto& side = a.sides[link.side];
+    for (int v : side) {
+      const double sa = along_side(a.uv[local[link.patch].at(v)], link.side);
+      const double sb = along_side(b.uv[local[link.other_patch].at(v)], link.other_side);
+      EXPECT_NEAR(sa, link.reversed ? 1.0 - sb : sb, 1e-12)
+          << "vertex " << v << " on side " << link.side << " of patch " << link.patch;
+    }
+  }
+}
+
+void expect_valid(const ModelParameterization& m, const std::string& name) {
+  for (std::size_t p = 0; p < m.patches.size(); ++p) expect_valid_patch(m.patches[p], name + " patch " + std::to_string(p));
+  expect_seams_agree(m);
+  // Every triangle of the mesh is in exactly one patch.
+  std::size_t triangles = 0;
+  for (const auto& p : m.patches) triangles += p.triangles.size();
+  EXPECT_EQ(triangles, m.mesh.triangles.size());
+}
+
+ParameterizationInput automatic(const TriMesh& mesh, const std::string& name) {
+  ParameterizationInput in;
+  in.mesh = mesh;
+  in.name = name;
+  const PartitionPoints points = choose_partition_points(mesh);
+  in.partition_points = points.partition_points;
+  in.auxiliary_points = points.auxiliary_points;
+  return in;
+}
+
+TEST(ConsistentParameterization, SphereGivesTwoValidSquares) {
+  const auto result = parameterize_consistently({automatic(test::sphere(4), "sphere")});
+  ASSERT_EQ(result.size(), 1u);
+  ASSERT_EQ(result[0].patches.size(), 2u);
+  expect_valid(result[0], "sphere");
+  for (const auto& p : result[0].patches) EXPECT_LT(p.stretch.l2, p.mvc_stretch.l2);
+}
+
+TEST(ConsistentParameterization, TorusGivesFourValidSquares) {
+  const auto result = parameterize_consistently({automatic(test::torus(48, 24), "torus")});
+  ASSERT_EQ(result[0].patches.size(), 4u);
+  expect_valid(result[0], "torus");
+}
+
+// Two differently deformed spheres with corresponding partition points and features: after the warp the
+// features sit at identical (u,v).
+TEST(ConsistentParameterization, FeaturesAlignAcrossModels) {
+  const TriMesh a = test::sphere(4);
+  TriMesh b = a;
+  for (auto& p : b.positions) p = Eigen::Vector3d(1.6 * p.x() + 0.2 * p.y() * p.y(), p.y(), 0.7 * p.z() + 0.3 * p.x() * p.y());
+  std::vector<ParameterizationInput> models(2);
+  models[0].mesh = a;
+  models[1].mesh = b;
+  models[0].name = "a";
+  models[1].name = "b";
+  // Corresponding points: same vertex ids (b is a deformation of a), on the equator z = 0 and off it.
+  const Eigen::Vector3d corners[4] = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
+  const Eigen::Vector3d features[4] = {{0.5, 0.5, 0.7}, {-0.5, 0.3, 0.8}, {0.2, -0.6, -0.75}, {-0.4, -0.4, -0.8}};
+  for (auto& m : models) {
+    for (const auto& c : corners) m.partition_points.push_back(test::nearest_vertex(a, c.normalized()));
+    for (const auto& f : features) m.features.push_back(test::nearest_vertex(a, f.normalized()));
+  }
+  const auto result = parameterize_consistently(models);
+  ASSERT_EQ(result.size(), 2u);
+  expect_valid(result[0], "a");
+  expect_valid(result[1], "b");
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(result[0].features[k].patch, result[1].features[k].patch);
+    EXPECT_LE((result[0].features[k].uv - result[1].features[k].uv).norm(), 1e-9) << "feature " << k;
+  }
+}
+
+TEST(ConsistentParameterization, RejectsBadInput) {
+  const TriMesh s = test::sphere(3);
+  ParameterizationInput in = automatic(s, "s");
+  {
+    ParameterizationInput bad = in;
+    bad.partition_points[1] = bad.partition_points[0];
+    EXPECT_THROW(parameterize_consistently({bad}), InvalidInput);  // not distinct
+  }
+  {
+    ParameterizationInput bad = in;
+    bad.partition_points[2] = static_cast<int>(s.positions.size()) + 5;
+    EXPECT_THROW(parameterize_consistently({bad}), InvalidInput);  // out of range
+  }
+  {
+    ParameterizationInput a = in, b = in;
+    b.features = {in.partition_points[0] == 0 ? 1 : 0};
+    EXPECT_THROW(parameterize_consistently({a, b}), InvalidInput);  // feature counts differ
+  }
+  {
+    ParameterizationInput bad = in;
+    bad.features = {bad.partition_points[0]};
+    EXPECT_THROW(parameterize_consistently({bad}), InvalidInput);  // a feature on the cut
+  }
+  {
+    ParameterizationInput bad = in;
+    bad.mesh = test::join(test::torus(16, 8), test::torus(16, 8));  // two components
+    EXPECT_THROW(parameterize_consistently({bad}), InvalidInput);
+  }
+}
+
+class SharedMeshParameterization : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SharedMeshParameterization, EveryPatchIsAValidSquareAndSeamsAgree) {
+  GEOMIP_REQUIRE_SHARED_MESH(path, GetParam());
+  TriMesh mesh = read_mesh(path);
+  const TopologyReport r = analyze_topology(mesh);
+  if (r.boundary_loops > 0 || !r.manifold) mesh = repair_mesh(mesh).mesh;
+  const auto result = parameterize_consistently({automatic(mesh, GetParam())});
+  expect_valid(result[0], GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(Shared, SharedMeshParameterization,
+                         ::testing::Values("bunny.obj", "bunny-small.obj", "horse.obj", "cow.obj", "spot.obj",
+                                           "pig.obj", "armadillo.obj", "max-planck.obj", "venus.obj",
+                                           "fandisk.obj", "rocker-arm.obj", "bob.obj", "camelhead.obj"),
+                         [](const ::testing::TestParamInfo<const char*>& param_info) {
+                           std::string name = param_info.param;
+                           for (char& c : name) {
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           }
+                           return name;
+                         });
+
+TEST(ConsistentParameterizationReal, StretchOptimizationBeatsMvcOnTheBunny) {
+  GEOMIP_REQUIRE_SHARED_MESH(path, "bunny.obj");
+  const TriMesh bunny = repair_mesh(read_mesh(path)).mesh;
+  const auto result = parameterize_consistently({automatic(bunny, "bunny")});
+  for (const auto& p : result[0].patches) {
+    EXPECT_LE(p.stretch.l2, 0.8 * p.mvc_stretch.l2) << "MVC " << p.mvc_stretch.l2 << " → " << p.stretch.l2;
+  }
+}
+
+}  // namespace
+}  // namespace geomip

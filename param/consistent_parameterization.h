@@ -36,6 +36,13 @@ struct ParameterizationOptions {
   StretchOptimizationOptions base_optimization;
   /// Local optimization of each inserted vertex and its neighbours during coarse-to-fine.
   VertexOptimizationOptions local_optimization;
+  /// optimize_vertex() calls per vertex and per insertion (each does `local_optimization.num_directions`
+  /// line searches).
+  int local_rounds = 4;
+  /// Global stretch sweeps over the current level each time coarse-to-fine has grown it by `level_growth`
+  /// (Sander et al. 2002's hierarchical optimization); 0 = only the paper's local moves.
+  std::size_t level_sweeps = 5;
+  double level_growth = 2.0;
   /// Global sweeps over each full patch after coarse-to-fine (boundary and features locked); 0 = none.
   std::size_t final_sweeps = 10;
   /// Also compute the mean-value embedding of each full patch, the baseline the stretch figures are

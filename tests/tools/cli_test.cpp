@@ -156,3 +156,90 @@ TEST_F(Cli, RepairBunnyThenInfoSaysClosedGenusZero) {
 
 }  // namespace
 }  // namespace geomip
+
+namespace geomip {
+namespace {
+
+class CliParam : public Cli {
+ protected:
+  std::string spot_ = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
+  std::string corr(const std::string& name, const std::string& models_json) {
+    return file(name, "{\"models\": [" + models_json + "]}");
+  }
+  std::string model(const std::string& points, const std::string& features = "[]") {
+    return "{\"mesh\": \"" + spot_ + "\", \"partition_points\": " + points + ", \"features\": " + features + "}";
+  }
+};
+
+TEST_F(CliParam, WritesObjWithPerPatchTexcoordsAndJson) {
+  const std::string out = dir_ + "/out";
+  const Outcome r = geomip("param --quiet '" + spot_ + "' -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(out + "/spot.param.json"));
+  ASSERT_EQ(j["patches"].size(), 2u);
+  EXPECT_EQ(j["flipped_triangles"], 0);
+  for (const auto& p : j["patches"]) {
+    EXPECT_LT(p["stretch"]["l2"].get<double>(), p["stretch_mvc"]["l2"].get<double>());
+    EXPECT_EQ(p["corners"].size(), 4u);
+  }
+  EXPECT_EQ(j["adjacency"].size(), 8u);
+  // The OBJ: the mesh's vertices in order, one group per patch, every corner v/vt with vt of its own patch.
+  std::istringstream obj(slurp(out + "/spot.param.obj"));
+  std::string line;
+  std::size_t v = 0, vt = 0, faces = 0, groups = 0, vt_group_start = 0;
+  bool vt_in_group = true;
+  while (std::getline(obj, line)) {
+    if (line.rfind("v ", 0) == 0) ++v;
+    if (line.rfind("vt ", 0) == 0) {
+      double a = -1, b = -1;
+      std::sscanf(line.c_str(), "vt %lf %lf", &a, &b);
+      EXPECT_TRUE(a >= 0 && a <= 1 && b >= 0 && b <= 1) << line;
+      ++vt;
+    }
+    if (line.rfind("g patch", 0) == 0) {
+      ++groups;
+      vt_group_start = vt;
+    }
+    if (line.rfind("f ", 0) == 0) {
+      ++faces;
+      std::istringstream f(line.substr(2));
+      std::string corner;
+      while (f >> corner) {
+        const std::size_t slash = corner.find('/');
+        ASSERT_NE(slash, std::string::npos) << line;
+        const std::size_t t = std::stoul(corner.substr(slash + 1));
+        vt_in_group = vt_in_group && t > vt_group_start && t <= vt;
+      }
+    }
+  }
+  EXPECT_EQ(v, 2930u);  // spot is closed and clean: no repair, no split
+  EXPECT_EQ(faces, 5856u);
+  EXPECT_EQ(groups, 2u);
+  EXPECT_GT(vt, v);  // seam vertices have one vt per patch
+  EXPECT_TRUE(vt_in_group);
+}
+
+TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
+  const std::string out = dir_ + "/out";
+  auto expect_two = [&](const std::string& path, const std::string& needle) {
+    const Outcome r = geomip("param --points '" + path + "' -o '" + out + "'");
+    EXPECT_FALSE(r.crashed);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+  };
+  expect_two(corr("dup.json", model("[10, 10, 200, 300]")), "distinct");
+  expect_two(corr("range.json", model("[10, 20, 30, 99999]")), "99999");
+  expect_two(corr("three.json", model("[10, 20, 30]")), "4 points");
+  expect_two(corr("features.json", model("[0, 1000, 2000, 2900]", "[5]") + "," + model("[0, 1000, 2000, 2900]")),
+             "features");
+  expect_two(file("garbage.json", "{not json"), "JSON");
+  expect_two(dir_ + "/missing.json", "no such file");
+  // Several meshes without a correspondence file.
+  const Outcome r = geomip("param '" + spot_ + "' '" + spot_ + "' -o '" + out + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--points"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out + "/spot.param.obj"));
+}
+
+}  // namespace
+}  // namespace geomip

@@ -165,7 +165,7 @@ PartitionPoints outline_points(const TriMesh& m, const std::vector<int>& opp, co
   return pts;
 }
 
-PartitionPoints genus0_points(const TriMesh& m) {
+PartitionPoints genus0_points(const TriMesh& m, const PartitionPointsOptions& options) {
   const int nf = static_cast<int>(m.triangles.size());
   std::vector<double> area(nf);
   std::vector<Eigen::Vector3d> centroid(nf);
@@ -196,7 +196,10 @@ PartitionPoints genus0_points(const TriMesh& m) {
   const Eigen::Vector3d e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
   const Eigen::Vector3d e3 = e1.cross(e2);
   // (normal, a, b) with a × b = normal: thinnest direction first.
-  const std::array<std::array<Eigen::Vector3d, 3>, 3> planes = {{{e3, e1, e2}, {e2, e3, e1}, {e1, e2, e3}}};
+  std::vector<std::array<Eigen::Vector3d, 3>> planes = {{e3, e1, e2}, {e2, e3, e1}, {e1, e2, e3}};
+  // The plane with normal e_cut_axis first, the others thinnest first.
+  const int first = 3 - options.cut_axis;
+  std::rotate(planes.begin(), planes.begin() + first, planes.begin() + first + 1);
 
   const std::vector<int> opp = opposite_halfedges(m);
   std::vector<int> order(nf);
@@ -504,7 +507,10 @@ PartitionPoints choose_partition_points(const TriMesh& closed_manifold, const Pa
                        "the mesh must be one closed, manifold, orientable component without degenerate "
                        "triangles; run repair_mesh first");
   }
-  if (*topo.genus == 0) return genus0_points(closed_manifold);
+  if (options.cut_axis < 1 || options.cut_axis > 3) {
+    throw InvalidInput(std::string(kFn) + "cut_axis must be 1, 2 or 3, got " + std::to_string(options.cut_axis));
+  }
+  if (*topo.genus == 0) return genus0_points(closed_manifold, options);
   if (*topo.genus == 1) return genus1_points(closed_manifold, options);
   throw InvalidInput(std::string(kFn) + "the mesh has genus " + std::to_string(*topo.genus) +
                      "; only genus 0 and 1 are supported");

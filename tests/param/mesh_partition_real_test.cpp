@@ -60,6 +60,14 @@ void check_genus0(const std::string& name) {
   EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
   const Figures autof = figures(m, r);
 
+  // The alternative considered: the loop around the "equator", across the longest axis; and the chosen
+  // corners without their guiding points.
+  PartitionPointsOptions equator_options;
+  equator_options.cut_axis = 1;
+  const PartitionPoints eq = choose_partition_points(m, equator_options);
+  const Figures equator = figures(m, partition_mesh(m, eq.partition_points, eq.auxiliary_points));
+  const Figures unguided = figures(m, partition_mesh(m, pts.partition_points, {}));
+
   // Naive 1: the first four vertex ids. Naive 2: four random vertices (mean of 10 seeded draws).
   Figures first;
   try {
@@ -92,6 +100,10 @@ void check_genus0(const std::string& name) {
       worst_random = 0.0;
     }
   }
+  std::printf("[figures] %-10s equator cut (cut_axis 1): balance %.3f cut/sqrtA %.2f min flatness %.2f | auto "
+              "corners without guides: balance %.3f cut/sqrtA %.2f min flatness %.2f\n",
+              name.c_str(), equator.balance, equator.cut, equator.flat_min, unguided.balance, unguided.cut,
+              unguided.flat_min);
   std::printf(
       "[figures] %-10s F=%zu splits=%zu | auto: balance %.3f cut/sqrtA %.2f min flatness %.2f | first-4-ids: "
       "balance %.3f cut/sqrtA %.2f flat %.2f | random (mean of 10, %d failed): balance %.3f (worst %.3f) cut/sqrtA "
@@ -100,6 +112,8 @@ void check_genus0(const std::string& name) {
       first.cut, first.flat_min, random_failures, random.balance, worst_random, random.cut, random.flat_min,
       t_choose, t_partition);
   EXPECT_GT(autof.balance, 0.7) << name;
+  EXPECT_GT(autof.flat_min, equator.flat_min) << name << ": the thin-axis cut should give flatter halves";
+  EXPECT_GE(autof.balance, unguided.balance) << name << ": guiding points should not hurt the balance";
   EXPECT_GT(autof.balance, first.balance) << name;
   EXPECT_GT(autof.balance, random.balance) << name;
 #ifdef NDEBUG

@@ -100,17 +100,19 @@ void check_genus0(const std::string& name) {
       worst_random = 0.0;
     }
   }
-  std::printf("[figures] %-10s equator cut (cut_axis 1): balance %.3f cut/sqrtA %.2f min flatness %.2f | auto "
-              "corners without guides: balance %.3f cut/sqrtA %.2f min flatness %.2f\n",
-              name.c_str(), equator.balance, equator.cut, equator.flat_min, unguided.balance, unguided.cut,
-              unguided.flat_min);
-  std::printf(
-      "[figures] %-10s F=%zu splits=%zu | auto: balance %.3f cut/sqrtA %.2f min flatness %.2f | first-4-ids: "
-      "balance %.3f cut/sqrtA %.2f flat %.2f | random (mean of 10, %d failed): balance %.3f (worst %.3f) cut/sqrtA "
-      "%.2f flat %.2f | time choose %.3f s, partition %.3f s\n",
-      name.c_str(), m.num_triangles(), r.split_vertices, autof.balance, autof.cut, autof.flat_min, first.balance,
-      first.cut, first.flat_min, random_failures, random.balance, worst_random, random.cut, random.flat_min,
-      t_choose, t_partition);
+  std::printf("[figures] %-10s F=%zu splits=%zu time: choose %.3f s, partition %.3f s\n", name.c_str(),
+              m.num_triangles(), r.split_vertices, t_choose, t_partition);
+  auto row = [&](const char* what, const Figures& f) {
+    std::printf("[figures] %-10s %-26s balance %.3f  cut/sqrt(area) %.2f  min flatness %.2f\n", name.c_str(),
+                what, f.balance, f.cut, f.flat_min);
+  };
+  row("auto (thin-axis outline)", autof);
+  row("auto corners, no guides", unguided);
+  row("equator (cut_axis 1)", equator);
+  row("first 4 vertex ids", first);
+  row("random (mean of 10)", random);
+  std::printf("[figures] %-10s random: worst balance %.3f, %d of 10 failed\n", name.c_str(), worst_random,
+              random_failures);
   EXPECT_GT(autof.balance, 0.7) << name;
   EXPECT_GT(autof.flat_min, equator.flat_min) << name << ": the thin-axis cut should give flatter halves";
   EXPECT_GE(autof.balance, unguided.balance) << name << ": guiding points should not hurt the balance";

@@ -112,6 +112,16 @@ TriMesh double_torus() {
   return base;
 }
 
+// Tutte's map of every patch onto the unit square is one-to-one (the use §3.3 makes of the patches).
+std::string embedding_problems(const PartitionResult& r) {
+  std::string problems;
+  for (int p = 0; p < static_cast<int>(r.patches.size()); ++p) {
+    const std::size_t flipped = test::tutte_square_embedding(r, p).flipped;
+    if (flipped) problems += "patch " + std::to_string(p) + ": " + std::to_string(flipped) + " flipped; ";
+  }
+  return problems;
+}
+
 void expect_invalid(const TriMesh& m, const std::vector<int>& p, const std::vector<int>& aux,
                     const std::string& fragment, const PartitionOptions& options = {}) {
   try {
@@ -132,6 +142,7 @@ TEST(PartitionGenus0, SphereEquatorLoopMakesNorthPatch0) {
                               nearest_vertex(m, {-1, 0, 0}), nearest_vertex(m, {0, -1, 0})};
   const PartitionResult r = partition_mesh(m, p, {});
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   // The loop runs CCW seen from +z, so patch 0 (left of the loop, outside) is the northern half.
   for (int k = 0; k < 2; ++k) {
     double z = 0.0;
@@ -160,6 +171,7 @@ TEST(PartitionGenus0, AuxiliaryPointsGuideThePaths) {
                                 nearest_vertex(m, {-0.7, -0.7, -0.1}), nearest_vertex(m, {0.7, -0.7, -0.1})};
   const PartitionResult r = partition_mesh(m, p, aux);
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   for (int k = 0; k < 4; ++k) {
     const auto& side = r.patches[0].sides[k].vertices;
     EXPECT_NE(std::find(side.begin(), side.end(), aux[k]), side.end()) << "side " << k;
@@ -178,6 +190,7 @@ TEST(PartitionGenus0, TetrahedronChordsAreSplit) {
   EXPECT_EQ(r.mesh.num_vertices(), 6u);
   EXPECT_EQ(r.mesh.num_triangles(), 8u);
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   PartitionOptions strict;
   strict.split_degenerate = false;
   expect_invalid(m, p, {}, "degenerate configuration", strict);
@@ -189,6 +202,7 @@ TEST(PartitionGenus0, CubeFaceLoopSplitsItsDiagonal) {
   const PartitionResult r = partition_mesh(m, p, {});
   EXPECT_EQ(r.split_vertices, 1u);
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   // Untouched triangles keep their ids and corners.
   int kept = 0;
   for (std::size_t f = 0; f < m.triangles.size(); ++f) kept += r.mesh.triangles[f] == m.triangles[f];
@@ -210,6 +224,7 @@ TEST(PartitionGenus0, EveryOrderedQuadrupleOnTetrahedronAndCubePartitions) {
             try {
               const PartitionResult r = partition_mesh(m, p, {});
               ASSERT_EQ(test::check_partition(m, p, r), "") << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+              ASSERT_EQ(embedding_problems(r), "") << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
             } catch (const Error& e) {
               ADD_FAILURE() << p[0] << "," << p[1] << "," << p[2] << "," << p[3] << ": " << e.what();
             }
@@ -231,6 +246,7 @@ TEST(PartitionGenus0, WalledInCornerIsFreedBySplittingChords) {
   const PartitionResult r = partition_mesh(m, p, {});
   EXPECT_GT(r.split_vertices, 0u);
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
 }
 
 TEST(PartitionGenus0, RandomQuadruplesOnASubdividedCubeAreValidOrCleanlyRejected) {
@@ -266,6 +282,7 @@ TEST(PartitionGenus0, RandomPointsOnAFineSphereAlwaysPartition) {
     }
     const PartitionResult r = partition_mesh(m, p, {});
     EXPECT_EQ(test::check_partition(m, p, r), "") << "trial " << trial;
+    EXPECT_EQ(embedding_problems(r), "") << "trial " << trial;
   }
 }
 
@@ -318,7 +335,8 @@ TEST(PartitionChecks, TheCheckerCatchesBrokenResults) {
   }
   const std::string problems = test::check_partition(cube, q, unsplit);
   EXPECT_NE(problems.find("all vertices on the cut"), std::string::npos) << problems;
-  EXPECT_EQ(problems.find(';'), problems.rfind(';')) << "only one problem expected: " << problems;
+  EXPECT_NE(problems.find("edge (0,2) joins two cut vertices"), std::string::npos) << problems;
+  EXPECT_EQ(std::count(problems.begin(), problems.end(), ';'), 2) << "only the chord expected: " << problems;
 }
 
 TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {
@@ -329,6 +347,7 @@ TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {
   EXPECT_EQ(pts.auxiliary_points.size(), 4u);
   const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
   EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   const PartitionStats s = partition_stats(r);
   EXPECT_GT(s.area_balance, 0.9);
   // Each half is the top or the bottom (z) of the flat ellipsoid: nearly a height field.
@@ -360,6 +379,7 @@ TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
   const TorusSetup t = torus_setup(24, 12);
   const PartitionResult r = partition_mesh(t.mesh, t.p, t.aux);
   EXPECT_EQ(test::check_partition(t.mesh, t.p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   ASSERT_EQ(r.patches.size(), 4u);
   auto side_between = [](const Patch& patch, int a, int b) -> const std::vector<int>* {
     for (int s = 0; s < 4; ++s) {
@@ -420,6 +440,7 @@ TEST(PartitionGenus1, CoarseTorusStillValid) {
   const TorusSetup t = torus_setup(8, 8);
   const PartitionResult r = partition_mesh(t.mesh, t.p, t.aux);
   EXPECT_EQ(test::check_partition(t.mesh, t.p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
 }
 
 TEST(PartitionGenus1, ContractibleEdgePairIsRejected) {
@@ -436,6 +457,7 @@ TEST(PartitionGenus1, ChosenPointsPartitionATorus) {
   ASSERT_EQ(pts.auxiliary_points.size(), 8u);
   const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
   EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   EXPECT_GT(partition_stats(r).area_balance, 0.6);
 }
 

@@ -6,10 +6,13 @@
 #include "param/mesh_partition.h"
 #include "param/mesh_topology.h"
 
+#include <Eigen/SparseCholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <unordered_map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -25,8 +28,83 @@ inline double surface_area(const TriMesh& m) {
   return a;
 }
 
-/// Every documented property of `r` = partition_mesh(input, points, aux). Returns "" when all hold, else a
-/// description of the first problems found.
+/// Result of embedding one patch on the unit square with Tutte's uniform barycentric map (boundary by arc
+/// length along the 4 sides, corner s at (0,0), (1,0), (1,1), (0,1)).
+struct SquareEmbedding {
+  std::size_t flipped = 0;  ///< triangles with signed parameter area <= 0 (none if the patch is fit for §3.3)
+};
+
+/// Tutte's theorem (with Floater's 2003 condition) makes this map bijective on a disk with a convex boundary
+/// when no interior edge joins two boundary vertices on one side of the square: the partition must allow it.
+/// Exact in theory; in floating point, long thin parts (a horse's legs) shrink below double precision, so
+/// use it on well-conditioned meshes and rely on the combinatorial check of check_partition() elsewhere.
+inline SquareEmbedding tutte_square_embedding(const PartitionResult& r, int p) {
+  const TriMesh& m = r.mesh;
+  const Patch& patch = r.patches[p];
+  std::unordered_map<int, Eigen::Vector2d> uv;  // boundary vertices
+  for (int s = 0; s < 4; ++s) {
+    const auto& v = patch.sides[s].vertices;
+    const Eigen::Vector2d corner[5] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}};
+    std::vector<double> arc(v.size(), 0.0);
+    for (std::size_t i = 1; i < v.size(); ++i) arc[i] = arc[i - 1] + (m.positions[v[i]] - m.positions[v[i - 1]]).norm();
+    for (std::size_t i = 0; i + 1 < v.size(); ++i) {
+      const double t = arc.back() > 0.0 ? arc[i] / arc.back() : 0.0;
+      uv[v[i]] = (1.0 - t) * corner[s] + t * corner[s + 1];
+    }
+  }
+  std::unordered_map<int, int> index;  // interior vertices
+  std::vector<int> interior;
+  std::vector<std::set<int>> neighbours;
+  auto id = [&](int v) {
+    auto [it, fresh] = index.emplace(v, static_cast<int>(interior.size()));
+    if (fresh) {
+      interior.push_back(v);
+      neighbours.emplace_back();
+    }
+    return it->second;
+  };
+  for (int f : patch.faces) {
+    const auto& t = m.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      if (!uv.count(t[k])) {
+        const int i = id(t[k]);
+        neighbours[i].insert(t[(k + 1) % 3]);
+        neighbours[i].insert(t[(k + 2) % 3]);
+      }
+    }
+  }
+  const int n = static_cast<int>(interior.size());
+  if (n > 0) {
+    std::vector<Eigen::Triplet<double>> trip;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 2);
+    for (int i = 0; i < n; ++i) {
+      trip.emplace_back(i, i, static_cast<double>(neighbours[i].size()));
+      for (int u : neighbours[i]) {
+        const auto b = uv.find(u);
+        if (b != uv.end()) {
+          rhs.row(i) += b->second.transpose();
+        } else {
+          trip.emplace_back(i, index.at(u), -1.0);
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> a(n, n);
+    a.setFromTriplets(trip.begin(), trip.end());
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
+    const Eigen::MatrixXd x = solver.solve(rhs);
+    for (int i = 0; i < n; ++i) uv[interior[i]] = x.row(i).transpose();
+  }
+  SquareEmbedding e;
+  for (int f : patch.faces) {
+    const auto& t = m.triangles[f];
+    const Eigen::Vector2d &a = uv.at(t[0]), &b = uv.at(t[1]), &c = uv.at(t[2]);
+    if (!((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x() > 0.0)) ++e.flipped;
+  }
+  return e;
+}
+
+/// Every documented property of `r` = partition_mesh(input, points, aux), and Floater's condition for a
+/// one-to-one square embedding. Returns "" when all hold, else a description of the problems.
 inline std::string check_partition(const TriMesh& input, const std::vector<int>& points, const PartitionResult& r) {
   std::ostringstream err;
   const TriMesh& m = r.mesh;
@@ -97,6 +175,7 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
     for (int k = 0; k < 3; ++k) mesh_halfedges.insert(key(t[k], t[(k + 1) % 3]));
   }
   std::set<int> cut_vertices;
+  std::set<std::uint64_t> cut_halfedges;  // both directions
   for (std::size_t p = 0; p < np; ++p) {
     const Patch& patch = r.patches[p];
     std::set<std::uint64_t> side_halfedges;
@@ -110,6 +189,8 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
       for (std::size_t i = 0; i + 1 < v.size(); ++i) {
         if (!mesh_halfedges.count(key(v[i], v[i + 1]))) err << "patch " << p << " side " << s << " not an edge path; ";
         side_halfedges.insert(key(v[i], v[i + 1]));
+        cut_halfedges.insert(key(v[i], v[i + 1]));
+        cut_halfedges.insert(key(v[i + 1], v[i]));
       }
       loop.insert(loop.end(), v.begin(), v.end() - 1);
       cut_vertices.insert(v.begin(), v.end());
@@ -166,6 +247,18 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
     if (!l.reversed) err << "a link is not reversed on an oriented surface; ";
     std::reverse(a.begin(), a.end());
     if (a != b) err << "glued sides differ; ";
+  }
+  // Fit for the square embedding of §3.3 (Floater's condition): no interior edge joins two cut vertices.
+  for (int f = 0; f < nf; ++f) {
+    const auto& t = m.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a < b && cut_vertices.count(a) && cut_vertices.count(b) && !cut_halfedges.count(key(a, b))) {
+        err << "edge (" << a << "," << b << ") joins two cut vertices across a patch; ";
+        f = nf;
+        break;
+      }
+    }
   }
   return err.str();
 }

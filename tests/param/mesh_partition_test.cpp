@@ -375,12 +375,23 @@ TorusSetup torus_setup(int n, int m) {
   return t;
 }
 
-TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
-  const TorusSetup t = torus_setup(24, 12);
+// The same grid with the roles of the two directions swapped: mirrored with respect to the header's picture.
+TorusSetup mirrored(const TorusSetup& t) {
+  TorusSetup u = t;
+  u.p = {t.p[0], t.p[2], t.p[1], t.p[3]};
+  u.aux = {t.aux[4], t.aux[5], t.aux[6], t.aux[7], t.aux[0], t.aux[1], t.aux[2], t.aux[3]};
+  return u;
+}
+
+// Checks the documented genus-1 order on a torus grid; returns whether the layout is transposed (mirrored).
+bool check_torus_grid(const TorusSetup& t) {
   const PartitionResult r = partition_mesh(t.mesh, t.p, t.aux);
   EXPECT_EQ(test::check_partition(t.mesh, t.p, r), "");
   EXPECT_EQ(embedding_problems(r), "");
-  ASSERT_EQ(r.patches.size(), 4u);
+  if (r.patches.size() != 4u) {
+    ADD_FAILURE() << r.patches.size() << " patches";
+    return false;
+  }
   auto side_between = [](const Patch& patch, int a, int b) -> const std::vector<int>* {
     for (int s = 0; s < 4; ++s) {
       const auto& v = patch.sides[s].vertices;
@@ -434,6 +445,14 @@ TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
   EXPECT_EQ(r.split_vertices, 8u);
   // Symmetric torus, symmetric grid: equal areas.
   EXPECT_GT(partition_stats(r).area_balance, 0.999);
+  return transposed;
+}
+
+TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
+  const TorusSetup t = torus_setup(24, 12);
+  const bool transposed = check_torus_grid(t);
+  // Mirroring the placement transposes the layout and nothing else.
+  EXPECT_NE(check_torus_grid(mirrored(t)), transposed);
 }
 
 TEST(PartitionGenus1, CoarseTorusStillValid) {

@@ -123,10 +123,18 @@ void check_genus0(const std::string& name) {
 #endif
 }
 
-TEST(PartitionReal, BunnyRepaired) { check_genus0("bunny.obj"); }
-TEST(PartitionReal, Spot) { check_genus0("spot.obj"); }
-TEST(PartitionReal, Horse) { check_genus0("horse.obj"); }
-TEST(PartitionReal, CowRepaired) { check_genus0("cow.obj"); }
+TEST(PartitionReal, BunnyRepaired) {
+  check_genus0("bunny.obj");
+}
+TEST(PartitionReal, Spot) {
+  check_genus0("spot.obj");
+}
+TEST(PartitionReal, Horse) {
+  check_genus0("horse.obj");
+}
+TEST(PartitionReal, CowRepaired) {
+  check_genus0("cow.obj");
+}
 
 // Genus 1: the committed point files partition validly; the automatic method does too.
 void check_genus1(const std::string& name, const std::string& points_file) {
@@ -160,15 +168,20 @@ void check_genus1(const std::string& name, const std::string& points_file) {
   const double t_choose = seconds_since(t0);
   const PartitionResult rc = partition_mesh(m, chosen.partition_points, chosen.auxiliary_points);
   EXPECT_EQ(test::check_partition(m, chosen.partition_points, rc), "");
-  std::printf("[figures] %-10s F=%zu file points: balance %.3f cut/sqrtA %.2f splits %zu, partition %.3f s | "
-              "choose_partition_points: balance %.3f, %.3f s\n",
-              name.c_str(), m.num_triangles(), s.area_balance, s.cut_length / std::sqrt(test::surface_area(m)),
-              r.split_vertices, t_partition, partition_stats(rc).area_balance, t_choose);
+  std::printf(
+      "[figures] %-10s F=%zu file points: balance %.3f cut/sqrtA %.2f splits %zu, partition %.3f s | "
+      "choose_partition_points: balance %.3f, %.3f s\n",
+      name.c_str(), m.num_triangles(), s.area_balance, s.cut_length / std::sqrt(test::surface_area(m)),
+      r.split_vertices, t_partition, partition_stats(rc).area_balance, t_choose);
   EXPECT_GT(s.area_balance, 0.2) << name;
 }
 
-TEST(PartitionReal, BobGenus1) { check_genus1("bob.obj", "bob.points.json"); }
-TEST(PartitionReal, RockerArmGenus1) { check_genus1("rocker-arm.obj", "rocker-arm.points.json"); }
+TEST(PartitionReal, BobGenus1) {
+  check_genus1("bob.obj", "bob.points.json");
+}
+TEST(PartitionReal, RockerArmGenus1) {
+  check_genus1("rocker-arm.obj", "rocker-arm.points.json");
+}
 
 }  // namespace
 }  // namespace geomip

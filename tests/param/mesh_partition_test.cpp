@@ -210,7 +210,8 @@ TEST(PartitionGenus0, CubeFaceLoopSplitsItsDiagonal) {
 }
 
 TEST(PartitionGenus0, EveryOrderedQuadrupleOnTetrahedronAndCubePartitions) {
-  // The coarsest closed meshes: paths are single edges, chords everywhere, corners walled in by earlier paths.
+  // The coarsest closed meshes: paths are single edges, chords everywhere, corners walled in by earlier
+  // paths.
   for (const TriMesh& m : {test::tetrahedron(), test::cube()}) {
     const int nv = static_cast<int>(m.positions.size());
     int count = 0;
@@ -223,7 +224,8 @@ TEST(PartitionGenus0, EveryOrderedQuadrupleOnTetrahedronAndCubePartitions) {
             ++count;
             try {
               const PartitionResult r = partition_mesh(m, p, {});
-              ASSERT_EQ(test::check_partition(m, p, r), "") << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+              ASSERT_EQ(test::check_partition(m, p, r), "")
+                  << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
               ASSERT_EQ(embedding_problems(r), "") << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
             } catch (const Error& e) {
               ADD_FAILURE() << p[0] << "," << p[1] << "," << p[2] << "," << p[3] << ": " << e.what();
@@ -261,7 +263,8 @@ TEST(PartitionGenus0, RandomQuadruplesOnASubdividedCubeAreValidOrCleanlyRejected
     const std::vector<int> p(ids.begin(), ids.begin() + 4);
     try {
       const PartitionResult r = partition_mesh(m, p, {});
-      EXPECT_EQ(test::check_partition(m, p, r), "") << "points " << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+      EXPECT_EQ(test::check_partition(m, p, r), "")
+          << "points " << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
       ++valid;
     } catch (const InvalidInput& e) {
       EXPECT_NE(std::string(e.what()).find("cannot trace path"), std::string::npos) << e.what();
@@ -365,13 +368,14 @@ struct TorusSetup {
   std::vector<int> p, aux;
 };
 
-// Torus grid (i around the big circle, j around the tube) with the corners and auxiliary points on grid lines.
+// Torus grid (i around the big circle, j around the tube) with the corners and auxiliary points on grid
+// lines.
 TorusSetup torus_setup(int n, int m) {
   TorusSetup t{test::torus(n, m), {}, {}};
   auto id = [&](int i, int j) { return ((i + n) % n) * m + (j + m) % m; };
   t.p = {id(0, 0), id(n / 2, 0), id(0, m / 2), id(n / 2, m / 2)};
-  t.aux = {id(n / 4, 0),     id(3 * n / 4, 0),     id(n / 4, m / 2), id(3 * n / 4, m / 2),
-           id(0, m / 4),     id(0, 3 * m / 4),     id(n / 2, m / 4), id(n / 2, 3 * m / 4)};
+  t.aux = {id(n / 4, 0), id(3 * n / 4, 0), id(n / 4, m / 2), id(3 * n / 4, m / 2),
+           id(0, m / 4), id(0, 3 * m / 4), id(n / 2, m / 4), id(n / 2, 3 * m / 4)};
   return t;
 }
 
@@ -415,7 +419,8 @@ bool check_torus_grid(const TorusSetup& t) {
     EXPECT_EQ(c[2], t.p[3 - (a + 2 * b)]) << "patch " << index;
   }
   // Side 0 is of the same kind (P0-P1/P2-P3 "horizontal" or P0-P2/P1-P3 "vertical") in all patches, so the
-  // 4 squares tile a 2x2 periodic grid with translations. Here: sides 0 and 2 of patch 0 vs 1 and 3 of patch 1.
+  // 4 squares tile a 2x2 periodic grid with translations. Here: sides 0 and 2 of patch 0 vs 1 and 3 of
+  // patch 1.
   auto horizontal = [&](const PatchSide& s) {
     const std::set<int> ends = {s.vertices.front(), s.vertices.back()};
     return ends == std::set<int>{t.p[0], t.p[1]} || ends == std::set<int>{t.p[2], t.p[3]};

@@ -12,10 +12,10 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
-#include <unordered_map>
 #include <set>
 #include <sstream>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace geomip::test {
@@ -46,7 +46,8 @@ inline SquareEmbedding tutte_square_embedding(const PartitionResult& r, int p) {
     const auto& v = patch.sides[s].vertices;
     const Eigen::Vector2d corner[5] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}};
     std::vector<double> arc(v.size(), 0.0);
-    for (std::size_t i = 1; i < v.size(); ++i) arc[i] = arc[i - 1] + (m.positions[v[i]] - m.positions[v[i - 1]]).norm();
+    for (std::size_t i = 1; i < v.size(); ++i)
+      arc[i] = arc[i - 1] + (m.positions[v[i]] - m.positions[v[i - 1]]).norm();
     for (std::size_t i = 0; i + 1 < v.size(); ++i) {
       const double t = arc.back() > 0.0 ? arc[i] / arc.back() : 0.0;
       uv[v[i]] = (1.0 - t) * corner[s] + t * corner[s + 1];
@@ -105,7 +106,8 @@ inline SquareEmbedding tutte_square_embedding(const PartitionResult& r, int p) {
 
 /// Every documented property of `r` = partition_mesh(input, points, aux), and Floater's condition for a
 /// one-to-one square embedding. Returns "" when all hold, else a description of the problems.
-inline std::string check_partition(const TriMesh& input, const std::vector<int>& points, const PartitionResult& r) {
+inline std::string check_partition(const TriMesh& input, const std::vector<int>& points,
+                                   const PartitionResult& r) {
   std::ostringstream err;
   const TriMesh& m = r.mesh;
   const int nf = static_cast<int>(m.triangles.size());
@@ -147,7 +149,8 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
   }
   for (int f = 0; f < nf; ++f) {
     if (owner[f] < 0) err << "face " << f << " in no patch; ";
-    if (f < static_cast<int>(r.face_patch.size()) && r.face_patch[f] != owner[f]) err << "face_patch[" << f << "]; ";
+    if (f < static_cast<int>(r.face_patch.size()) && r.face_patch[f] != owner[f])
+      err << "face_patch[" << f << "]; ";
     if (err.tellp() > 2000) return err.str();
   }
 
@@ -155,7 +158,8 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
   const std::set<int> point_set(points.begin(), points.end());
   for (std::size_t p = 0; p < np; ++p) {
     const auto& c = r.patches[p].corners;
-    if (std::set<int>(c.begin(), c.end()) != point_set) err << "patch " << p << " corners are not the 4 points; ";
+    if (std::set<int>(c.begin(), c.end()) != point_set)
+      err << "patch " << p << " corners are not the 4 points; ";
     // Genus 0: P0; genus 1: patch 2a+b starts at P_{a+2b}.
     const int first = in_topo.genus == 0 ? points[0] : points[p / 2 + 2 * (p % 2)];
     if (c[0] != first) err << "patch " << p << " corner 0 is not the documented one; ";
@@ -187,7 +191,8 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
         continue;
       }
       for (std::size_t i = 0; i + 1 < v.size(); ++i) {
-        if (!mesh_halfedges.count(key(v[i], v[i + 1]))) err << "patch " << p << " side " << s << " not an edge path; ";
+        if (!mesh_halfedges.count(key(v[i], v[i + 1])))
+          err << "patch " << p << " side " << s << " not an edge path; ";
         side_halfedges.insert(key(v[i], v[i + 1]));
         cut_halfedges.insert(key(v[i], v[i + 1]));
         cut_halfedges.insert(key(v[i + 1], v[i]));
@@ -195,7 +200,8 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
       loop.insert(loop.end(), v.begin(), v.end() - 1);
       cut_vertices.insert(v.begin(), v.end());
     }
-    if (std::set<int>(loop.begin(), loop.end()).size() != loop.size()) err << "patch " << p << " loop not simple; ";
+    if (std::set<int>(loop.begin(), loop.end()).size() != loop.size())
+      err << "patch " << p << " loop not simple; ";
     // Disk: boundary half-edges of the patch's faces are exactly the sides' (same direction: CCW), V−E+F = 1.
     std::map<std::uint64_t, int> edge_use;
     std::set<int> verts;

@@ -216,9 +216,10 @@ class Partitioner {
       paths_.push_back(std::move(path));
     }
     mark_cut();
-    if (!chords().empty()) {
+    const std::size_t chord_count = chords().size();
+    if (chord_count > 0) {
       if (!options_.split_degenerate) {
-        throw InvalidInput(std::string(kFn) + "degenerate configuration: " + std::to_string(chords().size()) +
+        throw InvalidInput(std::string(kFn) + "degenerate configuration: " + std::to_string(chord_count) +
                            " edge(s) join two cut vertices without being on the cut (a triangle with all "
                            "three vertices on the cut); enable split_degenerate");
       }

@@ -114,7 +114,7 @@ PartitionPoints outline_points(const TriMesh& m, const std::vector<int>& opp, co
   const Outline o = longest_outline(m, opp, n, a, b, offset);
   const int count = static_cast<int>(o.vertex.size());
   PartitionPoints pts;
-  if (count < 8) return pts;
+  if (count < 4) return pts;
   std::array<int, 4> at;  // outline entries of the corners
   const std::array<Eigen::Vector3d, 4> dirs = {a, b, -a, -b};
   for (int k = 0; k < 4; ++k) {
@@ -138,8 +138,21 @@ PartitionPoints outline_points(const TriMesh& m, const std::vector<int>& opp, co
                pts.auxiliary_points.end();
   };
   for (int k = 0; k < 4; ++k) {
-    if (!distinct(o.vertex[at[k]])) return {};
+    if (!distinct(o.vertex[at[k]])) break;
     pts.partition_points.push_back(o.vertex[at[k]]);
+  }
+  if (pts.partition_points.size() < 4) {
+    // Coarse mesh: neighbouring entries share vertices. Spread the corners over the outline's distinct
+    // vertices, in order from the +a extreme, and let the paths go unguided.
+    std::vector<int> ring;
+    for (int i = 0; i < count; ++i) {
+      const int v = o.vertex[(at[0] + i) % count];
+      if (std::find(ring.begin(), ring.end(), v) == ring.end()) ring.push_back(v);
+    }
+    pts.partition_points.clear();
+    if (ring.size() < 4) return pts;
+    for (std::size_t k = 0; k < 4; ++k) pts.partition_points.push_back(ring[k * ring.size() / 4]);
+    return pts;
   }
   for (int k = 0; k < 4; ++k) {
     // Entry half way (by arc length) from corner k to corner k+1, or the nearest entry between them whose
@@ -224,13 +237,36 @@ PartitionPoints genus0_points(const TriMesh& m, const PartitionPointsOptions& op
       }
     }
     const PartitionPoints pts = outline_points(m, opp, n, a, b, offset);
-    if (pts.partition_points.size() != 4) continue;
+    if (pts.partition_points.size() != 4) {
+      failures += " an outline with fewer than 4 vertices;";
+      continue;
+    }
     try {
       partition_mesh(m, pts.partition_points, pts.auxiliary_points);
       return pts;
     } catch (const Error& e) {
       failures += std::string(" ") + e.what() + ";";
     }
+  }
+  // Last resort (a handful of triangles): the vertices extreme in ±a, ±b of the first plane.
+  PartitionPoints pts;
+  const Eigen::Vector3d a0 = planes.front()[1], b0 = planes.front()[2];
+  for (const Eigen::Vector3d& dir : {a0, b0, Eigen::Vector3d(-a0), Eigen::Vector3d(-b0)}) {
+    int best = -1;
+    for (const auto& t : m.triangles) {
+      for (int v : t) {
+        const auto& chosen = pts.partition_points;
+        if (std::find(chosen.begin(), chosen.end(), v) != chosen.end()) continue;
+        if (best < 0 || m.positions[v].dot(dir) > m.positions[best].dot(dir)) best = v;
+      }
+    }
+    pts.partition_points.push_back(best);
+  }
+  try {
+    partition_mesh(m, pts.partition_points, {});
+    return pts;
+  } catch (const Error& e) {
+    failures += std::string(" extreme vertices: ") + e.what() + ";";
   }
   throw SolverFailure(std::string(kFn) + "no principal plane gave a valid loop:" + failures);
 }

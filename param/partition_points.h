@@ -53,7 +53,9 @@ struct PartitionPointsOptions {
 ///   90° apart spread the corners evenly along the outline, so the 4 sides have similar lengths. The guiding
 ///   points matter: with the same corners but no guides, the balance drops (horse 0.95 → 0.86, armadillo
 ///   0.97 → 0.54, fandisk 0.73 → 0.46). If the loop fails to partition (possible on very coarse meshes), the
-///   other principal planes are tried (normals e3, e2, e1, after options.cut_axis).
+///   other principal planes are tried (normals e3, e2, e1, after options.cut_axis); on an outline too short
+///   for distinct corners the corners are spread over its vertices without guides, and on a mesh of a few
+///   triangles (a tetrahedron) the vertices extreme in ±e1, ±e2 are the last resort.
 ///
 /// Genus 1 — the 2×2 grid follows the torus's flat (conformal) coordinates:
 /// 1. a homology basis by tree–cotree (Eppstein 2003) gives two closed, non-exact 1-forms on the edges;

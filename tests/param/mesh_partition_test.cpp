@@ -361,6 +361,15 @@ TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {
   EXPECT_GT(max_abs_x, 2.9);
 }
 
+TEST(PartitionGenus0, ChosenPointsWorkOnCoarseMeshes) {
+  for (const TriMesh& m : {test::cube(), subdivide(test::cube(), 1), sphere(1), test::tetrahedron()}) {
+    const PartitionPoints pts = choose_partition_points(m);
+    const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
+    EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "") << m.num_triangles() << " triangles";
+    EXPECT_EQ(embedding_problems(r), "");
+  }
+}
+
 // ------------------------------------------------------------------------------------------- genus 1
 
 struct TorusSetup {

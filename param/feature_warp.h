@@ -1,0 +1,125 @@
+// Foldover-free feature alignment of a patch embedding: "triangulation over time" (paper §3.3.3 and §3.4,
+// after Fujimura & Makarov 1998, "Foldover-free image warping").
+//
+// Each patch of each model has an embedding `uv` of its base mesh in the unit square (corners on the square's
+// corners, boundary vertices on its sides, interior vertices strictly inside, no flipped triangle). Some
+// interior vertices are features; corresponding features of all models must end at the same uv, the average
+// of their positions (§3.4.1, `average_feature_targets`). `warp_features` moves them there (§3.4.2) with a
+// piecewise-linear homeomorphism of the square, and keeps the base mesh itself free of flipped triangles.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+namespace geomip {
+
+struct FeatureWarpOptions {
+  /// Stop the binary search for an event (a warp triangle incident to the moving feature reaching zero signed
+  /// area) when the bracket on the path parameter t ∈ [0,1] is this narrow.
+  double event_tolerance = 1e-13;
+  /// A feature's straight path may not pass closer than this (uv units) to another warp vertex (a corner or
+  /// another feature): such a path is re-routed through one waypoint, or deferred until the blocking feature
+  /// has moved. Targets must be farther apart than this, and farther than this from the square's sides.
+  double collision_distance = 1e-7;
+  /// A path should pass another feature no closer than this times the sum of both features' star radii (the
+  /// longest base edge at each): squeezing one feature's star past another's is what folds base meshes. Such a
+  /// path is re-routed through a waypoint beside the other feature (or waits while that feature has yet to
+  /// move); it is taken straight only when no such route exists.
+  double clearance = 0;
+  /// When a base-mesh triangle would invert during a step, the feature stops this fraction of the way to the
+  /// inversion (the triangle keeps 1 - fraction of its area) and the free vertices around that triangle are
+  /// repaired: moved to the centroid of the kernel of their star. In (0,1).
+  double repair_stop_fraction = 0.5;
+  /// A repair relaxes the free vertices of the triangle, then of its 1-ring, 2-ring, ... up to this many rings,
+  /// until the triangle has doubled its area.
+  int repair_rings = 3;
+  /// Gauss–Seidel sweeps of kernel-centroid moves per ring.
+  int repair_sweeps = 3;
+  /// Keep the base mesh free of inverted triangles (stop before an inversion and repair, see above). false
+  /// gives the plain warp of the paper, which maps vertices only and may invert straight-edged base triangles
+  /// (counted in `FeatureWarpResult::flipped_triangles`, no exception); for comparison and tests.
+  bool keep_base_mesh_valid = true;
+  /// A step moves the feature at most this fraction of its distance to the nearest other warp vertex
+  /// (0: no bound, steps end only at events and repairs).
+  double max_step_fraction = 0.1;
+  /// After every step, flip warp edges until the warp mesh is Delaunay again (kinetic Delaunay). false: flip
+  /// only at degeneracy events, as in the paper.
+  bool keep_delaunay = true;
+  /// Upper bound on warp edge flips (events) over the whole call.
+  std::size_t max_events = 100000;
+  /// Upper bound on steps (moves between events/repairs) of one feature; a feature that needs more is stopped
+  /// where it is (still foldover-free) and reported in `FeatureWarpResult::unreached`.
+  std::size_t max_steps_per_feature = 20000;
+  /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
+  /// order; counter-clockwise triangles) after it is built and after every move and every edge flip. May be
+  /// empty. For tests and visualization.
+  std::function<void(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles)>
+      observer;
+};
+
+struct FeatureWarpResult {
+  /// Warp edge flips performed ("events" of §3.4.2).
+  std::size_t events = 0;
+  /// Base-mesh vertex relocations done to keep base triangles from inverting (a vertex repaired twice counts
+  /// twice). Each moves a non-feature interior vertex to the centroid of the kernel of its star.
+  std::size_t repaired_vertices = 0;
+  /// Moves between events and repairs, over all features.
+  std::size_t steps = 0;
+  /// Features routed through a waypoint because their straight path passed a warp vertex.
+  std::size_t detours = 0;
+  /// max_k |uv[features[k]] - targets[k]| after the warp; 0 when every feature arrived.
+  double max_feature_error = 0;
+  /// Smallest signed area of a warp triangle seen after any move or flip (> 0: the warp never folded).
+  double min_warp_triangle_area = 0;
+  /// Indices k (into `features`) of features that could not reach their target without folding the base
+  /// mesh (e.g. a target that inverts a base triangle whose vertices are all features or on the boundary, or
+  /// features that would have to pass through each other); they stay at a foldover-free intermediate position.
+  std::vector<int> unreached;
+  /// Base triangles with signed area <= 0 after the warp, checked with exact predicates: always 0 unless
+  /// `keep_base_mesh_valid` is false.
+  std::size_t flipped_triangles = 0;
+};
+
+/// Warps the embedding `uv` so that uv[features[k]] = targets[k] exactly, for every k (§3.4.2).
+///
+/// A warp mesh is the 2D Delaunay triangulation of the square's 4 corners and the features' current uv;
+/// every other interior vertex is bound to its enclosing warp triangle by barycentric coordinates. Features
+/// move one at a time along straight lines toward their targets; before an event (an incident warp triangle
+/// about to degenerate) the edge opposite the vertex that becomes the middle of the collinear triple is
+/// flipped and the points of the two triangles are re-bound. Non-feature vertices follow their barycentric
+/// coordinates, so the warp is a piecewise-linear homeomorphism of the square: corners and boundary vertices
+/// do not move (bit-identical) and points outside the warp triangles incident to a moving feature do not move.
+/// Because a PL map of the vertices alone can still invert a straight-edged base triangle, every step also
+/// stops before a base triangle would invert and relocates one of its free vertices into the kernel of its
+/// star (`repaired_vertices`). The base mesh therefore has no flipped triangle afterwards.
+///
+/// \param triangles  #F base-mesh triangles, 0-based indices into `uv`, counter-clockwise (positive area).
+/// \param uv         #V positions in [0,1]²: corners at the square's corners, boundary vertices with a
+///                   coordinate exactly 0 or 1, other vertices strictly inside; no triangle of area <= 0.
+///                   Modified in place.
+/// \param features   indices into `uv` of interior vertices, pairwise distinct.
+/// \param targets    one target per feature, strictly inside the square (farther than
+///                   `collision_distance` from the sides) and pairwise farther apart than that.
+/// \throw InvalidInput when a precondition does not hold (nothing is modified then).
+/// \throw SolverFailure when, with `keep_base_mesh_valid`, the result would contain a flipped triangle (a bug).
+/// A target that cannot be reached without a fold is not an error: see `FeatureWarpResult::unreached`.
+FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
+                                const std::vector<int>& features, const std::vector<Eigen::Vector2d>& targets,
+                                const FeatureWarpOptions& options = {});
+
+/// The targets of feature alignment (§3.4.1): f_k = (1/m) Σ_i f_k^i, the average over the m models of the
+/// uv of corresponding feature k. `feature_uv_per_model[i][k]` is feature k's uv on model i.
+/// \throw InvalidInput when there is no model or the models have different feature counts.
+std::vector<Eigen::Vector2d> average_feature_targets(
+    const std::vector<std::vector<Eigen::Vector2d>>& feature_uv_per_model);
+
+/// The initial warp mesh of §3.4.2: the Delaunay triangulation (counter-clockwise triangles) of the points
+/// (0,0),(1,0),(1,1),(0,1), feature_uv[0], feature_uv[1], ... (indices in that order). Exposed for tests
+/// and visualization. \throw InvalidInput when a feature is not strictly inside the square or two coincide.
+std::vector<std::array<int, 3>> feature_warp_triangulation(const std::vector<Eigen::Vector2d>& feature_uv);
+
+}  // namespace geomip

@@ -505,7 +505,10 @@ class Warper {
       }
       if (moved && options_.keep_delaunay) result_.events += warp_.make_delaunay([&](int t) { note_area(t); });
       // 5. The repair: one free vertex of the base triangle about to invert goes into its star's kernel.
-      if (offending >= 0 && !repair(offending, false) && !repair(offending, true)) return Outcome::kStuck;
+      if (offending >= 0 && !repair(offending, false, options_.repair_rings) &&
+          !repair(offending, true, options_.repair_rings) && !repair(offending, false, 4 * options_.repair_rings)) {
+        return Outcome::kStuck;
+      }
     }
     return Outcome::kStuck;
   }
@@ -552,7 +555,7 @@ class Warper {
   /// one to the centroid of the kernel of its star, which keeps every triangle positive (a vertex is moved
   /// only when the exact predicates confirm it). The region grows ring by ring until t has at least doubled
   /// its area; succeeds when t grew at all.
-  bool repair(int t, bool maximin) {
+  bool repair(int t, bool maximin, int rings) {
     const Tri& T = triangles_[t];
     auto area = [&] { return area2(uv_[T[0]], uv_[T[1]], uv_[T[2]]); };
     auto contains = [](const std::vector<int>& list, int v) {
@@ -560,7 +563,7 @@ class Warper {
     };
     const double before = area();
     std::vector<int> reached(T.begin(), T.end()), frontier = reached, region, relocated;
-    for (int ring = 0; ring <= options_.repair_rings; ++ring) {
+    for (int ring = 0; ring <= rings; ++ring) {
       for (int v : frontier) {
         if (!fixed_[v]) region.push_back(v);
       }

@@ -6,7 +6,7 @@
 
 #include "param/errors.h"
 
-// CGAL's headers shadow names freely; silence that here only (param/CMakeLists.txt is not ours to change).
+// CGAL's headers shadow names freely; silence that for them only.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
 #include <CGAL/Delaunay_triangulation_2.h>
@@ -503,8 +503,13 @@ class Warper {
         ++result_.events;
         notify();
       }
-      if (moved && options_.keep_delaunay) result_.events += warp_.make_delaunay([&](int t) { note_area(t); });
-      // 5. The repair: one free vertex of the base triangle about to invert goes into its star's kernel.
+      if (moved && options_.keep_delaunay) {
+        const std::size_t flips = warp_.make_delaunay([&](int t) { note_area(t); });
+        result_.events += flips;
+        if (flips > 0) notify();
+      }
+      // 5. The repair: relax the free vertices around the base triangle about to invert (kernel centroids; then
+      // the max-min-area point; then centroids over a wider region).
       if (offending >= 0 && !repair(offending, false, options_.repair_rings) &&
           !repair(offending, true, options_.repair_rings) && !repair(offending, false, 4 * options_.repair_rings)) {
         return Outcome::kStuck;

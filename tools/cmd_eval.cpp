@@ -1,5 +1,6 @@
 // geomip eval ORIGINAL APPROX [--json]: Metro-style surface distance, symmetric Hausdorff/RMS and PSNR.
 #include "gimage/surface_distance.h"
+#include "param/errors.h"
 #include "param/mesh_io.h"
 #include "tools/commands.h"
 
@@ -45,7 +46,12 @@ int run_eval(EvalArgs args) {
   const TriMesh original = read_mesh(args.original);
   const TriMesh approx = read_mesh(args.approx);
   const auto start = std::chrono::steady_clock::now();
-  const SurfaceDistance d = measure_surface_distance(original, approx, args.options);
+  SurfaceDistance d;
+  try {
+    d = measure_surface_distance(original, approx, args.options);
+  } catch (const InvalidInput& e) {  // name the files: the library only knows "original" and "approx"
+    throw InvalidInput(args.original + " vs " + args.approx + ": " + e.what());
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const bool finite_psnr = std::isfinite(d.psnr_db);
 

@@ -116,11 +116,16 @@ TEST(SurfaceDistance, PatchInsideSquareIsOneSided) {
   EXPECT_EQ(swapped.bbox_diagonal, referenced_bounding_box(patch).diagonal());
   EXPECT_LT(swapped.bbox_diagonal, d.bbox_diagonal);
 
-  // Face samples alone estimate the area integral: RMS → √(1/48) = 0.1443.
+  // Face samples alone estimate the area integral: RMS → √(1/48) = 0.1443, also when the square's triangles
+  // have very different areas (grid lines at x², y²: face-uniform instead of area-uniform sampling would
+  // crowd the corner at the origin and miss by ~20%).
+  TriMesh warped = test::grid(16);
+  for (auto& p : warped.positions) p = Eigen::Vector3d(p.x() * p.x(), p.y() * p.y(), 0);
   SurfaceDistanceOptions faces_only;
   faces_only.sample_vertices = false;
   faces_only.face_samples = 200000;
-  const SurfaceDistance area = measure_surface_distance(big, patch, faces_only);
+  const SurfaceDistance area =
+      measure_surface_distance(transformed(warped, Eigen::Affine3d(r)), patch, faces_only);
   EXPECT_EQ(area.original_to_approx.vertex_samples, 0u);
   EXPECT_EQ(area.original_to_approx.samples(), 200000u);
   EXPECT_NEAR(area.original_to_approx.rms, std::sqrt(1.0 / 48), 0.005 * std::sqrt(1.0 / 48));

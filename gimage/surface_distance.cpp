@@ -37,7 +37,9 @@ constexpr std::size_t kAutoSamplesPerFace = 10;
 constexpr std::size_t kAutoMinSamples = 10000;
 constexpr std::size_t kAutoMaxSamples = 1000000;
 
-Point to_point(const Eigen::Vector3d& p) { return Point(p.x(), p.y(), p.z()); }
+Point to_point(const Eigen::Vector3d& p) {
+  return Point(p.x(), p.y(), p.z());
+}
 
 double triangle_area(const TriMesh& mesh, const std::array<int, 3>& t) {
   const Eigen::Vector3d& a = mesh.positions[t[0]];
@@ -55,10 +57,11 @@ void validate(const TriMesh& mesh, const char* which) {
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     for (int v : mesh.triangles[f]) {
       if (v < 0 || v >= n) {
-        fail("triangle " + std::to_string(f) + " has vertex index " + std::to_string(v) + " out of range [0, " +
-             std::to_string(n) + ")");
+        fail("triangle " + std::to_string(f) + " has vertex index " + std::to_string(v) +
+             " out of range [0, " + std::to_string(n) + ")");
       }
-      if (!mesh.positions[v].allFinite()) fail("vertex " + std::to_string(v) + " has a non-finite coordinate");
+      if (!mesh.positions[v].allFinite())
+        fail("vertex " + std::to_string(v) + " has a non-finite coordinate");
     }
     has_area = has_area || triangle_area(mesh, mesh.triangles[f]) > 0;
   }
@@ -250,18 +253,21 @@ SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh&
                                          const SurfaceDistanceOptions& options) {
   validate(original, "original");
   validate(approx, "approx");
-  const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads =
+      options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   const double noise_floor = 64 * std::numeric_limits<double>::epsilon() *
                              std::max(max_abs_coordinate(original), max_abs_coordinate(approx));
 
   SurfaceDistance r;
   {
     const SearchSurface approx_surface(approx);
-    r.original_to_approx = one_sided(sample_surface(original, options, 0), approx_surface, noise_floor, threads);
+    r.original_to_approx =
+        one_sided(sample_surface(original, options, 0), approx_surface, noise_floor, threads);
   }
   {
     const SearchSurface original_surface(original);
-    r.approx_to_original = one_sided(sample_surface(approx, options, 1), original_surface, noise_floor, threads);
+    r.approx_to_original =
+        one_sided(sample_surface(approx, options, 1), original_surface, noise_floor, threads);
   }
   r.hausdorff = std::max(r.original_to_approx.max, r.approx_to_original.max);
   r.rms = std::max(r.original_to_approx.rms, r.approx_to_original.rms);

@@ -1,13 +1,14 @@
 // Metro-style surface distance between two triangle meshes: sampled one-sided distances both ways, symmetric
 // Hausdorff and RMS, and the PSNR used by the consistent mesh parameterization paper (§5) to judge remeshes.
 //
-// Cignoni, Rocchini, Scopigno, "Metro: measuring error on simplified surfaces", Computer Graphics Forum 17(2),
-// 1998. Each surface is sampled (all its vertices plus area-uniform random points on its faces, optionally
-// points along its edges); for every sample the exact distance to the closest point of the OTHER surface is
-// taken (an AABB tree over its triangles). Like Metro and MeshLab's "Hausdorff Distance" filter (Metro's code),
-// the mean and RMS are plain averages over all samples: the face samples are area-uniform, so their average
-// estimates the area integral, and the vertex (and edge) samples enter with the same weight as any other
-// sample (a slight bias that Metro accepts for finding the maxima, which sit on vertices and edges).
+// Cignoni, Rocchini, Scopigno, "Metro: measuring error on simplified surfaces", Computer Graphics Forum
+// 17(2), 1998. Each surface is sampled (all its vertices plus area-uniform random points on its faces,
+// optionally points along its edges); for every sample the exact distance to the closest point of the OTHER
+// surface is taken (an AABB tree over its triangles). Like Metro and MeshLab's "Hausdorff Distance" filter
+// (Metro's code), the mean and RMS are plain averages over all samples: the face samples are area-uniform, so
+// their average estimates the area integral, and the vertex (and edge) samples enter with the same weight as
+// any other sample (a slight bias that Metro accepts for finding the maxima, which sit on vertices and
+// edges).
 #pragma once
 
 #include "param/mesh.h"
@@ -48,7 +49,7 @@ struct OneSidedDistance {
 struct SurfaceDistance {
   OneSidedDistance original_to_approx;  ///< samples on the original, distances to the approximation
   OneSidedDistance approx_to_original;  ///< samples on the approximation, distances to the original
-  double hausdorff = 0;      ///< symmetric Hausdorff distance: max of the two one-sided maxima
+  double hausdorff = 0;                 ///< symmetric Hausdorff distance: max of the two one-sided maxima
   double rms = 0;            ///< symmetric RMS distance: the larger of the two one-sided RMS (Metro)
   double bbox_diagonal = 0;  ///< diagonal of the ORIGINAL's bounding box (its referenced vertices)
   double hausdorff_pct = 0;  ///< 100·hausdorff / bbox_diagonal

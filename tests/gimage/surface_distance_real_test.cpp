@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -18,7 +19,6 @@
 #include <map>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 namespace geomip {
@@ -27,11 +27,12 @@ namespace {
 namespace fs = std::filesystem;
 
 void print(const char* what, const SurfaceDistance& d, double seconds) {
-  std::printf("%s: original->approx %zu samples max %.6g rms %.6g | approx->original %zu samples max %.6g "
-              "rms %.6g | Hausdorff %.4f%%  RMS %.4f%%  PSNR %.2f dB  (%.2f s)\n",
-              what, d.original_to_approx.samples(), d.original_to_approx.max, d.original_to_approx.rms,
-              d.approx_to_original.samples(), d.approx_to_original.max, d.approx_to_original.rms,
-              d.hausdorff_pct, d.rms_pct, d.psnr_db, seconds);
+  std::printf(
+      "%s: original->approx %zu samples max %.6g rms %.6g | approx->original %zu samples max %.6g "
+      "rms %.6g | Hausdorff %.4f%%  RMS %.4f%%  PSNR %.2f dB  (%.2f s)\n",
+      what, d.original_to_approx.samples(), d.original_to_approx.max, d.original_to_approx.rms,
+      d.approx_to_original.samples(), d.approx_to_original.max, d.approx_to_original.rms, d.hausdorff_pct,
+      d.rms_pct, d.psnr_db, seconds);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -46,8 +47,9 @@ TEST(SurfaceDistanceReal, BunnyAgainstItsRepairedCopy) {
   const SurfaceDistance d = measure_surface_distance(bunny, closed);
   print("bunny vs repaired bunny", d, seconds_since(t0));
   // Repair keeps every triangle of the bunny (it has no degenerate or duplicate ones): the bunny lies on its
-  // repaired copy. The copy adds five hole patches on the base, off the open bunny: distance in that direction
-  // only, up to a few % of the diagonal in the middle of the largest hole (measured: 3.6%, PSNR 56.6 dB).
+  // repaired copy. The copy adds five hole patches on the base, off the open bunny: distance in that
+  // direction only, up to a few % of the diagonal in the middle of the largest hole (measured: 3.6%,
+  // PSNR 56.6 dB).
   EXPECT_EQ(d.original_to_approx.max, 0.0);
   EXPECT_EQ(d.original_to_approx.rms, 0.0);
   EXPECT_EQ(d.rms, d.approx_to_original.rms);
@@ -75,7 +77,8 @@ TEST(SurfaceDistanceReal, BunnyAgainstBunnySmall) {
   EXPECT_GT(d.psnr_db, 50.0);
   EXPECT_LT(d.psnr_db, 62.0);
   EXPECT_GT(d.approx_to_original.max, 5 * d.original_to_approx.max);
-  EXPECT_LT(seconds, 20.0);  // about a second on two busy cores; far more means the trees are rebuilt per query
+  EXPECT_LT(seconds,
+            20.0);  // about a second on two busy cores; far more means the trees are rebuilt per query
   const TriMesh repaired = repair_mesh(bunny).mesh;
   const auto t1 = std::chrono::steady_clock::now();
   const SurfaceDistance closed = measure_surface_distance(repaired, small);
@@ -104,7 +107,8 @@ std::string find_program(const std::string& name) {
   return {};
 }
 
-/// `mesh` without its unreferenced vertices (MeshLab samples every vertex it loads; geomip only referenced ones).
+/// `mesh` without its unreferenced vertices (MeshLab samples every vertex it loads; geomip only referenced
+/// ones).
 TriMesh compacted(const TriMesh& mesh) {
   TriMesh out;
   std::vector<int> index(mesh.positions.size(), -1);
@@ -138,7 +142,8 @@ std::string hausdorff_filter(int sampled, int target, std::size_t samples) {
     << "  <Param type=\"RichBool\" value=\"false\" name=\"SampleEdge\"/>\n"
     << "  <Param type=\"RichBool\" value=\"false\" name=\"SampleFauxEdge\"/>\n"
     << "  <Param type=\"RichBool\" value=\"true\" name=\"SampleFace\"/>\n"
-    << "  <Param type=\"RichInt\" value=\"" << samples << "\" name=\"SampleNum\"/>\n"
+    << "  <Param type=\"RichInt\" value=\"" << samples
+    << "\" name=\"SampleNum\"/>\n"
     // MeshLab drops samples farther than MaxDist (default 5% of the diagonal): make it unbounded.
     << "  <Param type=\"RichAbsPerc\" value=\"1e30\" min=\"0\" max=\"1e30\" name=\"MaxDist\"/>\n"
     << " </filter>\n";
@@ -150,11 +155,11 @@ std::string hausdorff_filter(int sampled, int target, std::size_t samples) {
 std::map<std::string, MeshLabDirection> run_meshlab(const std::string& dir, const std::string& meshlab,
                                                     const std::string& xvfb, std::size_t samples0,
                                                     std::size_t samples1) {
-  std::ofstream(dir + "/hausdorff.mlx") << "<!DOCTYPE FilterScript>\n<FilterScript>\n"
-                                        << hausdorff_filter(0, 1, samples0) << hausdorff_filter(1, 0, samples1)
-                                        << "</FilterScript>\n";
-  const std::string cmd = "cd '" + dir + "' && timeout 300 " + (xvfb.empty() ? "" : "'" + xvfb + "' -a ") + "'" +
-                          meshlab + "' -l log.txt -i a.off -i b.off -s hausdorff.mlx > out.txt 2>&1";
+  std::ofstream(dir + "/hausdorff.mlx")
+      << "<!DOCTYPE FilterScript>\n<FilterScript>\n"
+      << hausdorff_filter(0, 1, samples0) << hausdorff_filter(1, 0, samples1) << "</FilterScript>\n";
+  const std::string cmd = "cd '" + dir + "' && timeout 300 " + (xvfb.empty() ? "" : "'" + xvfb + "' -a ") +
+                          "'" + meshlab + "' -l log.txt -i a.off -i b.off -s hausdorff.mlx > out.txt 2>&1";
   const int status = std::system(cmd.c_str());
   EXPECT_EQ(status, 0) << cmd;
 
@@ -203,7 +208,8 @@ TEST(SurfaceDistanceReal, AgreesWithMeshLabHausdorffFilter) {
   if (meshlab.empty()) GTEST_SKIP() << "meshlabserver not found (Debian: apt-get install meshlab xvfb)";
   const bool has_display = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
   const std::string xvfb = has_display ? std::string() : find_program("xvfb-run");
-  if (!has_display && xvfb.empty()) GTEST_SKIP() << "meshlabserver needs a display: no DISPLAY and no xvfb-run";
+  if (!has_display && xvfb.empty())
+    GTEST_SKIP() << "meshlabserver needs a display: no DISPLAY and no xvfb-run";
 
   struct Pair {
     std::string name;
@@ -231,10 +237,11 @@ TEST(SurfaceDistanceReal, AgreesWithMeshLabHausdorffFilter) {
     ASSERT_GT(ab.rms, 0.0);
     ASSERT_GT(ba.rms, 0.0);
     const double their_psnr = 20 * std::log10(ours.bbox_diagonal / std::max(ab.rms, ba.rms));
-    std::printf("%s: geomip PSNR %.3f dB, MeshLab %.3f dB | RMS %.6g / %.6g vs %.6g / %.6g | max %.6g / %.6g vs "
-                "%.6g / %.6g\n",
-                p.name.c_str(), ours.psnr_db, their_psnr, ours.original_to_approx.rms, ours.approx_to_original.rms,
-                ab.rms, ba.rms, ours.original_to_approx.max, ours.approx_to_original.max, ab.max, ba.max);
+    std::printf(
+        "%s: geomip PSNR %.3f dB, MeshLab %.3f dB | RMS %.6g / %.6g vs %.6g / %.6g | max %.6g / %.6g vs "
+        "%.6g / %.6g\n",
+        p.name.c_str(), ours.psnr_db, their_psnr, ours.original_to_approx.rms, ours.approx_to_original.rms,
+        ab.rms, ba.rms, ours.original_to_approx.max, ours.approx_to_original.max, ab.max, ba.max);
     EXPECT_NEAR(ours.psnr_db, their_psnr, 0.5) << p.name;  // the issue's tolerance
     // Same sampling plan (all vertices + the same number of area-uniform face samples), so per direction the
     // sample counts match and the RMS agree within sampling noise; maxima sit on random face samples too.

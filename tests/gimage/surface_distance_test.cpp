@@ -95,11 +95,13 @@ TEST(SurfaceDistance, SphereScaledByOnePlusEpsilonIsEpsilonAway) {
 }
 
 TEST(SurfaceDistance, PatchInsideSquareIsOneSided) {
-  // A patch [¼,¾]² inside the unit square: every point of the patch lies on the square (distance 0), while the
-  // square's corners are √2/4 from the patch. Area RMS of the square → patch distance: ∫d² = 1/48 over area 1.
+  // A patch [¼,¾]² inside the unit square: every point of the patch lies on the square (distance 0), while
+  // the square's corners are √2/4 from the patch. Area RMS of the square → patch distance: ∫d² = 1/48 over
+  // area 1.
   const Eigen::Matrix3d r = some_rotation();
   const TriMesh big = square(8, r);
-  const Eigen::Affine3d to_patch = Eigen::Affine3d(r) * Eigen::Translation3d(0.25, 0.25, 0) * Eigen::Scaling(0.5);
+  const Eigen::Affine3d to_patch =
+      Eigen::Affine3d(r) * Eigen::Translation3d(0.25, 0.25, 0) * Eigen::Scaling(0.5);
   const TriMesh patch = transformed(test::grid(3), to_patch);
 
   const SurfaceDistance d = measure_surface_distance(big, patch);
@@ -135,8 +137,8 @@ TEST(SurfaceDistance, EdgeSamplesFollowTheEdges) {
   // Samples along the big square's edges (spaced ~0.003 apart) come close to its corners, the farthest points
   // from the patch (√2/4), and never beyond; samples along the patch's edges all lie on the square.
   const TriMesh big = square(4);
-  const TriMesh patch = transformed(test::grid(2), Eigen::Affine3d(Eigen::Translation3d(0.25, 0.25, 0) *
-                                                                   Eigen::Scaling(0.5)));
+  const TriMesh patch =
+      transformed(test::grid(2), Eigen::Affine3d(Eigen::Translation3d(0.25, 0.25, 0) * Eigen::Scaling(0.5)));
   SurfaceDistanceOptions options;
   options.edge_samples = 5000;
   options.sample_vertices = false;

@@ -20,5 +20,6 @@ using CommandRunner = std::function<int()>;
 CommandRunner add_info_command(CLI::App& app);
 CommandRunner add_repair_command(CLI::App& app);
 CommandRunner add_param_command(CLI::App& app);
+CommandRunner add_eval_command(CLI::App& app);
 
 }  // namespace geomip::tools

@@ -11,11 +11,16 @@ import heapq, json, math, os, sys
 
 # forward, up (unit axes of the file), head yaw toward the animal's left in degrees, head depth (fraction of length)
 MODELS = [
-    ('horse', (0, 1, 0), (0, 0, 1), 45.0, 0.35),
+    ('horse', (0, 1, 0), (0, 0, 1), 60.0, 0.35),
     ('cow',   (1, 0, 0), (0, 1, 0), 0.0, 0.25),
     ('pig',   (0, 0, -1), (0, -1, 0), 0.0, 0.30),
     ('spot',  (0, 0, -1), (0, 1, 0), 0.0, 0.35),
 ]
+# Eyes: a ray aimed at the point `a` of the way from the top of the head to the nose, shot from the side (the
+# horse's and the cow's eyes are on the sides of the head) or, offset sideways by `w` times the ear-tip distance,
+# from the front (the pig's eyes are the two ovals on its face; Spot has no modelled eyes, so the rays hit the
+# upper face where its texture has them). Read off close-up renders of the heads.
+EYES = {'horse': (0.30, None), 'cow': (0.30, None), 'pig': (0.78, 0.155), 'spot': (0.35, 0.12)}
 
 def dot(a, b): return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 def cross(a, b): return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
@@ -132,7 +137,34 @@ def find_points(V, F, fr, name):
         P['crotch'] = vertical_hit(V, F, fr, fb + 0.01 * step * L, fr.lmid, True)
         if P['crotch'] is not None: break
     P['withers'] = vertical_hit(V, F, fr, ff, fr.lmid, False)
+    a, w = EYES[name]
+    N, T = V[P['nose']], V[P['head_top']]
+    X = tuple(T[i] + a * (N[i] - T[i]) for i in range(3))
+    for key, sg in (('eye_l', 1), ('eye_r', -1)):
+        if w is None:
+            O = tuple(X[i] + 2 * sg * sep * fr.hl[i] for i in range(3)); D = tuple(-sg * fr.hl[i] for i in range(3))
+        else:
+            O = tuple(X[i] + sg * w * sep * fr.hl[i] + 2 * sep * fr.hf[i] for i in range(3)); D = tuple(-x for x in fr.hf)
+        P[key] = ray_hit(V, F, O, D)
+    # Brow: the head vertex as near as possible to both eyes.
+    el, er = V[P['eye_l']], V[P['eye_r']]
+    P['brow'] = min(hd, key=lambda k: max(norm(sub(V[k], el)), norm(sub(V[k], er))))
     return P
+
+def ray_hit(V, F, O, D):
+    """The vertex nearest the first intersection of the ray O + tD (t > 0) with the mesh (Moller-Trumbore)."""
+    best = None
+    for t in F:
+        a, b, c = V[t[0]], V[t[1]], V[t[2]]
+        e1 = sub(b, a); e2 = sub(c, a); p = cross(D, e2); det = dot(e1, p)
+        if abs(det) < 1e-18: continue
+        s = sub(O, a); u = dot(s, p) / det
+        if u < 0 or u > 1: continue
+        q = cross(s, e1); v = dot(D, q) / det
+        if v < 0 or u + v > 1: continue
+        d = dot(e2, q) / det
+        if d > 0 and (best is None or d < best[0]): best = (d, t, (1 - u - v, u, v))
+    return best[1][max(range(3), key=lambda i: best[2][i])]
 
 def vertical_hit(V, F, fr, f0, l0, from_below):
     best = None
@@ -209,7 +241,7 @@ def trace_loop(V, F, corners, aux=()):
     face_patch = [0 if x == left else 1 for x in label]
     return paths, (face_patch, nreg)
 
-FEATURES = ['foot_lf', 'foot_rf', 'foot_lb', 'foot_rb', 'ear_l', 'ear_r']
+FEATURES = ['foot_lf', 'foot_rf', 'foot_lb', 'foot_rb', 'ear_l', 'ear_r', 'eye_l', 'eye_r']
 
 def main():
     mesh_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)),
@@ -221,10 +253,11 @@ def main():
         fr = Frame(V0, fwd, up, yaw, head_frac)
         P = find_points(V0, F0, fr, name)
         corners = [P['nose'], P['head_top'], P['tail'], P['chest']]
-        # Auxiliary points pin the loop to the midline: path 1 through the withers, path 2 through the crotch
-        # (without it the rump-to-chest path cuts across a flank); paths 0 and 3 through their own middle vertex.
+        # Auxiliary points pin the loop to the midline: path 0 through the brow between the eyes (the horse's
+        # turned head otherwise lets it run past the left eye), path 1 through the withers, path 2 through the
+        # crotch (without it the rump-to-chest path cuts across a flank), path 3 through its own middle vertex.
         free, _ = trace_loop(V, F, corners)
-        aux = [free[0][len(free[0]) // 2], P['withers'], P['crotch'], free[3][len(free[3]) // 2]]
+        aux = [P['brow'], P['withers'], P['crotch'], free[3][len(free[3]) // 2]]
         points = corners + aux + [P[k] for k in FEATURES]
         assert len(set(points)) == len(points) and not any(v in copies for v in points), name
         paths, (face_patch, regions) = trace_loop(V, F, corners, aux)

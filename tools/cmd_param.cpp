@@ -234,9 +234,10 @@ int run_param(const ParamArgs& args) {
     } else if (!args.quiet) {
       std::cout << "param " << paths[i] << " → " << stem << ".param.obj\n";
       for (const auto& p : result[i].patches) {
-        std::printf("  patch: %zu vertices, L2 stretch %.4f (MVC %.4f), Linf %.3f (MVC %.3f), %zu flipped\n",
-                    p.vertices.size(), p.stretch.l2, p.mvc_stretch.l2, p.stretch.linf, p.mvc_stretch.linf,
-                    p.flipped);
+        std::printf("  patch: %zu vertices, L2 stretch %.4f, Linf %.3f", p.vertices.size(), p.stretch.l2,
+                    p.stretch.linf);
+        if (p.mvc_stretch.l2 > 0) std::printf(" (MVC: %.4f, %.3f)", p.mvc_stretch.l2, p.mvc_stretch.linf);
+        std::printf(", %zu flipped%s\n", p.flipped, p.mvc_fallback ? ", optimized MVC kept" : "");
       }
     }
   }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <string>
 
 namespace geomip {
@@ -93,15 +94,15 @@ inline void store(float* out, const Eigen::Vector3d& v, bool renormalize) {
   out[2] = static_cast<float>(w.z());
 }
 
-// Rasterizes one patch: every sample claimed by a (u,v) triangle gets its barycentric interpolation. Returns
-// the number of unclaimed samples, which are then filled from their nearest claimed neighbour on the grid.
-std::size_t rasterize_patch(const PatchParameterization& patch, const Attribute& attribute, bool renormalize,
-                            GeometryImage& image) {
-  const int intervals = 1 << image.level;
-  const int n = image.size();
-  const double h = std::ldexp(1.0, -image.level);
-  std::vector<char> claimed(static_cast<std::size_t>(n) * n, 0);
-  for (const auto& t : patch.triangles) {
+// Rasterizes the (u,v) triangles of `patch` onto the level-`level` grid and calls
+// claim(i, j, triangle, wa, wb, wc) for every (sample, claiming triangle), with the sample's (unnormalized)
+// barycentric weights. Triangles with (u,v) area <= 0 claim nothing.
+template <typename Claim>
+void rasterize(const PatchParameterization& patch, int level, Claim&& claim) {
+  const int intervals = 1 << level;
+  const double h = std::ldexp(1.0, -level);
+  for (std::size_t tri = 0; tri < patch.triangles.size(); ++tri) {
+    const auto& t = patch.triangles[tri];
     const Eigen::Vector2d& a = patch.uv[t[0]];
     const Eigen::Vector2d& b = patch.uv[t[1]];
     const Eigen::Vector2d& c = patch.uv[t[2]];
@@ -112,27 +113,34 @@ std::size_t rasterize_patch(const PatchParameterization& patch, const Attribute&
     const int i1 = std::min(intervals, static_cast<int>(std::floor(umax * intervals)));
     const int j0 = std::max(0, static_cast<int>(std::ceil(vmin * intervals)));
     const int j1 = std::min(intervals, static_cast<int>(std::floor(vmax * intervals)));
-    if (i0 > i1 || j0 > j1) continue;
-    const Eigen::Vector3d& pa = attribute[patch.vertices[t[0]]];
-    const Eigen::Vector3d& pb = attribute[patch.vertices[t[1]]];
-    const Eigen::Vector3d& pc = attribute[patch.vertices[t[2]]];
     for (int j = j0; j <= j1; ++j) {
-      const int sy = 2 * j < intervals ? 1 : -1;
+      const int sy = 2 * j < intervals ? 1 : -1;  // perturb toward the square's centre
       for (int i = i0; i <= i1; ++i) {
         const int sx = 2 * i < intervals ? 1 : -1;
         const Eigen::Vector2d p(i * h, j * h);
         if (!left_of(a, b, p, sx, sy) || !left_of(b, c, p, sx, sy) || !left_of(c, a, p, sx, sy)) continue;
-        // Barycentric weights as sub-triangle areas, normalized by their sum.
-        const double wa = (b - p).x() * (c - p).y() - (b - p).y() * (c - p).x();
-        const double wb = (c - p).x() * (a - p).y() - (c - p).y() * (a - p).x();
-        const double wc = (a - p).x() * (b - p).y() - (a - p).y() * (b - p).x();
-        const double sum = wa + wb + wc;
-        const Eigen::Vector3d v = (wa * pa + wb * pb + wc * pc) / sum;
-        store(image.at(i, j), v, renormalize);
-        claimed[static_cast<std::size_t>(j) * n + i] = 1;
+        const Eigen::Vector2d pa = a - p, pb = b - p, pc = c - p;
+        claim(i, j, static_cast<int>(tri), pb.x() * pc.y() - pb.y() * pc.x(), pc.x() * pa.y() - pc.y() * pa.x(),
+              pa.x() * pb.y() - pa.y() * pb.x());
       }
     }
   }
+}
+
+// Resamples one patch: every sample claimed by a (u,v) triangle gets its barycentric interpolation. Returns
+// the number of unclaimed samples, which are then filled from their nearest claimed neighbour on the grid.
+std::size_t rasterize_patch(const PatchParameterization& patch, const Attribute& attribute, bool renormalize,
+                            GeometryImage& image) {
+  const int n = image.size();
+  std::vector<char> claimed(static_cast<std::size_t>(n) * n, 0);
+  rasterize(patch, image.level, [&](int i, int j, int tri, double wa, double wb, double wc) {
+    const auto& t = patch.triangles[tri];
+    const Eigen::Vector3d v = (wa * attribute[patch.vertices[t[0]]] + wb * attribute[patch.vertices[t[1]]] +
+                               wc * attribute[patch.vertices[t[2]]]) /
+                              (wa + wb + wc);
+    store(image.at(i, j), v, renormalize);
+    claimed[static_cast<std::size_t>(j) * n + i] = 1;
+  });
   // Unclaimed samples (only with flipped or degenerate triangles): breadth-first fill from claimed ones.
   std::deque<int> queue;
   std::size_t unclaimed = 0;
@@ -208,16 +216,16 @@ void walk_side(const PatchParameterization& patch, const std::vector<int>& local
 }
 
 void check_patch(const PatchParameterization& p, std::size_t num_vertices, const std::string& where) {
-  if (p.uv.size() != p.vertices.size()) throw InvalidInput("resample_geometry: " + where + ": uv and vertices differ in size");
+  if (p.uv.size() != p.vertices.size()) throw InvalidInput(where + ": uv and vertices differ in size");
   for (int v : p.vertices) {
     if (v < 0 || static_cast<std::size_t>(v) >= num_vertices) {
-      throw InvalidInput("resample_geometry: " + where + ": vertex id out of range");
+      throw InvalidInput(where + ": vertex id out of range");
     }
   }
   for (const auto& t : p.triangles) {
     for (int c : t) {
       if (c < 0 || static_cast<std::size_t>(c) >= p.vertices.size()) {
-        throw InvalidInput("resample_geometry: " + where + ": triangle index out of range");
+        throw InvalidInput(where + ": triangle index out of range");
       }
     }
   }
@@ -266,6 +274,25 @@ std::vector<GeometryImage> resample_attribute(const ModelParameterization& model
 
 }  // namespace
 
+GridLocation locate_grid_samples(const PatchParameterization& patch, int level) {
+  if (level < 0 || level > kMaxGeometryImageLevel) {
+    throw InvalidInput("locate_grid_samples: level " + std::to_string(level) + " is outside [0, " +
+                       std::to_string(kMaxGeometryImageLevel) + "]");
+  }
+  check_patch(patch, std::numeric_limits<std::size_t>::max(), "locate_grid_samples: the patch");
+  GridLocation location;
+  location.level = level;
+  const int n = (1 << level) + 1;
+  location.triangle.assign(static_cast<std::size_t>(n) * n, -1);
+  location.claims.assign(static_cast<std::size_t>(n) * n, 0);
+  rasterize(patch, level, [&](int i, int j, int tri, double, double, double) {
+    const std::size_t k = static_cast<std::size_t>(j) * n + i;
+    if (location.triangle[k] < 0) location.triangle[k] = tri;
+    if (location.claims[k] < 255) ++location.claims[k];
+  });
+  return location;
+}
+
 std::vector<Eigen::Vector3d> area_weighted_vertex_normals(const TriMesh& mesh) {
   std::vector<Eigen::Vector3d> normals(mesh.positions.size(), Eigen::Vector3d::Zero());
   for (const auto& t : mesh.triangles) {
@@ -293,7 +320,7 @@ GeometryImages resample_geometry(const ModelParameterization& model, int level, 
   }
   const std::size_t num_patches = model.patches.size();
   for (std::size_t p = 0; p < num_patches; ++p) {
-    check_patch(model.patches[p], model.mesh.positions.size(), "patch " + std::to_string(p));
+    check_patch(model.patches[p], model.mesh.positions.size(), "resample_geometry: patch " + std::to_string(p));
   }
   if (!model.adjacency.empty() && model.adjacency.size() != 4 * num_patches) {
     throw InvalidInput("resample_geometry: adjacency must have 4 entries per patch");

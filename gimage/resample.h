@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace geomip {
@@ -80,6 +81,20 @@ struct ResampleOptions {
 ///   out of range, corners or sides missing from the patch, a side not monotone in (u,v)), an adjacency that
 ///   links sides of different lengths in the mesh (different vertex sequences).
 GeometryImages resample_geometry(const ModelParameterization& model, int level, const ResampleOptions& options = {});
+
+/// Point location of the grid samples of one patch, as resample_geometry() does it.
+struct GridLocation {
+  int level = 0;
+  std::vector<int> triangle;          ///< per sample (j·(2^level+1) + i): the claiming triangle, -1 for none
+  std::vector<std::uint8_t> claims;   ///< per sample: how many triangles claim it (1 for a valid patch; saturates)
+};
+
+/// Which (u,v) triangle of `patch` contains each sample (i, j) = (u, v)·2^level. Exact orientation tests; a
+/// sample on an edge or a vertex goes to the triangle that contains the sample moved infinitesimally toward the
+/// square's centre (by (±ε, ±ε·η), ε ≫ η), so on a patch without flipped triangles that tiles the unit square
+/// every sample, boundary included, is claimed exactly once. Triangles with (u,v) area <= 0 claim nothing.
+/// 	hrow InvalidInput for a level outside [0, kMaxGeometryImageLevel] or triangle indices out of range.
+GridLocation locate_grid_samples(const PatchParameterization& patch, int level);
 
 /// Area-weighted vertex normals of `mesh` (sum of the incident triangles' cross products, normalized); a vertex
 /// of no or only degenerate triangles gets (0, 0, 1).

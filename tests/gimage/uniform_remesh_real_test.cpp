@@ -1,0 +1,39 @@
+// Uniform remeshes of real meshes (../shared/meshes): watertight, oriented, genus 0, outward, at M1..M6.
+#include "gimage/uniform_remesh.h"
+#include "param/mesh_io.h"
+#include "param/mesh_repair.h"
+#include "param/mesh_topology.h"
+#include "tests/gimage/gimage_fixtures.h"
+#include "tests/gimage/remesh_checks.h"
+
+#include <gtest/gtest.h>
+
+namespace geomip {
+namespace {
+
+class RealRemesh : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(RealRemesh, WatertightOrientedAtLevels1To6) {
+  GEOMIP_REQUIRE_SHARED_MESH(path, GetParam());
+  TriMesh mesh = read_mesh(path);
+  const TopologyReport r = analyze_topology(mesh);
+  if (r.boundary_loops > 0 || !r.manifold) mesh = repair_mesh(mesh).mesh;
+  const auto model = parameterize_consistently({test::automatic_input(mesh, GetParam())}, test::quick_options())[0];
+  const GeometryImages g = resample_geometry(model, 6);
+  EXPECT_EQ(g.uncovered_samples, 0u);
+  for (int level = 1; level <= 6; ++level) {
+    const UniformRemeshResult remesh = uniform_remesh(g, level);
+    EXPECT_EQ(remesh.mesh.triangles.size(), 4u << (2 * level));
+    test::expect_watertight_oriented(remesh.mesh, 0, std::string(GetParam()) + " M" + std::to_string(level));
+  }
+  // M6 keeps the volume of the original within a few percent.
+  EXPECT_NEAR(test::signed_volume(uniform_remesh(g, 6).mesh) / test::signed_volume(mesh), 1.0, 0.05);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shared, RealRemesh, ::testing::Values("spot.obj", "bunny.obj"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           return std::string(info.param).substr(0, std::string(info.param).find('.'));
+                         });
+
+}  // namespace
+}  // namespace geomip

@@ -31,8 +31,8 @@ TEST_P(RealRemesh, WatertightOrientedAtLevels1To6) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, RealRemesh, ::testing::Values("spot.obj", "bunny.obj"),
-                         [](const ::testing::TestParamInfo<const char*>& info) {
-                           return std::string(info.param).substr(0, std::string(info.param).find('.'));
+                         [](const ::testing::TestParamInfo<const char*>& param_info) {
+                           return std::string(param_info.param).substr(0, std::string(param_info.param).find('.'));
                          });
 
 }  // namespace

@@ -51,7 +51,8 @@ void write_parts(const std::string& file_path, const std::vector<GeometryImage>&
   std::vector<Imf::Header> headers;
   for (std::size_t p = 0; p < patches.size(); ++p) {
     Imf::Header h(size, size);
-    h.setTileDescription(Imf::TileDescription(options.tile_size, options.tile_size, Imf::MIPMAP_LEVELS, Imf::ROUND_UP));
+    h.setTileDescription(
+        Imf::TileDescription(options.tile_size, options.tile_size, Imf::MIPMAP_LEVELS, Imf::ROUND_UP));
     for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(type));
     h.setName("patch" + std::to_string(p));
     h.setType(Imf::TILEDIMAGE);

@@ -37,15 +37,15 @@ struct GeometryImageFileInfo {
 };
 
 struct ExrWriteOptions {
-  bool half = false;    ///< channels as half (normal maps) instead of float32 (positions)
-  int tile_size = 64;   ///< square tiles of tile_size² texels
+  bool half = false;   ///< channels as half (normal maps) instead of float32 (positions)
+  int tile_size = 64;  ///< square tiles of tile_size² texels
 };
 
 /// Writes `patches` (all of one level) to `path` as a multipart tiled EXR with one MIP pyramid per patch (see
-/// the file comment). `info.level` is taken from the images. Written to `path + ".tmp-<pid>"` and renamed over
-/// `path`; on failure the temporary file is removed and `path` is untouched.
-/// \throw InvalidInput when `patches` is empty, the images' levels differ or their sizes are wrong.
-/// \throw IoError when the file cannot be written (OpenEXR's message included).
+/// the file comment). `info.level` is taken from the images. Written to `path + ".tmp-<pid>"` and renamed
+/// over `path`; on failure the temporary file is removed and `path` is untouched. \throw InvalidInput when
+/// `patches` is empty, the images' levels differ or their sizes are wrong. \throw IoError when the file
+/// cannot be written (OpenEXR's message included).
 void write_geometry_image_exr(const std::string& path, const std::vector<GeometryImage>& patches,
                               const GeometryImageFileInfo& info, const ExrWriteOptions& options = {});
 

@@ -51,7 +51,8 @@ int orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Ve
   const double left = (a.x() - c.x()) * (b.y() - c.y());
   const double right = (a.y() - c.y()) * (b.x() - c.x());
   const double det = left - right;
-  const double bound = (3.0 + 16.0 * 1.1102230246251565e-16) * 1.1102230246251565e-16 * (std::abs(left) + std::abs(right));
+  const double bound =
+      (3.0 + 16.0 * 1.1102230246251565e-16) * 1.1102230246251565e-16 * (std::abs(left) + std::abs(right));
   if (det > bound) return 1;
   if (-det > bound) return -1;
   // ax·by − ax·cy − cx·by − ay·bx + ay·cx + cy·bx
@@ -63,7 +64,8 @@ int orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Ve
 // Is `p` inside triangle edge a→b's closed left half-plane, ties broken by the symbolic perturbation
 // p + ε·(sx, sy·η) (ε ≫ η > 0 infinitesimal)? The same perturbation for every triangle at p makes the inside
 // test a partition: each p in the (perturbed-into-the-square) domain is in exactly one triangle.
-inline bool left_of(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p, int sx, int sy) {
+inline bool left_of(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p, int sx,
+                    int sy) {
   const int o = orient2d(a, b, p);
   if (o != 0) return o > 0;
   // cross(b − a, (sx, sy·η)) = (bx−ax)·sy·η − (by−ay)·sx
@@ -74,10 +76,14 @@ inline bool left_of(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Ei
 // Grid index (i, j) of the k-th sample along side s (k = 0 at corner s), on a grid with 2^level intervals.
 inline std::pair<int, int> side_sample(int s, int k, int intervals) {
   switch (s) {
-    case 0: return {k, 0};
-    case 1: return {intervals, k};
-    case 2: return {intervals - k, intervals};
-    default: return {0, intervals - k};
+    case 0:
+      return {k, 0};
+    case 1:
+      return {intervals, k};
+    case 2:
+      return {intervals - k, intervals};
+    default:
+      return {0, intervals - k};
   }
 }
 
@@ -120,8 +126,8 @@ void rasterize(const PatchParameterization& patch, int level, Claim&& claim) {
         const Eigen::Vector2d p(i * h, j * h);
         if (!left_of(a, b, p, sx, sy) || !left_of(b, c, p, sx, sy) || !left_of(c, a, p, sx, sy)) continue;
         const Eigen::Vector2d pa = a - p, pb = b - p, pc = c - p;
-        claim(i, j, static_cast<int>(tri), pb.x() * pc.y() - pb.y() * pc.x(), pc.x() * pa.y() - pc.y() * pa.x(),
-              pa.x() * pb.y() - pa.y() * pb.x());
+        claim(i, j, static_cast<int>(tri), pb.x() * pc.y() - pb.y() * pc.x(),
+              pc.x() * pa.y() - pc.y() * pa.x(), pa.x() * pb.y() - pa.y() * pb.x());
       }
     }
   }
@@ -145,8 +151,10 @@ std::size_t rasterize_patch(const PatchParameterization& patch, const Attribute&
   std::deque<int> queue;
   std::size_t unclaimed = 0;
   for (int k = 0; k < n * n; ++k) {
-    if (claimed[k]) queue.push_back(k);
-    else ++unclaimed;
+    if (claimed[k])
+      queue.push_back(k);
+    else
+      ++unclaimed;
   }
   if (unclaimed == 0) return 0;
   if (queue.empty()) {
@@ -170,12 +178,14 @@ std::size_t rasterize_patch(const PatchParameterization& patch, const Attribute&
 }
 
 // The varying (u,v) coordinate along side s (u on sides 0 and 2, v on sides 1 and 3).
-inline double along_coordinate(const Eigen::Vector2d& uv, int s) { return (s % 2 == 0) ? uv.x() : uv.y(); }
+inline double along_coordinate(const Eigen::Vector2d& uv, int s) {
+  return (s % 2 == 0) ? uv.x() : uv.y();
+}
 
 // Walks side s of `patch` in its varying coordinate and writes its 2^level + 1 samples in place (the
 // interpolation the boundary triangle would give, restricted to its boundary edge; corners exactly).
-void walk_side(const PatchParameterization& patch, const std::vector<int>& local, int s, const Attribute& attribute,
-               bool renormalize, GeometryImage& image, const std::string& where) {
+void walk_side(const PatchParameterization& patch, const std::vector<int>& local, int s,
+               const Attribute& attribute, bool renormalize, GeometryImage& image, const std::string& where) {
   const std::vector<int>& side = patch.sides[s];
   if (side.size() < 2 || side.front() != patch.corners[s] || side.back() != patch.corners[(s + 1) % 4]) {
     throw InvalidInput("resample_geometry: " + where + " does not run from its corner to the next");
@@ -307,35 +317,41 @@ std::vector<Eigen::Vector3d> area_weighted_vertex_normals(const TriMesh& mesh) {
   return normals;
 }
 
-GeometryImages resample_geometry(const ModelParameterization& model, int level, const ResampleOptions& options) {
+GeometryImages resample_geometry(const ModelParameterization& model, int level,
+                                 const ResampleOptions& options) {
   if (level < 0 || level > kMaxGeometryImageLevel) {
     throw InvalidInput("resample_geometry: level " + std::to_string(level) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
   }
   if (model.patches.empty()) throw InvalidInput("resample_geometry: the model has no patches");
-  const int normal_level = options.normal_level < 0 ? std::min(level + 1, kMaxGeometryImageLevel) : options.normal_level;
+  const int normal_level =
+      options.normal_level < 0 ? std::min(level + 1, kMaxGeometryImageLevel) : options.normal_level;
   if (options.normals && (normal_level < level || normal_level > kMaxGeometryImageLevel)) {
     throw InvalidInput("resample_geometry: normal level " + std::to_string(normal_level) + " is outside [" +
                        std::to_string(level) + ", " + std::to_string(kMaxGeometryImageLevel) + "]");
   }
   const std::size_t num_patches = model.patches.size();
   for (std::size_t p = 0; p < num_patches; ++p) {
-    check_patch(model.patches[p], model.mesh.positions.size(), "resample_geometry: patch " + std::to_string(p));
+    check_patch(model.patches[p], model.mesh.positions.size(),
+                "resample_geometry: patch " + std::to_string(p));
   }
   if (!model.adjacency.empty() && model.adjacency.size() != 4 * num_patches) {
     throw InvalidInput("resample_geometry: adjacency must have 4 entries per patch");
   }
   for (std::size_t key = 0; key < model.adjacency.size(); ++key) {
     const SideLink& link = model.adjacency[key];
-    if (link.patch != static_cast<int>(key / 4) || link.side != static_cast<int>(key % 4) || link.other_patch < 0 ||
-        link.other_patch >= static_cast<int>(num_patches) || link.other_side < 0 || link.other_side > 3) {
-      throw InvalidInput("resample_geometry: adjacency entry " + std::to_string(key) + " is out of place or range");
+    if (link.patch != static_cast<int>(key / 4) || link.side != static_cast<int>(key % 4) ||
+        link.other_patch < 0 || link.other_patch >= static_cast<int>(num_patches) || link.other_side < 0 ||
+        link.other_side > 3) {
+      throw InvalidInput("resample_geometry: adjacency entry " + std::to_string(key) +
+                         " is out of place or range");
     }
     const SideLink& back = model.adjacency[4 * link.other_patch + link.other_side];
     std::vector<int> a = model.patches[link.patch].sides[link.side];
     const std::vector<int>& b = model.patches[link.other_patch].sides[link.other_side];
     if (link.reversed) std::reverse(a.begin(), a.end());
-    if (back.other_patch != link.patch || back.other_side != link.side || back.reversed != link.reversed || a != b) {
+    if (back.other_patch != link.patch || back.other_side != link.side || back.reversed != link.reversed ||
+        a != b) {
       throw InvalidInput("resample_geometry: adjacency entry " + std::to_string(key) +
                          " glues sides that are not the same mesh path");
     }

@@ -18,8 +18,8 @@ int find_root(std::vector<int>& parent, int x) {
 
 }  // namespace
 
-UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches, const std::vector<SideLink>& adjacency,
-                                                int level) {
+UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches,
+                                                const std::vector<SideLink>& adjacency, int level) {
   if (level < 0 || level > kMaxGeometryImageLevel) {
     throw InvalidInput("uniform_remesh: level " + std::to_string(level) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
@@ -36,22 +36,33 @@ UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches, const s
   auto side_index = [&](int p, int s, int k) {
     int i, j;
     switch (s) {
-      case 0: i = k, j = 0; break;
-      case 1: i = intervals, j = k; break;
-      case 2: i = intervals - k, j = intervals; break;
-      default: i = 0, j = intervals - k; break;
+      case 0:
+        i = k, j = 0;
+        break;
+      case 1:
+        i = intervals, j = k;
+        break;
+      case 2:
+        i = intervals - k, j = intervals;
+        break;
+      default:
+        i = 0, j = intervals - k;
+        break;
     }
     return static_cast<int>(p * per_patch + static_cast<std::size_t>(j) * n + i);
   };
   for (std::size_t key = 0; key < adjacency.size(); ++key) {
     const SideLink& link = adjacency[key];
-    if (link.patch != static_cast<int>(key / 4) || link.side != static_cast<int>(key % 4) || link.other_patch < 0 ||
-        link.other_patch >= static_cast<int>(num_patches) || link.other_side < 0 || link.other_side > 3) {
-      throw InvalidInput("uniform_remesh: adjacency entry " + std::to_string(key) + " is out of place or range");
+    if (link.patch != static_cast<int>(key / 4) || link.side != static_cast<int>(key % 4) ||
+        link.other_patch < 0 || link.other_patch >= static_cast<int>(num_patches) || link.other_side < 0 ||
+        link.other_side > 3) {
+      throw InvalidInput("uniform_remesh: adjacency entry " + std::to_string(key) +
+                         " is out of place or range");
     }
     for (int k = 0; k <= intervals; ++k) {
       const int a = find_root(parent, side_index(link.patch, link.side, k));
-      const int b = find_root(parent, side_index(link.other_patch, link.other_side, link.reversed ? intervals - k : k));
+      const int b =
+          find_root(parent, side_index(link.other_patch, link.other_side, link.reversed ? intervals - k : k));
       if (a != b) parent[std::max(a, b)] = std::min(a, b);
     }
   }
@@ -97,8 +108,8 @@ UniformRemeshResult uniform_remesh(const GeometryImages& images, int level) {
     }
   }
   if (level < 0 || level > n) {
-    throw InvalidInput("uniform_remesh: level " + std::to_string(level) + " is outside [0, " + std::to_string(n) +
-                       "] (the geometry images' level)");
+    throw InvalidInput("uniform_remesh: level " + std::to_string(level) + " is outside [0, " +
+                       std::to_string(n) + "] (the geometry images' level)");
   }
   UniformRemeshResult result = uniform_remesh_connectivity(images.geometry.size(), images.adjacency, level);
   const int size = (1 << level) + 1;

@@ -1,7 +1,7 @@
-// Uniform consistent remeshing (§4 of ../shared/seed/consistent-mesh-parameterizations.txt, "Uniform remeshing";
-// Gu et al. 2002's geometry image triangulation): the level-K grid of every patch triangulated, (2^K)² quads per
-// patch (genus 0: 2·4^K quads), each split in two along a fixed diagonal rule, seam samples welded by the patch
-// layout (SideLinks), not by position.
+// Uniform consistent remeshing (§4 of ../shared/seed/consistent-mesh-parameterizations.txt, "Uniform
+// remeshing"; Gu et al. 2002's geometry image triangulation): the level-K grid of every patch triangulated,
+// (2^K)² quads per patch (genus 0: 2·4^K quads), each split in two along a fixed diagonal rule, seam samples
+// welded by the patch layout (SideLinks), not by position.
 //
 // The face list and the vertex numbering depend only on K and the layout (number of patches and their
 // adjacency): every model of a consistent set gets the identical face list.
@@ -27,18 +27,18 @@ struct UniformRemeshResult {
 /// `num_patches` patches glued by `adjacency` (adjacency[4·p + s] = side s of patch p; empty = no gluing).
 ///
 /// Quad (i, j) of patch p, corners a = (i, j), b = (i+1, j), c = (i+1, j+1), d = (i, j+1), is split along a–c
-/// when (i + j + p) is even, along b–d otherwise: the 4-8 pattern within a patch; alternating the rule between
-/// patches makes genus-0 level 0 a tetrahedron rather than four triangles on one diagonal. A genus-1
+/// when (i + j + p) is even, along b–d otherwise: the 4-8 pattern within a patch; alternating the rule
+/// between patches makes genus-0 level 0 a tetrahedron rather than four triangles on one diagonal. A genus-1
 /// layout at level 0 has only 4 vertices and repeats edges; use level ≥ 1 there.
 /// Vertices are numbered in order of first appearance over patches, rows j, columns i.
 /// \throw InvalidInput for a level outside [0, kMaxGeometryImageLevel] or an adjacency of the wrong size or
 ///   out of range.
-UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches, const std::vector<SideLink>& adjacency,
-                                                int level);
+UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches,
+                                                const std::vector<SideLink>& adjacency, int level);
 
-/// Uniform remesh of `images` at `level` ≤ the images' level: the connectivity above with the positions of the
-/// nested level-`level` grid samples (every 2^(n−level)-th sample of the level-n images).
-/// \throw InvalidInput when there are no images, they differ in level, `level` is above it or negative, or
+/// Uniform remesh of `images` at `level` ≤ the images' level: the connectivity above with the positions of
+/// the nested level-`level` grid samples (every 2^(n−level)-th sample of the level-n images). \throw
+/// InvalidInput when there are no images, they differ in level, `level` is above it or negative, or
 ///   the adjacency does not fit.
 UniformRemeshResult uniform_remesh(const GeometryImages& images, int level);
 

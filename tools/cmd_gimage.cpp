@@ -1,6 +1,6 @@
-// geomip gimage MESH... [--points CORR.json] --level N -o DIR: consistent parameterization (as `geomip param`),
-// then per model DIR/<stem>.geometry.exr (float32 xyz) and DIR/<stem>.normals.exr (half unit normals), one
-// tiled ROUND_UP MIP pyramid per patch (gimage/exr_io.h).
+// geomip gimage MESH... [--points CORR.json] --level N -o DIR: consistent parameterization (as `geomip
+// param`), then per model DIR/<stem>.geometry.exr (float32 xyz) and DIR/<stem>.normals.exr (half unit
+// normals), one tiled ROUND_UP MIP pyramid per patch (gimage/exr_io.h).
 #include "gimage/exr_io.h"
 #include "gimage/resample.h"
 #include "param/consistent_parameterization.h"
@@ -39,11 +39,13 @@ int run_gimage(const GimageArgs& args) {
     throw InvalidInput("--level " + std::to_string(args.level) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
   }
-  if (args.normal_level >= 0 && (args.normal_level < args.level || args.normal_level > kMaxGeometryImageLevel)) {
+  if (args.normal_level >= 0 &&
+      (args.normal_level < args.level || args.normal_level > kMaxGeometryImageLevel)) {
     throw InvalidInput("--normal-level " + std::to_string(args.normal_level) + " is outside [" +
                        std::to_string(args.level) + ", " + std::to_string(kMaxGeometryImageLevel) + "]");
   }
-  const PreparedModels models = prepare_models(args.meshes, args.points, "geomip gimage", args.quiet || args.json);
+  const PreparedModels models =
+      prepare_models(args.meshes, args.points, "geomip gimage", args.quiet || args.json);
   std::filesystem::create_directories(args.output);
 
   ParameterizationOptions options;
@@ -86,11 +88,12 @@ int run_gimage(const GimageArgs& args) {
                          {"resample_seconds", resample_seconds},
                          {"write_seconds", write_seconds}});
     } else if (!args.quiet) {
-      std::printf("gimage %s → %s.geometry.exr (%zu patches, %d², %.1f KiB), %s.normals.exr (%d², %.1f KiB); "
-                  "resampled in %.3f s\n",
-                  models.paths[i].c_str(), stem.c_str(), images.geometry.size(), images.geometry.front().size(),
-                  geometry_bytes / 1024.0, stem.c_str(), images.normals.front().size(), normals_bytes / 1024.0,
-                  resample_seconds);
+      std::printf(
+          "gimage %s → %s.geometry.exr (%zu patches, %d², %.1f KiB), %s.normals.exr (%d², %.1f KiB); "
+          "resampled in %.3f s\n",
+          models.paths[i].c_str(), stem.c_str(), images.geometry.size(), images.geometry.front().size(),
+          geometry_bytes / 1024.0, stem.c_str(), images.normals.front().size(), normals_bytes / 1024.0,
+          resample_seconds);
     }
   }
   if (args.json) {
@@ -108,13 +111,15 @@ CommandRunner add_gimage_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "gimage",
       "Geometry images (paper §4, Gu et al. 2002): parameterize as `geomip param`, resample each patch on a "
-      "(2^N+1)² grid and write DIR/<stem>.geometry.exr (float32 xyz) and DIR/<stem>.normals.exr (half normals), "
+      "(2^N+1)² grid and write DIR/<stem>.geometry.exr (float32 xyz) and DIR/<stem>.normals.exr (half "
+      "normals), "
       "one tiled MIP pyramid per patch whose level l is the nested (2^(N-l)+1)² grid.");
   cmd->add_option("mesh", args->meshes, "One mesh (partition points chosen automatically)");
   cmd->add_option("--points", args->points,
                   "Correspondence file naming the meshes, their partition/auxiliary points and features");
   cmd->add_option("--level", args->level, "Grid level N in [0, 10]: (2^N+1)² samples per patch")->required();
-  cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
+  cmd->add_option("--normal-level", args->normal_level,
+                  "Normal map level in [N, 10] (default N+1, at most 10)");
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
   cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar, no report");

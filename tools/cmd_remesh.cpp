@@ -1,6 +1,7 @@
 // geomip remesh MESH... [--points CORR.json] --level K -o DIR [--ply]: consistent parameterization (as
-// `geomip param`), then the uniform level-K remesh of every model, DIR/<stem>.M<K>.obj (and .ply): watertight,
-// consistently oriented, one face list for all models of a consistent set (gimage/uniform_remesh.h).
+// `geomip param`), then the uniform level-K remesh of every model, DIR/<stem>.M<K>.obj (and .ply):
+// watertight, consistently oriented, one face list for all models of a consistent set
+// (gimage/uniform_remesh.h).
 #include "gimage/resample.h"
 #include "gimage/uniform_remesh.h"
 #include "param/consistent_parameterization.h"
@@ -37,7 +38,8 @@ int run_remesh(const RemeshArgs& args) {
     throw InvalidInput("--level " + std::to_string(args.level) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
   }
-  const PreparedModels models = prepare_models(args.meshes, args.points, "geomip remesh", args.quiet || args.json);
+  const PreparedModels models =
+      prepare_models(args.meshes, args.points, "geomip remesh", args.quiet || args.json);
   std::filesystem::create_directories(args.output);
 
   ParameterizationOptions options;
@@ -54,13 +56,17 @@ int run_remesh(const RemeshArgs& args) {
     t0 = std::chrono::steady_clock::now();
     ResampleOptions resample;
     resample.normals = false;
-    const UniformRemeshResult remesh = uniform_remesh(resample_geometry(result[i], args.level, resample), args.level);
-    const double remesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const UniformRemeshResult remesh =
+        uniform_remesh(resample_geometry(result[i], args.level, resample), args.level);
+    const double remesh_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string stem = (std::filesystem::path(args.output) / models.inputs[i].name).string() + ".M" +
                              std::to_string(args.level);
-    write_file_atomically(stem + ".obj", [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kObj); });
+    write_file_atomically(stem + ".obj",
+                          [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kObj); });
     if (args.ply) {
-      write_file_atomically(stem + ".ply", [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kPly); });
+      write_file_atomically(stem + ".ply",
+                            [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kPly); });
     }
     if (args.json) {
       nlohmann::json j{{"mesh", models.paths[i]},
@@ -73,8 +79,8 @@ int run_remesh(const RemeshArgs& args) {
       summary.push_back(j);
     } else if (!args.quiet) {
       std::printf("remesh %s → %s.obj: %zu vertices, %zu faces (resampled and remeshed in %.3f s)\n",
-                  models.paths[i].c_str(), stem.c_str(), remesh.mesh.positions.size(), remesh.mesh.triangles.size(),
-                  remesh_seconds);
+                  models.paths[i].c_str(), stem.c_str(), remesh.mesh.positions.size(),
+                  remesh.mesh.triangles.size(), remesh_seconds);
     }
   }
   if (args.json) {
@@ -92,7 +98,8 @@ CommandRunner add_remesh_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "remesh",
       "Uniform consistent remeshing (paper §4): parameterize as `geomip param`, resample every patch on its "
-      "level-K grid and triangulate it, seams welded: DIR/<stem>.M<K>.obj, watertight and oriented, with one face "
+      "level-K grid and triangulate it, seams welded: DIR/<stem>.M<K>.obj, watertight and oriented, with one "
+      "face "
       "list for all models of a consistent set.");
   cmd->add_option("mesh", args->meshes, "One mesh (partition points chosen automatically)");
   cmd->add_option("--points", args->points,

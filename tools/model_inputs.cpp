@@ -22,8 +22,8 @@ TriMesh prepare_mesh(const std::string& path, const TriMesh& input, const std::s
   if (!quiet) {
     std::cerr << command << ": " << path << ": " << (r.boundary_loops ? "open" : "non-manifold or degenerate")
               << " mesh repaired first (as `geomip repair`): " << repaired.filled_holes << " holes filled, "
-              << repaired.split_non_manifold_vertices << " vertices split, " << repaired.removed_degenerate_faces
-              << " degenerate faces removed\n";
+              << repaired.split_non_manifold_vertices << " vertices split, "
+              << repaired.removed_degenerate_faces << " degenerate faces removed\n";
   }
   return repaired.mesh;
 }
@@ -35,8 +35,8 @@ int resolve_point(const PointSpec& p, const TriMesh& input, const TriMesh& mesh,
   Eigen::Vector3d target = p.position;
   if (p.index >= 0) {
     if (p.index >= static_cast<long long>(input.positions.size())) {
-      throw InvalidInput(file + ": " + what + " is vertex " + std::to_string(p.index) + ", but the mesh has " +
-                         std::to_string(input.positions.size()) + " vertices");
+      throw InvalidInput(file + ": " + what + " is vertex " + std::to_string(p.index) +
+                         ", but the mesh has " + std::to_string(input.positions.size()) + " vertices");
     }
     if (&input == &mesh) return static_cast<int>(p.index);
     target = input.positions[p.index];
@@ -56,8 +56,8 @@ int resolve_point(const PointSpec& p, const TriMesh& input, const TriMesh& mesh,
   return best;
 }
 
-std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMesh& input, const TriMesh& mesh,
-                                const std::string& what, const std::string& file) {
+std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMesh& input,
+                                const TriMesh& mesh, const std::string& what, const std::string& file) {
   std::vector<int> ids;
   for (std::size_t i = 0; i < specs.size(); ++i) {
     ids.push_back(resolve_point(specs[i], input, mesh, what + "[" + std::to_string(i) + "]", file));
@@ -93,7 +93,8 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
     in.mesh = prepare_mesh(spec.mesh, input, command, quiet);
     in.name = std::filesystem::path(spec.mesh).stem().string();
     // Point indices refer to the file as written; after a repair they are matched by position.
-    const bool repaired = in.mesh.positions.size() != input.positions.size() || in.mesh.triangles != input.triangles;
+    const bool repaired =
+        in.mesh.positions.size() != input.positions.size() || in.mesh.triangles != input.triangles;
     const TriMesh& source = repaired ? input : in.mesh;
     const std::string where = points_file.empty() ? spec.mesh : points_file;
     if (spec.partition_points.empty()) {

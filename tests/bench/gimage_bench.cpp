@@ -20,7 +20,9 @@
 namespace geomip {
 namespace {
 
-std::string shared(const std::string& name) { return std::string(GEOMIP_SHARED_MESHES) + "/" + name; }
+std::string shared(const std::string& name) {
+  return std::string(GEOMIP_SHARED_MESHES) + "/" + name;
+}
 
 // The repaired bunny's parameterization (automatic points, MVC baseline off), computed once.
 const ModelParameterization* bunny() {
@@ -85,7 +87,8 @@ void BM_WriteExr(benchmark::State& state) {
   }
   const int level = static_cast<int>(state.range(0));
   const GeometryImages images = resample_geometry(*model, level);
-  const std::string stem = (std::filesystem::temp_directory_path() / ("gimage_bench_" + std::to_string(::getpid()))).string();
+  const std::string stem =
+      (std::filesystem::temp_directory_path() / ("gimage_bench_" + std::to_string(::getpid()))).string();
   GeometryImageFileInfo info;
   info.source_mesh = "bunny.obj";
   info.adjacency = images.adjacency;

@@ -69,7 +69,8 @@ TEST_F(Exr, FloatRoundTripWithNestedMipLevels) {
         for (int y = 0; y < expected; ++y) {
           for (int x = 0; x < expected; ++x) {
             for (int c = 0; c < 3; ++c) {
-              ASSERT_EQ(mip.rgb[3 * (y * expected + x) + c], nested.at(x, y)[c]) << "mip " << l << " " << x << "," << y;
+              ASSERT_EQ(mip.rgb[3 * (y * expected + x) + c], nested.at(x, y)[c])
+                  << "mip " << l << " " << x << "," << y;
               // the nested grid is every 2^l-th sample of the original
               ASSERT_EQ(mip.rgb[3 * (y * expected + x) + c], patches[p].at(x << l, y << l)[c]);
             }

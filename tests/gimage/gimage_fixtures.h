@@ -43,7 +43,8 @@ inline const std::vector<ModelParameterization>& deformed_sphere_pair() {
   if (!pair.empty()) return pair;
   const TriMesh a = sphere(3);
   TriMesh b = a;
-  for (auto& p : b.positions) p = Eigen::Vector3d(1.6 * p.x() + 0.2 * p.y() * p.y(), p.y(), 0.7 * p.z() + 0.3 * p.x() * p.y());
+  for (auto& p : b.positions)
+    p = Eigen::Vector3d(1.6 * p.x() + 0.2 * p.y() * p.y(), p.y(), 0.7 * p.z() + 0.3 * p.x() * p.y());
   std::vector<ParameterizationInput> models(2);
   models[0].mesh = a;
   models[1].mesh = b;
@@ -58,6 +59,8 @@ inline const std::vector<ModelParameterization>& deformed_sphere_pair() {
 }
 
 /// Bitwise equality of two float triples.
-inline bool same_bits(const float* a, const float* b) { return std::memcmp(a, b, 3 * sizeof(float)) == 0; }
+inline bool same_bits(const float* a, const float* b) {
+  return std::memcmp(a, b, 3 * sizeof(float)) == 0;
+}
 
 }  // namespace geomip::test

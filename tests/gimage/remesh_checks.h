@@ -18,8 +18,10 @@ inline double signed_volume(const TriMesh& m) {
   return v / 6.0;
 }
 
-/// `outward`: also require a positive signed volume (not for M0 of a sphere, whose 4 corners may be coplanar).
-inline void expect_watertight_oriented(const TriMesh& mesh, int genus, const std::string& what, bool outward = true) {
+/// `outward`: also require a positive signed volume (not for M0 of a sphere, whose 4 corners may be
+/// coplanar).
+inline void expect_watertight_oriented(const TriMesh& mesh, int genus, const std::string& what,
+                                       bool outward = true) {
   SCOPED_TRACE(what);
   std::map<std::pair<int, int>, int> directed;
   for (const auto& t : mesh.triangles) {

@@ -14,8 +14,8 @@ namespace {
 
 // One disk patch over the unit square: the flat grid test::grid(cells), (u,v) = (x,y), interior vertices
 // jittered in both (u,v) and 3D (so the surface stays the plane), positions mapped by `affine`.
-ModelParameterization planar_patch(int cells, const Eigen::Matrix<double, 3, 2>& linear, const Eigen::Vector3d& offset,
-                                   double jitter) {
+ModelParameterization planar_patch(int cells, const Eigen::Matrix<double, 3, 2>& linear,
+                                   const Eigen::Vector3d& offset, double jitter) {
   ModelParameterization m;
   TriMesh grid = test::grid(cells);
   std::mt19937 rng(7);
@@ -55,7 +55,8 @@ TEST(Resample, AxisAlignedPlanarPatchReproducesItselfExactly) {
       const int n = img.size();
       for (int j = 0; j < n; ++j) {
         for (int i = 0; i < n; ++i) {
-          const float expected[3] = {static_cast<float>(std::ldexp(i, -level)), static_cast<float>(std::ldexp(j, -level)), 0.0f};
+          const float expected[3] = {static_cast<float>(std::ldexp(i, -level)),
+                                     static_cast<float>(std::ldexp(j, -level)), 0.0f};
           ASSERT_TRUE(test::same_bits(img.at(i, j), expected))
               << "level " << level << " jitter " << jitter << " sample " << i << "," << j << ": "
               << img.sample(i, j).transpose();
@@ -80,8 +81,10 @@ TEST(Resample, TiltedPlanarPatchReproducesThePlane) {
     const GeometryImage& img = g.geometry[0];
     for (int j = 0; j < img.size(); ++j) {
       for (int i = 0; i < img.size(); ++i) {
-        const Eigen::Vector3d expected = linear * Eigen::Vector2d(std::ldexp(i, -level), std::ldexp(j, -level)) + offset;
-        ASSERT_LE((img.sample(i, j).cast<double>() - expected).norm(), 4e-6 * expected.norm()) << i << "," << j;
+        const Eigen::Vector3d expected =
+            linear * Eigen::Vector2d(std::ldexp(i, -level), std::ldexp(j, -level)) + offset;
+        ASSERT_LE((img.sample(i, j).cast<double>() - expected).norm(), 4e-6 * expected.norm())
+            << i << "," << j;
       }
     }
     const Eigen::Vector3d normal = linear.col(0).cross(linear.col(1)).normalized();
@@ -93,21 +96,24 @@ TEST(Resample, TiltedPlanarPatchReproducesThePlane) {
   }
 }
 
-// Samples on grid vertices and edges (grid(8) at level ≥ 3) and on the square's boundary are each claimed once.
+// Samples on grid vertices and edges (grid(8) at level ≥ 3) and on the square's boundary are each claimed
+// once.
 TEST(Resample, EverySampleIsClaimedExactlyOnce) {
   Eigen::Matrix<double, 3, 2> identity = Eigen::Matrix<double, 3, 2>::Zero();
   identity(0, 0) = identity(1, 1) = 1;
   const ModelParameterization flat = planar_patch(8, identity, Eigen::Vector3d::Zero(), 0.0);
   for (int level = 0; level <= 6; ++level) {
     const GridLocation loc = locate_grid_samples(flat.patches[0], level);
-    EXPECT_TRUE(std::all_of(loc.claims.begin(), loc.claims.end(), [](std::uint8_t c) { return c == 1; })) << level;
+    EXPECT_TRUE(std::all_of(loc.claims.begin(), loc.claims.end(), [](std::uint8_t c) { return c == 1; }))
+        << level;
   }
   for (const char* which : {"sphere", "torus"}) {
     const ModelParameterization& m = test::parameterized(which);
     for (const auto& patch : m.patches) {
       for (int level : {0, 1, 4, 7}) {
         const GridLocation loc = locate_grid_samples(patch, level);
-        const auto bad = std::count_if(loc.claims.begin(), loc.claims.end(), [](std::uint8_t c) { return c != 1; });
+        const auto bad =
+            std::count_if(loc.claims.begin(), loc.claims.end(), [](std::uint8_t c) { return c != 1; });
         EXPECT_EQ(bad, 0) << which << " level " << level;
       }
     }
@@ -124,14 +130,19 @@ void expect_seams_bit_identical(const ModelParameterization& m, const GeometryIm
       const int last = a.size() - 1;
       auto at = [last](const GeometryImage& img, int side, int k) {
         switch (side) {
-          case 0: return img.at(k, 0);
-          case 1: return img.at(last, k);
-          case 2: return img.at(last - k, last);
-          default: return img.at(0, last - k);
+          case 0:
+            return img.at(k, 0);
+          case 1:
+            return img.at(last, k);
+          case 2:
+            return img.at(last - k, last);
+          default:
+            return img.at(0, last - k);
         }
       };
       for (int k = 0; k <= last; ++k) {
-        ASSERT_TRUE(test::same_bits(at(a, link.side, k), at(b, link.other_side, link.reversed ? last - k : k)))
+        ASSERT_TRUE(
+            test::same_bits(at(a, link.side, k), at(b, link.other_side, link.reversed ? last - k : k)))
             << "patch " << link.patch << " side " << link.side << " sample " << k;
       }
     }
@@ -141,7 +152,8 @@ void expect_seams_bit_identical(const ModelParameterization& m, const GeometryIm
     const int ij[4][2] = {{0, 0}, {last, 0}, {last, last}, {0, last}};
     for (int c = 0; c < 4; ++c) {
       const Eigen::Vector3f exact = m.mesh.positions[m.patches[p].corners[c]].cast<float>();
-      EXPECT_TRUE(test::same_bits(g.geometry[p].at(ij[c][0], ij[c][1]), exact.data())) << "patch " << p << " corner " << c;
+      EXPECT_TRUE(test::same_bits(g.geometry[p].at(ij[c][0], ij[c][1]), exact.data()))
+          << "patch " << p << " corner " << c;
     }
   }
 }

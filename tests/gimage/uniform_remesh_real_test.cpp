@@ -18,7 +18,8 @@ TEST_P(RealRemesh, WatertightOrientedAtLevels1To6) {
   TriMesh mesh = read_mesh(path);
   const TopologyReport r = analyze_topology(mesh);
   if (r.boundary_loops > 0 || !r.manifold) mesh = repair_mesh(mesh).mesh;
-  const auto model = parameterize_consistently({test::automatic_input(mesh, GetParam())}, test::quick_options())[0];
+  const auto model =
+      parameterize_consistently({test::automatic_input(mesh, GetParam())}, test::quick_options())[0];
   const GeometryImages g = resample_geometry(model, 6);
   EXPECT_EQ(g.uncovered_samples, 0u);
   for (int level = 1; level <= 6; ++level) {
@@ -30,10 +31,11 @@ TEST_P(RealRemesh, WatertightOrientedAtLevels1To6) {
   EXPECT_NEAR(test::signed_volume(uniform_remesh(g, 6).mesh) / test::signed_volume(mesh), 1.0, 0.05);
 }
 
-INSTANTIATE_TEST_SUITE_P(Shared, RealRemesh, ::testing::Values("spot.obj", "bunny.obj"),
-                         [](const ::testing::TestParamInfo<const char*>& param_info) {
-                           return std::string(param_info.param).substr(0, std::string(param_info.param).find('.'));
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Shared, RealRemesh, ::testing::Values("spot.obj", "bunny.obj"),
+    [](const ::testing::TestParamInfo<const char*>& param_info) {
+      return std::string(param_info.param).substr(0, std::string(param_info.param).find('.'));
+    });
 
 }  // namespace
 }  // namespace geomip

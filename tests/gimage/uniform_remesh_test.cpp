@@ -43,7 +43,8 @@ TEST(UniformRemesh, PositionsAreTheNestedSamples) {
   for (std::size_t p = 0; p < 2; ++p) {
     for (int j = 0; j <= 8; ++j) {
       for (int i = 0; i <= 8; ++i) {
-        EXPECT_EQ(r.mesh.positions[r.grid_vertex[p][j * 9 + i]], g.geometry[p].sample(4 * i, 4 * j).cast<double>());
+        EXPECT_EQ(r.mesh.positions[r.grid_vertex[p][j * 9 + i]],
+                  g.geometry[p].sample(4 * i, 4 * j).cast<double>());
       }
     }
   }

@@ -120,44 +120,6 @@ TEST(Resample, EverySampleIsClaimedExactlyOnce) {
   }
 }
 
-// Shared sides and corners: bit-identical floats in every patch that holds them, in geometry and normals; and
-// the copied side is the right one (close to what its own patch's triangles give).
-void expect_seams_bit_identical(const ModelParameterization& m, const GeometryImages& g) {
-  for (const auto* images : {&g.geometry, &g.normals}) {
-    for (const SideLink& link : g.adjacency) {
-      const GeometryImage& a = (*images)[link.patch];
-      const GeometryImage& b = (*images)[link.other_patch];
-      const int last = a.size() - 1;
-      auto at = [last](const GeometryImage& img, int side, int k) {
-        switch (side) {
-          case 0:
-            return img.at(k, 0);
-          case 1:
-            return img.at(last, k);
-          case 2:
-            return img.at(last - k, last);
-          default:
-            return img.at(0, last - k);
-        }
-      };
-      for (int k = 0; k <= last; ++k) {
-        ASSERT_TRUE(
-            test::same_bits(at(a, link.side, k), at(b, link.other_side, link.reversed ? last - k : k)))
-            << "patch " << link.patch << " side " << link.side << " sample " << k;
-      }
-    }
-  }
-  for (std::size_t p = 0; p < m.patches.size(); ++p) {
-    const int last = g.geometry[p].size() - 1;
-    const int ij[4][2] = {{0, 0}, {last, 0}, {last, last}, {0, last}};
-    for (int c = 0; c < 4; ++c) {
-      const Eigen::Vector3f exact = m.mesh.positions[m.patches[p].corners[c]].cast<float>();
-      EXPECT_TRUE(test::same_bits(g.geometry[p].at(ij[c][0], ij[c][1]), exact.data()))
-          << "patch " << p << " corner " << c;
-    }
-  }
-}
-
 TEST(Resample, SeamsAndCornersAreBitIdentical) {
   for (const char* which : {"sphere", "torus"}) {
     SCOPED_TRACE(which);
@@ -167,7 +129,7 @@ TEST(Resample, SeamsAndCornersAreBitIdentical) {
     for (int level : {0, 1, 3, 6}) {
       const GeometryImages g = resample_geometry(m, level);
       EXPECT_EQ(g.uncovered_samples, 0u);
-      expect_seams_bit_identical(m, g);
+      test::expect_seams_bit_identical(m, g);
       // Without the links every side is computed from its own patch: the copies must agree to rounding.
       const GeometryImages own = resample_geometry(unlinked, level, {false, -1});
       for (std::size_t p = 0; p < m.patches.size(); ++p) {

@@ -1,4 +1,5 @@
-// Uniform remeshes of real meshes (../shared/meshes): watertight, oriented, genus 0, outward, at M1..M6.
+// Real meshes (../shared/meshes): point location exactly once, bit-identical seams, and uniform remeshes that
+// are watertight, oriented, outward and of the input's genus at M1..M6.
 #include "gimage/uniform_remesh.h"
 #include "param/mesh_io.h"
 #include "param/mesh_repair.h"
@@ -7,6 +8,8 @@
 #include "tests/gimage/remesh_checks.h"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 namespace geomip {
 namespace {
@@ -20,19 +23,28 @@ TEST_P(RealRemesh, WatertightOrientedAtLevels1To6) {
   if (r.boundary_loops > 0 || !r.manifold) mesh = repair_mesh(mesh).mesh;
   const auto model =
       parameterize_consistently({test::automatic_input(mesh, GetParam())}, test::quick_options())[0];
+  const int genus = r.genus.value_or(-1);
+  // Point location at M8: every sample of every patch claimed by exactly one (u,v) triangle.
+  for (const auto& patch : model.patches) {
+    const GridLocation loc = locate_grid_samples(patch, 8);
+    EXPECT_EQ(std::count(loc.claims.begin(), loc.claims.end(), std::uint8_t{1}),
+              static_cast<std::ptrdiff_t>(loc.claims.size()));
+  }
   const GeometryImages g = resample_geometry(model, 6);
   EXPECT_EQ(g.uncovered_samples, 0u);
+  test::expect_seams_bit_identical(model, g);
   for (int level = 1; level <= 6; ++level) {
     const UniformRemeshResult remesh = uniform_remesh(g, level);
-    EXPECT_EQ(remesh.mesh.triangles.size(), 4u << (2 * level));
-    test::expect_watertight_oriented(remesh.mesh, 0, std::string(GetParam()) + " M" + std::to_string(level));
+    EXPECT_EQ(remesh.mesh.triangles.size(), 2 * model.patches.size() << (2 * level));
+    test::expect_watertight_oriented(remesh.mesh, genus,
+                                     std::string(GetParam()) + " M" + std::to_string(level));
   }
   // M6 keeps the volume of the original within a few percent.
   EXPECT_NEAR(test::signed_volume(uniform_remesh(g, 6).mesh) / test::signed_volume(mesh), 1.0, 0.05);
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    Shared, RealRemesh, ::testing::Values("spot.obj", "bunny.obj"),
+    Shared, RealRemesh, ::testing::Values("spot.obj", "bunny.obj", "bob.obj"),
     [](const ::testing::TestParamInfo<const char*>& param_info) {
       return std::string(param_info.param).substr(0, std::string(param_info.param).find('.'));
     });

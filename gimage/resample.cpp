@@ -362,7 +362,8 @@ GeometryImages resample_geometry(const ModelParameterization& model, int level,
   result.geometry = resample_attribute(model, model.mesh.positions, level, false, result.uncovered_samples);
   if (options.normals) {
     const Attribute normals = area_weighted_vertex_normals(model.mesh);
-    result.normals = resample_attribute(model, normals, normal_level, true, result.uncovered_samples);
+    std::size_t uncovered_normals = 0;  // the same triangles, a finer grid: not counted again
+    result.normals = resample_attribute(model, normals, normal_level, true, uncovered_normals);
   }
   return result;
 }

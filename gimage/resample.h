@@ -56,9 +56,9 @@ struct GeometryImages {
   std::vector<GeometryImage> normals;   ///< per patch, unit normals (empty when not asked for)
   std::vector<SideLink>
       adjacency;  ///< copied from the parameterization: adjacency[4·p + s] is side s of patch p
-  /// Samples no triangle claimed (only possible when the parameterization has flipped or degenerate (u,v)
-  /// triangles, i.e. PatchParameterization::flipped > 0): they take the value at the nearest point of the
-  /// nearest triangle in (u,v). 0 for every valid parameterization.
+  /// Geometry samples no triangle claimed (only possible when the parameterization has flipped or degenerate
+  /// (u,v) triangles, i.e. PatchParameterization::flipped > 0): they, and such normal-map texels, take the
+  /// value of the nearest claimed sample on the grid (breadth-first). 0 for every valid parameterization.
   std::size_t uncovered_samples = 0;
 };
 

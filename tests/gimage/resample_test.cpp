@@ -169,6 +169,37 @@ TEST(Resample, SphereSamplesAndNormalsLieOnTheSphere) {
   }
 }
 
+// A hole in the (u,v) tiling (a missing triangle, as a flipped one would leave) is reported and filled from
+// the nearest claimed samples.
+TEST(Resample, UnclaimedSamplesAreCountedAndFilled) {
+  Eigen::Matrix<double, 3, 2> identity = Eigen::Matrix<double, 3, 2>::Zero();
+  identity(0, 0) = identity(1, 1) = 1;
+  ModelParameterization m = planar_patch(4, identity, Eigen::Vector3d::Zero(), 0.0);
+  const auto removed = m.patches[0].triangles[10];
+  m.patches[0].triangles.erase(m.patches[0].triangles.begin() + 10);
+  const GeometryImages g = resample_geometry(m, 6);
+  const GridLocation loc = locate_grid_samples(m.patches[0], 6);
+  const auto unclaimed = std::count(loc.claims.begin(), loc.claims.end(), std::uint8_t{0});
+  EXPECT_GT(unclaimed, 0);
+  EXPECT_EQ(g.uncovered_samples, static_cast<std::size_t>(unclaimed));
+  // Filled values stay near the hole: within the removed triangle's bounding box grown by one sample.
+  Eigen::Vector2d lo(1, 1), hi(0, 0);
+  for (int c : removed) {
+    lo = lo.cwiseMin(m.patches[0].uv[c]);
+    hi = hi.cwiseMax(m.patches[0].uv[c]);
+  }
+  const GeometryImage& img = g.geometry[0];
+  for (int j = 0; j < img.size(); ++j) {
+    for (int i = 0; i < img.size(); ++i) {
+      if (loc.claims[j * img.size() + i] != 0) continue;
+      const Eigen::Vector3f x = img.sample(i, j);
+      EXPECT_TRUE(x.x() >= lo.x() - 1.0 / 64 && x.x() <= hi.x() + 1.0 / 64 && x.y() >= lo.y() - 1.0 / 64 &&
+                  x.y() <= hi.y() + 1.0 / 64)
+          << i << "," << j << ": " << x.transpose();
+    }
+  }
+}
+
 TEST(Resample, RejectsBadInput) {
   const ModelParameterization& m = test::parameterized("sphere");
   EXPECT_THROW(resample_geometry(m, -1), InvalidInput);

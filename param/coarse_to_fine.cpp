@@ -1,5 +1,6 @@
 #include "param/coarse_to_fine.h"
 
+
 #include "param/errors.h"
 #include "param/mean_value_embedding.h"
 
@@ -145,7 +146,7 @@ double CoarseToFine::side_arclength(int side, int v) const {
   throw SolverFailure("CoarseToFine: boundary split between vertices of different sides");
 }
 
-void CoarseToFine::insert_interior(int v, int kept) {
+bool CoarseToFine::move_to_kernel_centroid(int v, const Eigen::Vector2d& anchor) {
   // Kernel of the neighbourhood polygon: the unit square clipped to the left of every edge (x, y) opposite v.
   std::vector<Eigen::Vector2d> kernel = {kSquareCorner[0], kSquareCorner[1], kSquareCorner[2],
                                          kSquareCorner[3]};
@@ -162,21 +163,63 @@ void CoarseToFine::insert_interior(int v, int kept) {
     }
     return true;
   };
-  if (!kernel.empty()) {
-    const Eigen::Vector2d centroid = polygon_centroid(kernel);
-    // In exact arithmetic the centroid is inside the (open, convex) kernel and so is the whole segment from
-    // it to v1, which lies on the kernel's closure; rounding can spoil the first, so walk towards v1.
-    Eigen::Vector2d p = centroid;
-    for (int attempt = 0; attempt < 60; ++attempt) {
-      if (all_positive(p)) {
-        uv_[v] = p;
-        return;
+  if (kernel.empty()) return false;
+  // In exact arithmetic the centroid is inside the (open, convex) kernel and so is the whole segment from it
+  // to the anchor, which lies on the kernel's closure; rounding can spoil the first, so walk towards it.
+  Eigen::Vector2d p = polygon_centroid(kernel);
+  for (int attempt = 0; attempt < 60; ++attempt) {
+    if (all_positive(p)) {
+      uv_[v] = p;
+      return true;
+    }
+    p = 0.5 * (p + anchor);
+  }
+  return false;
+}
+
+void CoarseToFine::insert_interior(int v, int kept) {
+  if (!move_to_kernel_centroid(v, uv_[kept])) {
+    throw SolverFailure("CoarseToFine: empty kernel when re-inserting vertex " + std::to_string(v) +
+                        " (the level before was not an embedding)");
+  }
+}
+
+bool CoarseToFine::settle_on_chord(int v, int rounds) {
+  // Each round moves v as far towards its chord-length position as its ring allows (place_on_side), then
+  // relaxes the free interior vertices of its 2-ring to the centroids of their kernels, which moves them away
+  // from the crowded stretch of the side and widens the admissible interval.
+  std::vector<int> region;
+  for (int round = 0; round < rounds; ++round) {
+    if (place_on_side(v)) return true;
+    region.clear();
+    for (int id : star_[v]) {
+      for (int w : triangles_[id]) {
+        if (std::find(region.begin(), region.end(), w) == region.end()) region.push_back(w);
       }
-      p = 0.5 * (p + uv_[kept]);
+    }
+    const std::size_t one_ring = region.size();
+    for (std::size_t i = 0; i < one_ring; ++i) {
+      for (int id : star_[region[i]]) {
+        for (int w : triangles_[id]) {
+          if (std::find(region.begin(), region.end(), w) == region.end()) region.push_back(w);
+        }
+      }
+    }
+    for (int w : region) {
+      if (fixed_[w] || side_of_[w] >= 0 || w == v) continue;
+      move_to_kernel_centroid(w, uv_[w]);
     }
   }
-  throw SolverFailure("CoarseToFine: empty kernel when re-inserting vertex " + std::to_string(v) +
-                      " (the level before was not an embedding)");
+  return place_on_side(v);
+}
+
+void CoarseToFine::settle_off_chord() {
+  for (int v = 0; v < static_cast<int>(off_chord_.size()); ++v) {
+    if (off_chord_[v] && settle_on_chord(v, kSettleRounds)) {
+      off_chord_[v] = 0;
+      --num_off_chord_;
+    }
+  }
 }
 
 bool CoarseToFine::place_on_side(int v) {
@@ -229,7 +272,7 @@ void CoarseToFine::insert_boundary(const HalfEdgeCollapse& c) {
     throw SolverFailure("CoarseToFine: boundary vertex " + std::to_string(v) +
                         " is not between its neighbours");
   }
-  if (!place_on_side(v)) {
+  if (!settle_on_chord(v, kInsertSettleRounds)) {
     if (!uv_[v].allFinite()) {
       throw SolverFailure("CoarseToFine: no place on its side for boundary vertex " + std::to_string(v));
     }
@@ -315,6 +358,7 @@ int CoarseToFine::split_next(const VertexOptimizer& optimize) {
   ++done_;
   if (finished() && num_off_chord_ != 0) {
     for (int w = 0; w < static_cast<int>(off_chord_.size()); ++w) retry_off_chord(w);
+    settle_off_chord();
   }
   return c.removed;
 }

@@ -97,6 +97,17 @@ class CoarseToFine {
 
  private:
   void insert_interior(int v, int kept);
+  /// Moves free vertex v to the area centroid of the kernel of its star (walking towards `anchor` if rounding
+  /// puts the centroid outside); false, and v unmoved, when the kernel is empty.
+  bool move_to_kernel_centroid(int v, const Eigen::Vector2d& anchor);
+  /// After the last split: brings boundary vertices still off their chord-length position there, relaxing
+  /// the interior vertices around them to make room (seams of adjacent patches must agree).
+  void settle_off_chord();
+  /// Puts boundary vertex v at its chord-length position, relaxing the free vertices of its 2-ring up to
+  /// `rounds` times to make room; false when it is still off (v is then at the admissible point nearest).
+  bool settle_on_chord(int v, int rounds);
+  static constexpr int kSettleRounds = 200;
+  static constexpr int kInsertSettleRounds = 8;
   void insert_boundary(const HalfEdgeCollapse& c);
   bool place_on_side(int v);
   void retry_off_chord(int v);

@@ -126,6 +126,75 @@ void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine&
   }
 }
 
+// Position along side k of the unit square, from corner k (0) to corner k+1 (1), and back.
+double along_side(const Eigen::Vector2d& uv, int side) {
+  switch (side) {
+    case 0: return uv.x();
+    case 1: return uv.y();
+    case 2: return 1.0 - uv.x();
+    default: return 1.0 - uv.y();
+  }
+}
+Eigen::Vector2d on_side(double s, int side) {
+  switch (side) {
+    case 0: return {s, 0.0};
+    case 1: return {1.0, s};
+    case 2: return {1.0 - s, 1.0};
+    default: return {0.0, 1.0 - s};
+  }
+}
+
+// Seam vertices sit at their chord-length position in both patches, so the two positions agree; where
+// coarse-to-fine could not put one there (a boundary vertex boxed in by long triangles), this moves the
+// vertex in the other patch to the same position if that flips nothing there, and copies the value bit for
+// bit. Returns the vertices whose positions still differ.
+std::size_t reconcile_seams(ModelParameterization& m) {
+  std::vector<std::vector<int>> local(m.patches.size(), std::vector<int>(m.mesh.positions.size(), -1));
+  std::vector<std::vector<std::vector<int>>> star(m.patches.size());
+  for (std::size_t p = 0; p < m.patches.size(); ++p) {
+    const auto& patch = m.patches[p];
+    for (std::size_t i = 0; i < patch.vertices.size(); ++i) local[p][patch.vertices[i]] = static_cast<int>(i);
+    star[p].assign(patch.vertices.size(), {});
+    for (std::size_t t = 0; t < patch.triangles.size(); ++t) {
+      for (int v : patch.triangles[t]) star[p][v].push_back(static_cast<int>(t));
+    }
+  }
+  auto star_valid = [&](std::size_t p, int v) {
+    for (int t : star[p][v]) {
+      const auto& tri = m.patches[p].triangles[t];
+      const auto& uv = m.patches[p].uv;
+      const Eigen::Vector2d a = uv[tri[1]] - uv[tri[0]], b = uv[tri[2]] - uv[tri[0]];
+      if (!(a.x() * b.y() - a.y() * b.x() > 0.0)) return false;
+    }
+    return true;
+  };
+  std::size_t mismatches = 0;
+  for (const SideLink& link : m.adjacency) {
+    if (link.patch > link.other_patch) continue;  // each seam once
+    auto& a = m.patches[link.patch];
+    auto& b = m.patches[link.other_patch];
+    const auto& side = a.sides[link.side];
+    for (std::size_t j = 1; j + 1 < side.size(); ++j) {
+      const int va = local[link.patch][side[j]], vb = local[link.other_patch][side[j]];
+      const double sa = along_side(a.uv[va], link.side);
+      const double sb_as_a = link.reversed ? 1.0 - along_side(b.uv[vb], link.other_side)
+                                           : along_side(b.uv[vb], link.other_side);
+      if (sa == sb_as_a) continue;
+      // Move b's copy to a's position; failing that, a's copy to b's.
+      const Eigen::Vector2d old_b = b.uv[vb];
+      b.uv[vb] = on_side(link.reversed ? 1.0 - sa : sa, link.other_side);
+      if (star_valid(link.other_patch, vb)) continue;
+      b.uv[vb] = old_b;
+      const Eigen::Vector2d old_a = a.uv[va];
+      a.uv[va] = on_side(sb_as_a, link.side);
+      if (star_valid(link.patch, va)) continue;
+      a.uv[va] = old_a;
+      ++mismatches;
+    }
+  }
+  return mismatches;
+}
+
 }  // namespace
 
 std::vector<ModelParameterization> parameterize_consistently(const std::vector<ParameterizationInput>& models,
@@ -332,12 +401,30 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
         throw SolverFailure("parameterize_consistently: patch " + std::to_string(p) + " of model '" +
                             models[i].name + "' has " + std::to_string(pp.flipped) + " flipped triangles");
       }
-      if (options.measure_mvc_baseline) {
+      // The full patch's MVC embedding: the baseline the figures are reported against, and a fallback for a
+      // patch without features where coarse-to-fine ends worse than MVC (it happens on CAD-like patches whose
+      // long thin triangles leave vertices squeezed into tiny kernels).
+      if (options.measure_mvc_baseline || pw.features.empty()) {
         t0 = Clock::now();
-        const auto mvc = mean_value_embedding(pw.local.positions, pw.local.triangles,
-                                              square_boundary_uv(pw.local.positions, pw.pm.sides));
+        auto mvc = mean_value_embedding(pw.local.positions, pw.local.triangles,
+                                        square_boundary_uv(pw.local.positions, pw.pm.sides));
         pp.mvc_stretch = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
         o.seconds.mvc_baseline += seconds_since(t0);
+        if (pw.features.empty() && pp.mvc_stretch.l2 < pp.stretch.l2) {
+          t0 = Clock::now();
+          StretchOptimizationOptions fallback = options.base_optimization;
+          fallback.seed = options.seed + 31u * static_cast<unsigned>(p + 1);
+          optimize_stretch(pw.local.positions, pw.local.triangles, mvc.uv, locked, fallback);
+          const StretchValues s = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
+          if (s.l2 < pp.stretch.l2 && count_flipped(pw.local.triangles, mvc.uv) == 0) {
+            pp.triangles = pw.local.triangles;
+            pp.uv = std::move(mvc.uv);
+            pp.stretch = s;
+            pp.boundary_off_chord = 0;
+            pp.mvc_fallback = true;
+          }
+          o.seconds.final_optimization += seconds_since(t0);
+        }
       }
       for (std::size_t j = 0; j < pw.features.size(); ++j) {
         FeatureLocation& f = o.features[pw.feature_index[j]];
@@ -347,6 +434,7 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
       }
       o.patches.push_back(std::move(pp));
     }
+    o.seam_mismatches = reconcile_seams(o);
   }
   report(options, "done", 1.0);
   return out;

@@ -65,6 +65,9 @@ struct PatchParameterization {
   StretchValues stretch;                      ///< of the final parameterization
   std::size_t flipped = 0;                    ///< triangles with uv area <= 0 in the final result (0)
   std::size_t boundary_off_chord = 0;         ///< boundary vertices not at their chord-length position
+  /// True when coarse-to-fine ended above the MVC embedding's stretch and the stretch-optimized MVC
+  /// embedding was used instead (patches without features only).
+  bool mvc_fallback = false;
 };
 
 /// Where a feature ended.
@@ -88,6 +91,9 @@ struct ModelParameterization {
   std::vector<FeatureLocation> features;
   std::size_t split_vertices = 0;
   std::size_t warp_events = 0;  ///< Delaunay flips of the feature warp, over this model's patches
+  /// Seam vertices whose position along the side differs between the two patches (0 unless a boundary
+  /// vertex could be placed at the same position in neither patch).
+  std::size_t seam_mismatches = 0;
   StageSeconds seconds;
 };
 

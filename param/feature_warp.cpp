@@ -6,7 +6,7 @@
 
 #include "param/errors.h"
 
-// CGAL's headers shadow names freely; silence that here only (param/CMakeLists.txt is not ours to change).
+// CGAL's headers shadow names freely; silence that for them only.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
 #include <CGAL/Delaunay_triangulation_2.h>
@@ -15,7 +15,6 @@
 #pragma GCC diagnostic pop
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -32,6 +31,7 @@ using Vec2 = Eigen::Vector2d;
 using Tri = std::array<int, 3>;
 
 constexpr int kCorners = 4;
+constexpr std::size_t kStallSteps = 500;  // a feature that gains < 0.1% of its remaining way in this many steps is stuck
 const Vec2 kCornerUv[kCorners] = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
 
 /// Exact sign of the orientation of (a, b, c): +1 counter-clockwise, 0 collinear, -1 clockwise.
@@ -201,7 +201,7 @@ class WarpMesh {
     return area2(at(tri[t][0], moving, x), at(tri[t][1], moving, x), at(tri[t][2], moving, x));
   }
 
-  /// Quality of p in t: the smallest barycentric coordinate (>= 0 inside).
+  /// Barycentric coordinates of p in triangle t (all >= 0 inside).
   Eigen::Vector3d barycentric(int t, const Vec2& p) const {
     const Vec2 &a = pos[tri[t][0]], &b = pos[tri[t][1]], &c = pos[tri[t][2]];
     const double total = area2(a, b, c);
@@ -270,6 +270,7 @@ class WarpMesh {
           if (!flip_quad(t, i, m, p, q, r)) continue;
           const auto pt = [&](int v) { return Kernel::Point_2(pos[v].x(), pos[v].y()); };
           if (CGAL::side_of_oriented_circle(pt(m), pt(p), pt(q), pt(r)) != CGAL::ON_POSITIVE_SIDE) continue;
+          if (orientation(pos[m], pos[p], pos[r]) <= 0 || orientation(pos[m], pos[r], pos[q]) <= 0) continue;
           for (int n : flip(t, i)) on_flip(n);
           ++flips;
           changed = true;
@@ -335,12 +336,28 @@ class Warper {
 
   enum class Outcome { kArrived, kStuck };
 
+  /// The longest base edge at feature k (current uv): the size of the star that travels with it.
+  double star_radius(int k) const {
+    double r = 0;
+    const int f = features_[k];
+    for (int t : star_[f]) {
+      for (int v : triangles_[t]) r = std::max(r, (uv_[v] - uv_[f]).norm());
+    }
+    return r;
+  }
+
   /// Moves feature k along the straight segment to q (the caller checked that it passes no warp vertex).
   Outcome move(int k, const Vec2& q) {
     const int w = kCorners + k;
+    double checkpoint = (warp_.pos[w] - q).norm();
     for (std::size_t step = 0; step < options_.max_steps_per_feature; ++step) {
       const Vec2 x0 = warp_.pos[w];
       if (x0 == q) return Outcome::kArrived;
+      if (step % kStallSteps == kStallSteps - 1) {  // a stall: repairs that keep the feature in place
+        const double remaining = (x0 - q).norm();
+        if (remaining > checkpoint * (1 - 1e-3)) return Outcome::kStuck;
+        checkpoint = remaining;
+      }
       const Vec2 d = q - x0;
       auto point_at = [&](double t) -> Vec2 { return t >= 1 ? q : Vec2(x0 + t * d); };
       const std::vector<int> inc = warp_.incident(w);
@@ -487,14 +504,16 @@ class Warper {
         ++result_.events;
         notify();
       }
-      if (moved && options_.keep_delaunay) result_.events += warp_.make_delaunay([&](int t) { note_area(t); });
-      // 5. The repair: one free vertex of the base triangle about to invert goes into its star's kernel.
-      if (offending >= 0) {
-        const Tri& T = triangles_[offending];
-        const double a_now = area2(uv_[T[0]], uv_[T[1]], uv_[T[2]]);
-        const bool ok = repair(offending);
-        if (getenv("FWDEBUG")) fprintf(stderr, "step %zu t_stop %g moved %d area %g -> %g  fixed %d%d%d  f=(%g,%g) verts (%g,%g) (%g,%g) (%g,%g)\n", step, t_stop, moved, a_now, area2(uv_[T[0]], uv_[T[1]], uv_[T[2]]), fixed_[T[0]], fixed_[T[1]], fixed_[T[2]], warp_.pos[w].x(), warp_.pos[w].y(), uv_[T[0]].x(), uv_[T[0]].y(), uv_[T[1]].x(), uv_[T[1]].y(), uv_[T[2]].x(), uv_[T[2]].y());
-        if (!ok) return Outcome::kStuck;
+      if (moved && options_.keep_delaunay) {
+        const std::size_t flips = warp_.make_delaunay([&](int t) { note_area(t); });
+        result_.events += flips;
+        if (flips > 0) notify();
+      }
+      // 5. The repair: relax the free vertices around the base triangle about to invert (kernel centroids; then
+      // the max-min-area point; then centroids over a wider region).
+      if (offending >= 0 && !repair(offending, false, options_.repair_rings) &&
+          !repair(offending, true, options_.repair_rings) && !repair(offending, false, 4 * options_.repair_rings)) {
+        return Outcome::kStuck;
       }
     }
     return Outcome::kStuck;
@@ -542,7 +561,7 @@ class Warper {
   /// one to the centroid of the kernel of its star, which keeps every triangle positive (a vertex is moved
   /// only when the exact predicates confirm it). The region grows ring by ring until t has at least doubled
   /// its area; succeeds when t grew at all.
-  bool repair(int t) {
+  bool repair(int t, bool maximin, int rings) {
     const Tri& T = triangles_[t];
     auto area = [&] { return area2(uv_[T[0]], uv_[T[1]], uv_[T[2]]); };
     auto contains = [](const std::vector<int>& list, int v) {
@@ -550,7 +569,7 @@ class Warper {
     };
     const double before = area();
     std::vector<int> reached(T.begin(), T.end()), frontier = reached, region, relocated;
-    for (int ring = 0; ring <= options_.repair_rings; ++ring) {
+    for (int ring = 0; ring <= rings; ++ring) {
       for (int v : frontier) {
         if (!fixed_[v]) region.push_back(v);
       }
@@ -558,7 +577,7 @@ class Warper {
         for (int v : region) {
           Vec2 c;
           const auto l = link(v);
-          if (!max_min_area_point(l, c) && !kernel_centroid(l, c)) continue;
+          if (maximin ? !max_min_area_point(l, c) : !kernel_centroid(l, c)) continue;
           const Vec2 old = uv_[v];
           uv_[v] = c;
           if (!base_valid(star_[v])) {
@@ -686,38 +705,47 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
   // cycle of such waits (features exchanging places) is broken by parking one feature beside its path.
   const double cd = options.collision_distance;
   const int n = int(features.size());
-  auto blocker = [&](int w, const Vec2& a, const Vec2& b) {
+  // Paths keep a clearance from other features proportional to the size of both features' base stars
+  // (`FeatureWarpOptions::clearance`): squeezing a feature's star past another's is where the base mesh
+  // folds. The hard limit is `collision_distance`.
+  auto needed = [&](int w, int v, bool soft) {
+    if (!soft || v < kCorners) return cd;
+    return std::max(cd, options.clearance * (warper.star_radius(w - kCorners) + warper.star_radius(v - kCorners)));
+  };
+  auto blocker = [&](int w, const Vec2& a, const Vec2& b, bool soft) {
     int worst = -1;
-    double closest = cd;
+    double ratio = 1;
     for (int v = 0; v < int(warp.pos.size()); ++v) {
       if (v == w) continue;
-      const double dist = distance_to_segment(warp.pos[v], a, b);
-      if (dist < closest) {
-        closest = dist;
+      const double r = distance_to_segment(warp.pos[v], a, b) / needed(w, v, soft);
+      if (r < ratio) {
+        ratio = r;
         worst = v;
       }
     }
     return worst;
   };
-  auto clearance = [&](int w, const Vec2& c) {  // distance from c to the nearest warp vertex other than w, and the sides
-    double dist = std::min({c.x(), c.y(), 1 - c.x(), 1 - c.y()});
-    for (int v = 0; v < int(warp.pos.size()); ++v) {
-      if (v != w && warp.pos[v] != c) dist = std::min(dist, (warp.pos[v] - c).norm());
-    }
-    return dist;
-  };
-  // A point beside `around`, perpendicular to a→b, such that a→point (and point→b when `through`) is clear.
-  auto waypoint = [&](int w, const Vec2& a, const Vec2& b, const Vec2& around, bool through, Vec2& out) {
+  // A point beside warp vertex `around` (or beside `a` when `around` < 0), off the line a→b, such that a→point
+  // (and point→b when `through`) is clear.
+  auto waypoint = [&](int w, const Vec2& a, const Vec2& b, int around, bool through, Vec2& out) {
     const Vec2 dir = (b - a).norm() > 0 ? Vec2((b - a).normalized()) : Vec2(1, 0);
     const Vec2 perp(-dir.y(), dir.x());
-    const double room = clearance(w, around);
-    for (double scale : {0.5, 0.25, 0.125, 0.0625}) {
-      for (double side : {1.0, -1.0}) {
-        const Vec2 c = around + side * scale * room * perp;
-        if (!strictly_inside(c, cd) || scale * room <= 2 * cd) continue;
-        if (blocker(w, a, c) >= 0 || (through && blocker(w, c, b) >= 0)) continue;
-        out = c;
-        return true;
+    const Vec2 center = around >= 0 ? warp.pos[around] : a;
+    double room = std::min({center.x(), center.y(), 1 - center.x(), 1 - center.y()});
+    for (int v = 0; v < int(warp.pos.size()); ++v) {
+      if (v != w && v != around) room = std::min(room, (warp.pos[v] - center).norm());
+    }
+    const double want = around >= 0 ? 1.5 * needed(w, around, true) : 0.0;
+    for (bool soft : {true, false}) {
+      for (double scale : {0.5, 0.35, 0.25, 0.125, 0.0625}) {
+        const double offset = std::max(scale * room, soft ? want : 0.0);
+        for (double side : {1.0, -1.0}) {
+          const Vec2 c = center + side * offset * perp;
+          if (!strictly_inside(c, cd) || offset <= 2 * cd || offset >= room) continue;
+          if (blocker(w, a, c, soft) >= 0 || (through && blocker(w, c, b, soft) >= 0)) continue;
+          out = c;
+          return true;
+        }
       }
     }
     return false;
@@ -727,47 +755,62 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
   for (int k = 0; k < n; ++k) {
     if (uv[features[k]] != targets[k]) pending.push_back(k);
   }
+  std::vector<int> legs(n, 0);
   int parks = 0, rounds = 0;
+  bool force = false;  // after a round without progress: accept paths that only miss the soft clearance
   auto give_up = [&](int k) { result.unreached.push_back(k); };
   while (!pending.empty()) {
-    if (rounds++ > 4 * n + 4) {
+    if (rounds++ > 8 * n + 8) {
       for (int k : pending) give_up(k);
       break;
     }
     std::vector<int> waiting;
     bool progress = false;
+    const bool was_forced = force;
     for (int k : pending) {
       const int w = kCorners + k;
       const Vec2 x0 = warp.pos[w];
-      const int b = blocker(w, x0, targets[k]);
-      if (b < 0) {
+      const int hard = blocker(w, x0, targets[k], false);
+      const int soft = hard >= 0 ? hard : blocker(w, x0, targets[k], true);
+      auto go = [&](const Vec2& to) {
         progress = true;
-        if (warper.move(k, targets[k]) != Warper::Outcome::kArrived) give_up(k);
+        return warper.move(k, to) == Warper::Outcome::kArrived;
+      };
+      if (soft < 0 || (hard < 0 && (force || legs[k] >= 2))) {
+        if (!go(targets[k])) give_up(k);
         continue;
       }
-      if ((warp.pos[b] - targets[k]).norm() < cd) {
+      // Wait while the target is still taken (or crowded) by a feature that has yet to move.
+      const bool occupant_pending =
+          soft >= kCorners && std::find(pending.begin(), pending.end(), soft - kCorners) != pending.end();
+      if ((warp.pos[soft] - targets[k]).norm() < needed(w, soft, hard < 0) && (hard >= 0 || (occupant_pending && !force))) {
         waiting.push_back(k);
         continue;
       }
       Vec2 via;
-      if (!waypoint(w, x0, targets[k], warp.pos[b], true, via)) {
-        waiting.push_back(k);
+      if (legs[k] < 2 && waypoint(w, x0, targets[k], soft, true, via)) {
+        ++result.detours;
+        ++legs[k];
+        if (!go(via)) {
+          give_up(k);
+          continue;
+        }
+        waiting.push_back(k);  // the second leg is checked in the next round
         continue;
       }
-      progress = true;
-      ++result.detours;
-      if (warper.move(k, via) != Warper::Outcome::kArrived) {
-        give_up(k);
+      if (hard < 0) {
+        if (!go(targets[k])) give_up(k);
         continue;
       }
-      waiting.push_back(k);  // the second leg is re-checked in the next round
+      waiting.push_back(k);
     }
-    if (!progress && !waiting.empty()) {
+    force = !progress;
+    if (!progress && !waiting.empty() && was_forced) {  // a cycle of features waiting on each other
       const int k = waiting.front();
       const int w = kCorners + k;
       const Vec2 x0 = warp.pos[w];
       Vec2 park;
-      if (parks++ > 2 * n || !waypoint(w, x0, targets[k], x0, false, park)) {
+      if (parks++ > 2 * n || !waypoint(w, x0, targets[k], -1, false, park)) {
         for (int l : waiting) give_up(l);
         break;
       }

@@ -25,14 +25,21 @@ struct FeatureWarpOptions {
   /// another feature): such a path is re-routed through one waypoint, or deferred until the blocking feature
   /// has moved. Targets must be farther apart than this, and farther than this from the square's sides.
   double collision_distance = 1e-7;
+  /// When > 0, a path should pass another feature no closer than this times the sum of both features' star
+  /// radii (the longest base edge at each); such a path is re-routed through a waypoint beside the other
+  /// feature, or waits while that feature has yet to move. Off by default: on the 20×20-grid trials of the
+  /// tests, 1.5 left more features unreached than straight paths did.
+  double clearance = 0;
   /// When a base-mesh triangle would invert during a step, the feature stops this fraction of the way to the
-  /// inversion (the triangle keeps 1 - fraction of its area) and the free vertices around that triangle are
-  /// repaired: moved to the centroid of the kernel of their star. In (0,1).
+  /// inversion (the triangle keeps 1 - fraction of its area) and the free (non-feature, non-boundary) vertices
+  /// around that triangle are repaired. In (0,1).
   double repair_stop_fraction = 0.5;
   /// A repair relaxes the free vertices of the triangle, then of its 1-ring, 2-ring, ... up to this many rings,
-  /// until the triangle has doubled its area.
+  /// until the triangle has doubled its area. Each vertex goes to the centroid of the kernel of its star; if
+  /// the triangle did not grow, to the point of the kernel that maximizes its smallest star triangle
+  /// (Freitag & Plassmann 2000); if it still did not grow, centroids again over 4× as many rings.
   int repair_rings = 3;
-  /// Gauss–Seidel sweeps of kernel-centroid moves per ring.
+  /// Gauss–Seidel sweeps per ring.
   int repair_sweeps = 3;
   /// Keep the base mesh free of inverted triangles (stop before an inversion and repair, see above). false
   /// gives the plain warp of the paper, which maps vertices only and may invert straight-edged base triangles
@@ -40,7 +47,7 @@ struct FeatureWarpOptions {
   bool keep_base_mesh_valid = true;
   /// A step moves the feature at most this fraction of its distance to the nearest other warp vertex
   /// (0: no bound, steps end only at events and repairs).
-  double max_step_fraction = 0.25;
+  double max_step_fraction = 0.1;
   /// After every step, flip warp edges until the warp mesh is Delaunay again (kinetic Delaunay). false: flip
   /// only at degeneracy events, as in the paper.
   bool keep_delaunay = true;
@@ -50,17 +57,18 @@ struct FeatureWarpOptions {
   /// where it is (still foldover-free) and reported in `FeatureWarpResult::unreached`.
   std::size_t max_steps_per_feature = 20000;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
-  /// order; counter-clockwise triangles) after it is built and after every move and every edge flip. May be
-  /// empty. For tests and visualization.
+  /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after
+  /// the Delaunay flips that follow a move. May be empty. For tests and visualization.
   std::function<void(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles)>
       observer;
 };
 
 struct FeatureWarpResult {
-  /// Warp edge flips performed ("events" of §3.4.2).
+  /// Warp edge flips performed: at degeneracy events (§3.4.2) and, with `keep_delaunay`, to restore the
+  /// Delaunay property after a step.
   std::size_t events = 0;
-  /// Base-mesh vertex relocations done to keep base triangles from inverting (a vertex repaired twice counts
-  /// twice). Each moves a non-feature interior vertex to the centroid of the kernel of its star.
+  /// Base-mesh vertex relocations done to keep base triangles from inverting (a vertex relocated by two
+  /// repairs counts twice). Relocated vertices are re-bound to the warp mesh where they land.
   std::size_t repaired_vertices = 0;
   /// Moves between events and repairs, over all features.
   std::size_t steps = 0;
@@ -88,9 +96,15 @@ struct FeatureWarpResult {
 /// flipped and the points of the two triangles are re-bound. Non-feature vertices follow their barycentric
 /// coordinates, so the warp is a piecewise-linear homeomorphism of the square: corners and boundary vertices
 /// do not move (bit-identical) and points outside the warp triangles incident to a moving feature do not move.
-/// Because a PL map of the vertices alone can still invert a straight-edged base triangle, every step also
-/// stops before a base triangle would invert and relocates one of its free vertices into the kernel of its
-/// star (`repaired_vertices`). The base mesh therefore has no flipped triangle afterwards.
+/// Steps are short and followed by Delaunay flips (`keep_delaunay`), so the kinks of the PL map move with
+/// the feature. Because a PL map of the vertices alone can still invert a straight-edged base triangle (every
+/// point moves linearly during a step, so each base triangle's area is linear in time and its inversion time
+/// is known exactly), every step stops before a base triangle would invert and relaxes the free vertices
+/// around it inside the kernels of their stars (`repaired_vertices`); every relocation is checked with exact
+/// predicates. The base mesh therefore has no flipped triangle afterwards. Points outside the warp triangles
+/// incident to a moving feature move only when repaired (they are then within a few rings of a moving one).
+/// Measured (tests, 20×20 grid, 3–6 features): targets within 0.2 of their features are all reached; targets
+/// anywhere in [0.1,0.9]² leave about a fifth of the features unreached, reported, never folded.
 ///
 /// \param triangles  #F base-mesh triangles, 0-based indices into `uv`, counter-clockwise (positive area).
 /// \param uv         #V positions in [0,1]²: corners at the square's corners, boundary vertices with a

@@ -19,8 +19,12 @@ namespace {
 const char* const kFn = "partition_mesh: ";
 
 // Half-edge h = 3·f + k of triangle f runs from triangles[f][k] to triangles[f][(k+1)%3].
-int he_from(const TriMesh& m, int h) { return m.triangles[h / 3][h % 3]; }
-int he_to(const TriMesh& m, int h) { return m.triangles[h / 3][(h + 1) % 3]; }
+int he_from(const TriMesh& m, int h) {
+  return m.triangles[h / 3][h % 3];
+}
+int he_to(const TriMesh& m, int h) {
+  return m.triangles[h / 3][(h + 1) % 3];
+}
 
 // Connectivity of a closed, consistently oriented triangle mesh: each half-edge's opposite, and each vertex's
 // outgoing half-edges (CSR). On such a mesh the outgoing half-edges of v reach every neighbour of v once.
@@ -62,9 +66,10 @@ Connectivity build_connectivity(const TriMesh& m) {
       if (c.out[i] != h && he_to(m, c.out[i]) == b) same_direction = 1;
     }
     if (found < 0 || same_direction) {
-      throw InvalidInput(std::string(kFn) + "edge (" + std::to_string(a) + "," + std::to_string(b) +
-                         ") is not shared by exactly two oppositely oriented triangles: the triangles must be "
-                         "consistently oriented");
+      throw InvalidInput(
+          std::string(kFn) + "edge (" + std::to_string(a) + "," + std::to_string(b) +
+          ") is not shared by exactly two oppositely oriented triangles: the triangles must be "
+          "consistently oriented");
     }
     c.opposite[h] = found;
   }
@@ -76,8 +81,8 @@ std::uint64_t edge_key(int a, int b) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
 }
 
-// Splits every listed edge at its midpoint; returns the number of vertices appended. Triangles keep their id for
-// their first piece (other pieces appended) and their orientation; untouched triangles stay as they are.
+// Splits every listed edge at its midpoint; returns the number of vertices appended. Triangles keep their id
+// for their first piece (other pieces appended) and their orientation; untouched triangles stay as they are.
 std::size_t split_edges(TriMesh& m, const std::vector<std::pair<int, int>>& edges) {
   std::unordered_map<std::uint64_t, int> mid;
   for (const auto& [a, b] : edges) {
@@ -98,7 +103,9 @@ std::size_t split_edges(TriMesh& m, const std::vector<std::pair<int, int>>& edge
     if (count == 0) continue;
     std::vector<std::array<int, 3>> pieces;
     if (count == 3) {
-      pieces = {{t[0], mids[0], mids[2]}, {mids[0], t[1], mids[1]}, {mids[2], mids[1], t[2]},
+      pieces = {{t[0], mids[0], mids[2]},
+                {mids[0], t[1], mids[1]},
+                {mids[2], mids[1], t[2]},
                 {mids[0], mids[1], mids[2]}};
     } else {
       // Rotate so that: one split edge is edge 0 (a→b); two split edges leave edge 2 (c→a) whole.
@@ -174,7 +181,9 @@ struct PathSpec {
   int from, to, via;
 };
 
-std::string vertex_name(int v) { return "vertex " + std::to_string(v); }
+std::string vertex_name(int v) {
+  return "vertex " + std::to_string(v);
+}
 
 // The working state of one partition: the mesh being cut (split as needed), its connectivity, and the cut.
 class Partitioner {
@@ -207,9 +216,10 @@ class Partitioner {
       paths_.push_back(std::move(path));
     }
     mark_cut();
-    if (!chords().empty()) {
+    const std::size_t chord_count = chords().size();
+    if (chord_count > 0) {
       if (!options_.split_degenerate) {
-        throw InvalidInput(std::string(kFn) + "degenerate configuration: " + std::to_string(chords().size()) +
+        throw InvalidInput(std::string(kFn) + "degenerate configuration: " + std::to_string(chord_count) +
                            " edge(s) join two cut vertices without being on the cut (a triangle with all "
                            "three vertices on the cut); enable split_degenerate");
       }
@@ -274,7 +284,8 @@ class Partitioner {
     }
     std::sort(vertices.begin(), vertices.end());
     const std::size_t nverts = std::unique(vertices.begin(), vertices.end()) - vertices.begin();
-    const long long euler = static_cast<long long>(nverts) - static_cast<long long>((3 * faces + boundary) / 2) +
+    const long long euler = static_cast<long long>(nverts) -
+                            static_cast<long long>((3 * faces + boundary) / 2) +
                             static_cast<long long>(faces);
     if (euler != 1) {
       why = "it is not a disk (V-E+F = " + std::to_string(euler) + ")";
@@ -297,8 +308,8 @@ class Partitioner {
     return cycle;
   }
 
-  // Cuts `cycle` (CCW, starting at corners[0]) into the 4 sides between `corners`, which must appear once each
-  // in that order; other partition points must not appear at all.
+  // Cuts `cycle` (CCW, starting at corners[0]) into the 4 sides between `corners`, which must appear once
+  // each in that order; other partition points must not appear at all.
   static bool make_sides(const std::vector<int>& cycle, const std::array<int, 4>& corners, Patch& patch) {
     patch.corners = corners;
     std::size_t pos = 0;
@@ -398,7 +409,8 @@ class Partitioner {
 // Fills each patch's face list (ascending) from face_patch.
 void collect_faces(PartitionResult& r) {
   for (Patch& patch : r.patches) patch.faces.clear();
-  for (int f = 0; f < static_cast<int>(r.face_patch.size()); ++f) r.patches[r.face_patch[f]].faces.push_back(f);
+  for (int f = 0; f < static_cast<int>(r.face_patch.size()); ++f)
+    r.patches[r.face_patch[f]].faces.push_back(f);
 }
 
 // Fills `adjacency` by matching every side with the side that walks the same vertices the other way.
@@ -440,7 +452,8 @@ void check_points(const TriMesh& mesh, const std::vector<int>& points, const std
   std::vector<char> referenced(nv, 0);
   for (const auto& t : mesh.triangles) {
     for (int v : t) {
-      if (v < 0 || v >= nv) throw InvalidInput(std::string(kFn) + "a triangle has a vertex index out of range");
+      if (v < 0 || v >= nv)
+        throw InvalidInput(std::string(kFn) + "a triangle has a vertex index out of range");
       referenced[v] = 1;
     }
   }
@@ -448,7 +461,7 @@ void check_points(const TriMesh& mesh, const std::vector<int>& points, const std
   all.insert(all.end(), aux.begin(), aux.end());
   for (std::size_t i = 0; i < all.size(); ++i) {
     const std::string what = i < points.size() ? "partition point " + std::to_string(i)
-                                                : "auxiliary point " + std::to_string(i - points.size());
+                                               : "auxiliary point " + std::to_string(i - points.size());
     if (all[i] < 0 || all[i] >= nv) {
       throw InvalidInput(std::string(kFn) + what + " = " + std::to_string(all[i]) + " is out of range [0," +
                          std::to_string(nv) + ")");
@@ -518,8 +531,9 @@ PartitionResult partition_genus1(const TriMesh& mesh, const std::vector<int>& p,
 
   PartitionResult& r = part.result();
   auto fail = [&](const std::string& why) {
-    throw InvalidInput(std::string(kFn) + "the genus-1 points do not cut the torus into a 2x2 grid of quads (" +
-                       why + "); check the order of the auxiliary points (see mesh_partition.h)");
+    throw InvalidInput(std::string(kFn) +
+                       "the genus-1 points do not cut the torus into a 2x2 grid of quads (" + why +
+                       "); check the order of the auxiliary points (see mesh_partition.h)");
   };
   const int regions = part.label_regions();
   if (regions != 4) fail(std::to_string(regions) + " patches instead of 4");
@@ -566,7 +580,8 @@ PartitionResult partition_genus1(const TriMesh& mesh, const std::vector<int>& p,
     const int index = 2 * a01 + a02;
     if (taken[index]) fail("two patches lie between the same P0-P1 and P0-P2 edges");
     // Corner 0 is P_{a+2b}: the patch's lower-left corner in the cover picture.
-    const int first = static_cast<int>(std::find(corners.begin(), corners.end(), p[a01 + 2 * a02]) - corners.begin());
+    const int first =
+        static_cast<int>(std::find(corners.begin(), corners.end(), p[a01 + 2 * a02]) - corners.begin());
     std::rotate(patch.corners.begin(), patch.corners.begin() + first, patch.corners.end());
     std::rotate(patch.sides.begin(), patch.sides.begin() + first, patch.sides.end());
     taken[index] = 1;
@@ -593,8 +608,9 @@ PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector
   check_points(mesh, partition_points, auxiliary_points);
   const TopologyReport topo = analyze_topology(mesh);
   if (!topo.manifold) {
-    throw InvalidInput(std::string(kFn) + "the mesh is not manifold (" + std::to_string(topo.non_manifold_edges) +
-                       " non-manifold edges, " + std::to_string(topo.non_manifold_vertices) +
+    throw InvalidInput(std::string(kFn) + "the mesh is not manifold (" +
+                       std::to_string(topo.non_manifold_edges) + " non-manifold edges, " +
+                       std::to_string(topo.non_manifold_vertices) +
                        " non-manifold vertices); run repair_mesh first");
   }
   if (topo.boundary_edges > 0) {
@@ -620,7 +636,8 @@ PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector
   }
   if (genus == 1) {
     if (auxiliary_points.size() != 8) {
-      throw InvalidInput(std::string(kFn) + "a genus-1 mesh takes 8 auxiliary points (one per patch edge), got " +
+      throw InvalidInput(std::string(kFn) +
+                         "a genus-1 mesh takes 8 auxiliary points (one per patch edge), got " +
                          std::to_string(auxiliary_points.size()));
     }
     return partition_genus1(mesh, partition_points, auxiliary_points, options);

@@ -18,8 +18,12 @@ namespace {
 
 const char* const kFn = "choose_partition_points: ";
 
-int he_from(const TriMesh& m, int h) { return m.triangles[h / 3][h % 3]; }
-int he_to(const TriMesh& m, int h) { return m.triangles[h / 3][(h + 1) % 3]; }
+int he_from(const TriMesh& m, int h) {
+  return m.triangles[h / 3][h % 3];
+}
+int he_to(const TriMesh& m, int h) {
+  return m.triangles[h / 3][(h + 1) % 3];
+}
 
 // Opposite half-edge of each half-edge (h = 3·f + k runs from corner k to corner k+1 of triangle f) of a
 // closed, consistently oriented mesh; partition_mesh() has already checked that.
@@ -52,9 +56,9 @@ Eigen::Vector3d face_normal(const TriMesh& m, int f) {  // length = 2 × area
 // The longest closed curve where the plane {x·n = offset} cuts the mesh, as the ordered crossing edges
 // (one half-edge each), oriented CCW around n. Vertices with x·n <= offset count as below the plane.
 struct Outline {
-  std::vector<int> vertex;            // per crossing edge: its endpoint nearer to the plane
+  std::vector<int> vertex;             // per crossing edge: its endpoint nearer to the plane
   std::vector<Eigen::Vector3d> point;  // per crossing edge: where it crosses the plane
-  std::vector<double> arc;            // arc length from entry 0 to entry k
+  std::vector<double> arc;             // arc length from entry 0 to entry k
   double length = 0.0;
 };
 
@@ -110,7 +114,7 @@ PartitionPoints outline_points(const TriMesh& m, const std::vector<int>& opp, co
   const Outline o = longest_outline(m, opp, n, a, b, offset);
   const int count = static_cast<int>(o.vertex.size());
   PartitionPoints pts;
-  if (count < 8) return pts;
+  if (count < 4) return pts;
   std::array<int, 4> at;  // outline entries of the corners
   const std::array<Eigen::Vector3d, 4> dirs = {a, b, -a, -b};
   for (int k = 0; k < 4; ++k) {
@@ -128,12 +132,27 @@ PartitionPoints outline_points(const TriMesh& m, const std::vector<int>& opp, co
     }
   }
   auto distinct = [&](int v) {
-    return std::find(pts.partition_points.begin(), pts.partition_points.end(), v) == pts.partition_points.end() &&
-           std::find(pts.auxiliary_points.begin(), pts.auxiliary_points.end(), v) == pts.auxiliary_points.end();
+    return std::find(pts.partition_points.begin(), pts.partition_points.end(), v) ==
+               pts.partition_points.end() &&
+           std::find(pts.auxiliary_points.begin(), pts.auxiliary_points.end(), v) ==
+               pts.auxiliary_points.end();
   };
   for (int k = 0; k < 4; ++k) {
-    if (!distinct(o.vertex[at[k]])) return {};
+    if (!distinct(o.vertex[at[k]])) break;
     pts.partition_points.push_back(o.vertex[at[k]]);
+  }
+  if (pts.partition_points.size() < 4) {
+    // Coarse mesh: neighbouring entries share vertices. Spread the corners over the outline's distinct
+    // vertices, in order from the +a extreme, and let the paths go unguided.
+    std::vector<int> ring;
+    for (int i = 0; i < count; ++i) {
+      const int v = o.vertex[(at[0] + i) % count];
+      if (std::find(ring.begin(), ring.end(), v) == ring.end()) ring.push_back(v);
+    }
+    pts.partition_points.clear();
+    if (ring.size() < 4) return pts;
+    for (std::size_t k = 0; k < 4; ++k) pts.partition_points.push_back(ring[k * ring.size() / 4]);
+    return pts;
   }
   for (int k = 0; k < 4; ++k) {
     // Entry half way (by arc length) from corner k to corner k+1, or the nearest entry between them whose
@@ -165,7 +184,7 @@ PartitionPoints outline_points(const TriMesh& m, const std::vector<int>& opp, co
   return pts;
 }
 
-PartitionPoints genus0_points(const TriMesh& m) {
+PartitionPoints genus0_points(const TriMesh& m, const PartitionPointsOptions& options) {
   const int nf = static_cast<int>(m.triangles.size());
   std::vector<double> area(nf);
   std::vector<Eigen::Vector3d> centroid(nf);
@@ -196,7 +215,10 @@ PartitionPoints genus0_points(const TriMesh& m) {
   const Eigen::Vector3d e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
   const Eigen::Vector3d e3 = e1.cross(e2);
   // (normal, a, b) with a × b = normal: thinnest direction first.
-  const std::array<std::array<Eigen::Vector3d, 3>, 3> planes = {{{e3, e1, e2}, {e2, e3, e1}, {e1, e2, e3}}};
+  std::vector<std::array<Eigen::Vector3d, 3>> planes = {{e3, e1, e2}, {e2, e3, e1}, {e1, e2, e3}};
+  // The plane with normal e_cut_axis first, the others thinnest first.
+  const int first = 3 - options.cut_axis;
+  std::rotate(planes.begin(), planes.begin() + first, planes.begin() + first + 1);
 
   const std::vector<int> opp = opposite_halfedges(m);
   std::vector<int> order(nf);
@@ -204,7 +226,8 @@ PartitionPoints genus0_points(const TriMesh& m) {
   for (const auto& [n, a, b] : planes) {
     // Area median along n.
     std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(), [&](int f, int g) { return centroid[f].dot(n) < centroid[g].dot(n); });
+    std::sort(order.begin(), order.end(),
+              [&](int f, int g) { return centroid[f].dot(n) < centroid[g].dot(n); });
     double acc = 0.0, offset = centroid[order.back()].dot(n);
     for (int f : order) {
       acc += area[f];
@@ -214,13 +237,36 @@ PartitionPoints genus0_points(const TriMesh& m) {
       }
     }
     const PartitionPoints pts = outline_points(m, opp, n, a, b, offset);
-    if (pts.partition_points.size() != 4) continue;
+    if (pts.partition_points.size() != 4) {
+      failures += " an outline with fewer than 4 vertices;";
+      continue;
+    }
     try {
       partition_mesh(m, pts.partition_points, pts.auxiliary_points);
       return pts;
     } catch (const Error& e) {
       failures += std::string(" ") + e.what() + ";";
     }
+  }
+  // Last resort (a handful of triangles): the vertices extreme in ±a, ±b of the first plane.
+  PartitionPoints pts;
+  const Eigen::Vector3d a0 = planes.front()[1], b0 = planes.front()[2];
+  for (const Eigen::Vector3d& dir : {a0, b0, Eigen::Vector3d(-a0), Eigen::Vector3d(-b0)}) {
+    int best = -1;
+    for (const auto& t : m.triangles) {
+      for (int v : t) {
+        const auto& chosen = pts.partition_points;
+        if (std::find(chosen.begin(), chosen.end(), v) != chosen.end()) continue;
+        if (best < 0 || m.positions[v].dot(dir) > m.positions[best].dot(dir)) best = v;
+      }
+    }
+    pts.partition_points.push_back(best);
+  }
+  try {
+    partition_mesh(m, pts.partition_points, {});
+    return pts;
+  } catch (const Error& e) {
+    failures += std::string(" extreme vertices: ") + e.what() + ";";
   }
   throw SolverFailure(std::string(kFn) + "no principal plane gave a valid loop:" + failures);
 }
@@ -299,7 +345,8 @@ FlatTorus flat_torus(const TriMesh& m) {
     }
   }
 
-  // Cotangent weights per half-edge (half the cotangent of the angle opposite it; an edge's weight is the sum).
+  // Cotangent weights per half-edge (half the cotangent of the angle opposite it; an edge's weight is the
+  // sum).
   std::vector<double> cot(nh);
   for (int h = 0; h < nh; ++h) {
     const auto& t = m.triangles[h / 3];
@@ -328,7 +375,8 @@ FlatTorus flat_torus(const TriMesh& m) {
   Eigen::SparseMatrix<double> lap(n, n);
   lap.setFromTriplets(triplets.begin(), triplets.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(lap);
-  if (solver.info() != Eigen::Success) throw SolverFailure(std::string(kFn) + "cotangent Laplacian is singular");
+  if (solver.info() != Eigen::Success)
+    throw SolverFailure(std::string(kFn) + "cotangent Laplacian is singular");
   const Eigen::MatrixXd f = solver.solve(rhs);
   auto potential = [&](int v, int i) { return index[v] < 0 ? 0.0 : f(index[v], i); };
   std::array<std::vector<double>, 2> eta = omega;
@@ -470,11 +518,13 @@ PartitionPoints genus1_points(const TriMesh& m, const PartitionPointsOptions& op
     const double xm0 = x0 + 0.5 * c.s.x(), xm1 = x1 + 0.5 * (1.0 - c.s.x());
     const double ym0 = y0 + 0.5 * c.s.y(), ym1 = y1 + 0.5 * (1.0 - c.s.y());
     const std::array<Eigen::Vector2d, 12> targets = {
-        Eigen::Vector2d(x0, y0),  Eigen::Vector2d(x1, y0),  Eigen::Vector2d(x0, y1),  Eigen::Vector2d(x1, y1),
-        Eigen::Vector2d(xm0, y0), Eigen::Vector2d(xm1, y0), Eigen::Vector2d(xm0, y1), Eigen::Vector2d(xm1, y1),
-        Eigen::Vector2d(x0, ym0), Eigen::Vector2d(x0, ym1), Eigen::Vector2d(x1, ym0), Eigen::Vector2d(x1, ym1)};
+        Eigen::Vector2d(x0, y0),  Eigen::Vector2d(x1, y0),  Eigen::Vector2d(x0, y1),
+        Eigen::Vector2d(x1, y1),  Eigen::Vector2d(xm0, y0), Eigen::Vector2d(xm1, y0),
+        Eigen::Vector2d(xm0, y1), Eigen::Vector2d(xm1, y1), Eigen::Vector2d(x0, ym0),
+        Eigen::Vector2d(x0, ym1), Eigen::Vector2d(x1, ym0), Eigen::Vector2d(x1, ym1)};
     PartitionPoints pts;
-    for (int k = 0; k < 12; ++k) (k < 4 ? pts.partition_points : pts.auxiliary_points).push_back(nearest(targets[k]));
+    for (int k = 0; k < 12; ++k)
+      (k < 4 ? pts.partition_points : pts.auxiliary_points).push_back(nearest(targets[k]));
     try {
       const double balance =
           partition_stats(partition_mesh(m, pts.partition_points, pts.auxiliary_points)).area_balance;
@@ -488,15 +538,16 @@ PartitionPoints genus1_points(const TriMesh& m, const PartitionPointsOptions& op
     }
   }
   if (best_balance < 0.0) {
-    throw SolverFailure(std::string(kFn) + "no placement on the flat torus partitioned the mesh (last: " +
-                        last_failure + ")");
+    throw SolverFailure(std::string(kFn) +
+                        "no placement on the flat torus partitioned the mesh (last: " + last_failure + ")");
   }
   return best;
 }
 
 }  // namespace
 
-PartitionPoints choose_partition_points(const TriMesh& closed_manifold, const PartitionPointsOptions& options) {
+PartitionPoints choose_partition_points(const TriMesh& closed_manifold,
+                                        const PartitionPointsOptions& options) {
   const TopologyReport topo = analyze_topology(closed_manifold);
   if (!topo.manifold || topo.boundary_edges > 0 || topo.components != 1 || topo.degenerate_faces > 0 ||
       !topo.genus) {
@@ -504,7 +555,11 @@ PartitionPoints choose_partition_points(const TriMesh& closed_manifold, const Pa
                        "the mesh must be one closed, manifold, orientable component without degenerate "
                        "triangles; run repair_mesh first");
   }
-  if (*topo.genus == 0) return genus0_points(closed_manifold);
+  if (options.cut_axis < 1 || options.cut_axis > 3) {
+    throw InvalidInput(std::string(kFn) + "cut_axis must be 1, 2 or 3, got " +
+                       std::to_string(options.cut_axis));
+  }
+  if (*topo.genus == 0) return genus0_points(closed_manifold, options);
   if (*topo.genus == 1) return genus1_points(closed_manifold, options);
   throw InvalidInput(std::string(kFn) + "the mesh has genus " + std::to_string(*topo.genus) +
                      "; only genus 0 and 1 are supported");

@@ -36,9 +36,10 @@ struct ProgressiveMeshOptions {
 /// One half-edge collapse (v1, v2) → v1 of the paper, read backwards: the vertex split that undoes it.
 /// Vertex ids are the patch's, triangle ids are indices into the patch's `triangles`.
 struct HalfEdgeCollapse {
-  int removed =
-      -1;         ///< v2 in the paper (OpenMesh's v0): the vertex the collapse removes, the split re-inserts
-  int kept = -1;  ///< v1: the vertex `removed` is merged into; it keeps its position (and parameter)
+  /// v2 in the paper (OpenMesh's v0): the vertex the collapse removes and the split re-inserts.
+  int removed = -1;
+  /// v1: the vertex `removed` is merged into; it keeps its position (and parameter).
+  int kept = -1;
   /// Wing vertices. The triangle (removed, kept, left) lies left of the half-edge removed→kept and
   /// (kept, removed, right) right of it, both in counter-clockwise order; the collapse deletes them. -1 where
   /// the half-edge (or its opposite) is a boundary half-edge and has no triangle.

@@ -84,7 +84,8 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
                        {"stretch_mvc", stretch_json(p.mvc_stretch)},
                        {"stretch", stretch_json(p.stretch)},
                        {"flipped", p.flipped},
-                       {"boundary_off_chord", p.boundary_off_chord}});
+                       {"boundary_off_chord", p.boundary_off_chord},
+                       {"mvc_fallback", p.mvc_fallback}});
     flipped += p.flipped;
   }
   j["patches"] = patches;
@@ -102,6 +103,7 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
   j["features"] = features;
   j["flipped_triangles"] = flipped;
   j["warp_events"] = m.warp_events;
+  j["seam_mismatches"] = m.seam_mismatches;
   const StageSeconds& s = m.seconds;
   j["seconds"] = {{"partition", s.partition},
                   {"progressive_mesh", s.progressive_mesh},

@@ -430,7 +430,11 @@ TEST(CoarseToFineReal, BunnyHalvesInACoupleOfSeconds) {
     seconds += run_real_half(
         half, std::string("bunny, axis ") + "xyz"[axis] + (lower ? " lower half" : " upper half"));
   }
+#ifdef NDEBUG
   EXPECT_LT(seconds, 3.0);  // PM + MVC + insertion for both; generous for a loaded machine
+#else
+  std::printf("unoptimised build: %.3f s not checked against the 3 s budget\n", seconds);
+#endif
 }
 
 }  // namespace

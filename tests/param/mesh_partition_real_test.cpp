@@ -60,6 +60,14 @@ void check_genus0(const std::string& name) {
   EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
   const Figures autof = figures(m, r);
 
+  // The alternative considered: the loop around the "equator", across the longest axis; and the chosen
+  // corners without their guiding points.
+  PartitionPointsOptions equator_options;
+  equator_options.cut_axis = 1;
+  const PartitionPoints eq = choose_partition_points(m, equator_options);
+  const Figures equator = figures(m, partition_mesh(m, eq.partition_points, eq.auxiliary_points));
+  const Figures unguided = figures(m, partition_mesh(m, pts.partition_points, {}));
+
   // Naive 1: the first four vertex ids. Naive 2: four random vertices (mean of 10 seeded draws).
   Figures first;
   try {
@@ -92,14 +100,22 @@ void check_genus0(const std::string& name) {
       worst_random = 0.0;
     }
   }
-  std::printf(
-      "[figures] %-10s F=%zu splits=%zu | auto: balance %.3f cut/sqrtA %.2f min flatness %.2f | first-4-ids: "
-      "balance %.3f cut/sqrtA %.2f flat %.2f | random (mean of 10, %d failed): balance %.3f (worst %.3f) cut/sqrtA "
-      "%.2f flat %.2f | time choose %.3f s, partition %.3f s\n",
-      name.c_str(), m.num_triangles(), r.split_vertices, autof.balance, autof.cut, autof.flat_min, first.balance,
-      first.cut, first.flat_min, random_failures, random.balance, worst_random, random.cut, random.flat_min,
-      t_choose, t_partition);
+  std::printf("[figures] %-10s F=%zu splits=%zu time: choose %.3f s, partition %.3f s\n", name.c_str(),
+              m.num_triangles(), r.split_vertices, t_choose, t_partition);
+  auto row = [&](const char* what, const Figures& f) {
+    std::printf("[figures] %-10s %-26s balance %.3f  cut/sqrt(area) %.2f  min flatness %.2f\n", name.c_str(),
+                what, f.balance, f.cut, f.flat_min);
+  };
+  row("auto (thin-axis outline)", autof);
+  row("auto corners, no guides", unguided);
+  row("equator (cut_axis 1)", equator);
+  row("first 4 vertex ids", first);
+  row("random (mean of 10)", random);
+  std::printf("[figures] %-10s random: worst balance %.3f, %d of 10 failed\n", name.c_str(), worst_random,
+              random_failures);
   EXPECT_GT(autof.balance, 0.7) << name;
+  EXPECT_GT(autof.flat_min, equator.flat_min) << name << ": the thin-axis cut should give flatter halves";
+  EXPECT_GE(autof.balance, unguided.balance) << name << ": guiding points should not hurt the balance";
   EXPECT_GT(autof.balance, first.balance) << name;
   EXPECT_GT(autof.balance, random.balance) << name;
 #ifdef NDEBUG
@@ -107,10 +123,18 @@ void check_genus0(const std::string& name) {
 #endif
 }
 
-TEST(PartitionReal, BunnyRepaired) { check_genus0("bunny.obj"); }
-TEST(PartitionReal, Spot) { check_genus0("spot.obj"); }
-TEST(PartitionReal, Horse) { check_genus0("horse.obj"); }
-TEST(PartitionReal, CowRepaired) { check_genus0("cow.obj"); }
+TEST(PartitionReal, BunnyRepaired) {
+  check_genus0("bunny.obj");
+}
+TEST(PartitionReal, Spot) {
+  check_genus0("spot.obj");
+}
+TEST(PartitionReal, Horse) {
+  check_genus0("horse.obj");
+}
+TEST(PartitionReal, CowRepaired) {
+  check_genus0("cow.obj");
+}
 
 // Genus 1: the committed point files partition validly; the automatic method does too.
 void check_genus1(const std::string& name, const std::string& points_file) {
@@ -144,15 +168,20 @@ void check_genus1(const std::string& name, const std::string& points_file) {
   const double t_choose = seconds_since(t0);
   const PartitionResult rc = partition_mesh(m, chosen.partition_points, chosen.auxiliary_points);
   EXPECT_EQ(test::check_partition(m, chosen.partition_points, rc), "");
-  std::printf("[figures] %-10s F=%zu file points: balance %.3f cut/sqrtA %.2f splits %zu, partition %.3f s | "
-              "choose_partition_points: balance %.3f, %.3f s\n",
-              name.c_str(), m.num_triangles(), s.area_balance, s.cut_length / std::sqrt(test::surface_area(m)),
-              r.split_vertices, t_partition, partition_stats(rc).area_balance, t_choose);
+  std::printf(
+      "[figures] %-10s F=%zu file points: balance %.3f cut/sqrtA %.2f splits %zu, partition %.3f s | "
+      "choose_partition_points: balance %.3f, %.3f s\n",
+      name.c_str(), m.num_triangles(), s.area_balance, s.cut_length / std::sqrt(test::surface_area(m)),
+      r.split_vertices, t_partition, partition_stats(rc).area_balance, t_choose);
   EXPECT_GT(s.area_balance, 0.2) << name;
 }
 
-TEST(PartitionReal, BobGenus1) { check_genus1("bob.obj", "bob.points.json"); }
-TEST(PartitionReal, RockerArmGenus1) { check_genus1("rocker-arm.obj", "rocker-arm.points.json"); }
+TEST(PartitionReal, BobGenus1) {
+  check_genus1("bob.obj", "bob.points.json");
+}
+TEST(PartitionReal, RockerArmGenus1) {
+  check_genus1("rocker-arm.obj", "rocker-arm.points.json");
+}
 
 }  // namespace
 }  // namespace geomip

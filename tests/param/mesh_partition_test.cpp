@@ -19,50 +19,9 @@
 namespace geomip {
 namespace {
 
-// 1-to-4 midpoint subdivision; with `radius` > 0 the vertices are projected on the sphere of that radius
-// around `center`.
-TriMesh subdivide(const TriMesh& in, int levels, const Eigen::Vector3d& center = Eigen::Vector3d::Zero(),
-                  double radius = 0.0) {
-  TriMesh m = in;
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<int, int>, int> mid;
-    auto midpoint = [&](int a, int b) {
-      const auto k = std::minmax(a, b);
-      const auto it = mid.find(k);
-      if (it != mid.end()) return it->second;
-      m.positions.push_back(0.5 * (m.positions[a] + m.positions[b]));
-      return mid[k] = static_cast<int>(m.positions.size()) - 1;
-    };
-    std::vector<std::array<int, 3>> tris;
-    for (const auto& t : m.triangles) {
-      const int a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), c = midpoint(t[2], t[0]);
-      tris.push_back({t[0], a, c});
-      tris.push_back({a, t[1], b});
-      tris.push_back({c, b, t[2]});
-      tris.push_back({a, b, c});
-    }
-    m.triangles = tris;
-  }
-  if (radius > 0.0) {
-    for (auto& p : m.positions) p = center + radius * (p - center).normalized();
-  }
-  return m;
-}
-
-// Unit sphere around the origin from a subdivided cube: 12·4^levels triangles.
-TriMesh sphere(int levels) {
-  TriMesh c = test::cube();
-  for (auto& p : c.positions) p -= Eigen::Vector3d::Constant(0.5);
-  return subdivide(c, levels, Eigen::Vector3d::Zero(), 1.0);
-}
-
-int nearest_vertex(const TriMesh& m, const Eigen::Vector3d& p) {
-  int best = 0;
-  for (int v = 1; v < static_cast<int>(m.positions.size()); ++v) {
-    if ((m.positions[v] - p).squaredNorm() < (m.positions[best] - p).squaredNorm()) best = v;
-  }
-  return best;
-}
+using test::nearest_vertex;
+using test::sphere;
+using test::subdivide;
 
 // Two tori joined by a tube: genus 2. The tube's winding and matching are searched so that the result is a
 // consistently oriented closed manifold.
@@ -112,6 +71,16 @@ TriMesh double_torus() {
   return base;
 }
 
+// Tutte's map of every patch onto the unit square is one-to-one (the use §3.3 makes of the patches).
+std::string embedding_problems(const PartitionResult& r) {
+  std::string problems;
+  for (int p = 0; p < static_cast<int>(r.patches.size()); ++p) {
+    const std::size_t flipped = test::tutte_square_embedding(r, p).flipped;
+    if (flipped) problems += "patch " + std::to_string(p) + ": " + std::to_string(flipped) + " flipped; ";
+  }
+  return problems;
+}
+
 void expect_invalid(const TriMesh& m, const std::vector<int>& p, const std::vector<int>& aux,
                     const std::string& fragment, const PartitionOptions& options = {}) {
   try {
@@ -132,6 +101,7 @@ TEST(PartitionGenus0, SphereEquatorLoopMakesNorthPatch0) {
                               nearest_vertex(m, {-1, 0, 0}), nearest_vertex(m, {0, -1, 0})};
   const PartitionResult r = partition_mesh(m, p, {});
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   // The loop runs CCW seen from +z, so patch 0 (left of the loop, outside) is the northern half.
   for (int k = 0; k < 2; ++k) {
     double z = 0.0;
@@ -160,6 +130,7 @@ TEST(PartitionGenus0, AuxiliaryPointsGuideThePaths) {
                                 nearest_vertex(m, {-0.7, -0.7, -0.1}), nearest_vertex(m, {0.7, -0.7, -0.1})};
   const PartitionResult r = partition_mesh(m, p, aux);
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   for (int k = 0; k < 4; ++k) {
     const auto& side = r.patches[0].sides[k].vertices;
     EXPECT_NE(std::find(side.begin(), side.end(), aux[k]), side.end()) << "side " << k;
@@ -178,6 +149,7 @@ TEST(PartitionGenus0, TetrahedronChordsAreSplit) {
   EXPECT_EQ(r.mesh.num_vertices(), 6u);
   EXPECT_EQ(r.mesh.num_triangles(), 8u);
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   PartitionOptions strict;
   strict.split_degenerate = false;
   expect_invalid(m, p, {}, "degenerate configuration", strict);
@@ -189,6 +161,7 @@ TEST(PartitionGenus0, CubeFaceLoopSplitsItsDiagonal) {
   const PartitionResult r = partition_mesh(m, p, {});
   EXPECT_EQ(r.split_vertices, 1u);
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   // Untouched triangles keep their ids and corners.
   int kept = 0;
   for (std::size_t f = 0; f < m.triangles.size(); ++f) kept += r.mesh.triangles[f] == m.triangles[f];
@@ -196,7 +169,8 @@ TEST(PartitionGenus0, CubeFaceLoopSplitsItsDiagonal) {
 }
 
 TEST(PartitionGenus0, EveryOrderedQuadrupleOnTetrahedronAndCubePartitions) {
-  // The coarsest closed meshes: paths are single edges, chords everywhere, corners walled in by earlier paths.
+  // The coarsest closed meshes: paths are single edges, chords everywhere, corners walled in by earlier
+  // paths.
   for (const TriMesh& m : {test::tetrahedron(), test::cube()}) {
     const int nv = static_cast<int>(m.positions.size());
     int count = 0;
@@ -209,7 +183,9 @@ TEST(PartitionGenus0, EveryOrderedQuadrupleOnTetrahedronAndCubePartitions) {
             ++count;
             try {
               const PartitionResult r = partition_mesh(m, p, {});
-              ASSERT_EQ(test::check_partition(m, p, r), "") << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+              ASSERT_EQ(test::check_partition(m, p, r), "")
+                  << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+              ASSERT_EQ(embedding_problems(r), "") << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
             } catch (const Error& e) {
               ADD_FAILURE() << p[0] << "," << p[1] << "," << p[2] << "," << p[3] << ": " << e.what();
             }
@@ -231,6 +207,7 @@ TEST(PartitionGenus0, WalledInCornerIsFreedBySplittingChords) {
   const PartitionResult r = partition_mesh(m, p, {});
   EXPECT_GT(r.split_vertices, 0u);
   EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
 }
 
 TEST(PartitionGenus0, RandomQuadruplesOnASubdividedCubeAreValidOrCleanlyRejected) {
@@ -245,7 +222,8 @@ TEST(PartitionGenus0, RandomQuadruplesOnASubdividedCubeAreValidOrCleanlyRejected
     const std::vector<int> p(ids.begin(), ids.begin() + 4);
     try {
       const PartitionResult r = partition_mesh(m, p, {});
-      EXPECT_EQ(test::check_partition(m, p, r), "") << "points " << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+      EXPECT_EQ(test::check_partition(m, p, r), "")
+          << "points " << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
       ++valid;
     } catch (const InvalidInput& e) {
       EXPECT_NE(std::string(e.what()).find("cannot trace path"), std::string::npos) << e.what();
@@ -266,6 +244,7 @@ TEST(PartitionGenus0, RandomPointsOnAFineSphereAlwaysPartition) {
     }
     const PartitionResult r = partition_mesh(m, p, {});
     EXPECT_EQ(test::check_partition(m, p, r), "") << "trial " << trial;
+    EXPECT_EQ(embedding_problems(r), "") << "trial " << trial;
   }
 }
 
@@ -318,7 +297,8 @@ TEST(PartitionChecks, TheCheckerCatchesBrokenResults) {
   }
   const std::string problems = test::check_partition(cube, q, unsplit);
   EXPECT_NE(problems.find("all vertices on the cut"), std::string::npos) << problems;
-  EXPECT_EQ(problems.find(';'), problems.rfind(';')) << "only one problem expected: " << problems;
+  EXPECT_NE(problems.find("edge (0,2) joins two cut vertices"), std::string::npos) << problems;
+  EXPECT_EQ(std::count(problems.begin(), problems.end(), ';'), 2) << "only the chord expected: " << problems;
 }
 
 TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {
@@ -329,6 +309,7 @@ TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {
   EXPECT_EQ(pts.auxiliary_points.size(), 4u);
   const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
   EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   const PartitionStats s = partition_stats(r);
   EXPECT_GT(s.area_balance, 0.9);
   // Each half is the top or the bottom (z) of the flat ellipsoid: nearly a height field.
@@ -339,6 +320,15 @@ TEST(PartitionGenus0, ChosenPointsCutAnEllipsoidAlongItsThinDirection) {
   EXPECT_GT(max_abs_x, 2.9);
 }
 
+TEST(PartitionGenus0, ChosenPointsWorkOnCoarseMeshes) {
+  for (const TriMesh& m : {test::cube(), subdivide(test::cube(), 1), sphere(1), test::tetrahedron()}) {
+    const PartitionPoints pts = choose_partition_points(m);
+    const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
+    EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "") << m.num_triangles() << " triangles";
+    EXPECT_EQ(embedding_problems(r), "");
+  }
+}
+
 // ------------------------------------------------------------------------------------------- genus 1
 
 struct TorusSetup {
@@ -346,21 +336,34 @@ struct TorusSetup {
   std::vector<int> p, aux;
 };
 
-// Torus grid (i around the big circle, j around the tube) with the corners and auxiliary points on grid lines.
+// Torus grid (i around the big circle, j around the tube) with the corners and auxiliary points on grid
+// lines.
 TorusSetup torus_setup(int n, int m) {
   TorusSetup t{test::torus(n, m), {}, {}};
   auto id = [&](int i, int j) { return ((i + n) % n) * m + (j + m) % m; };
   t.p = {id(0, 0), id(n / 2, 0), id(0, m / 2), id(n / 2, m / 2)};
-  t.aux = {id(n / 4, 0),     id(3 * n / 4, 0),     id(n / 4, m / 2), id(3 * n / 4, m / 2),
-           id(0, m / 4),     id(0, 3 * m / 4),     id(n / 2, m / 4), id(n / 2, 3 * m / 4)};
+  t.aux = {id(n / 4, 0), id(3 * n / 4, 0), id(n / 4, m / 2), id(3 * n / 4, m / 2),
+           id(0, m / 4), id(0, 3 * m / 4), id(n / 2, m / 4), id(n / 2, 3 * m / 4)};
   return t;
 }
 
-TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
-  const TorusSetup t = torus_setup(24, 12);
+// The same grid with the roles of the two directions swapped: mirrored with respect to the header's picture.
+TorusSetup mirrored(const TorusSetup& t) {
+  TorusSetup u = t;
+  u.p = {t.p[0], t.p[2], t.p[1], t.p[3]};
+  u.aux = {t.aux[4], t.aux[5], t.aux[6], t.aux[7], t.aux[0], t.aux[1], t.aux[2], t.aux[3]};
+  return u;
+}
+
+// Checks the documented genus-1 order on a torus grid; returns whether the layout is transposed (mirrored).
+bool check_torus_grid(const TorusSetup& t) {
   const PartitionResult r = partition_mesh(t.mesh, t.p, t.aux);
   EXPECT_EQ(test::check_partition(t.mesh, t.p, r), "");
-  ASSERT_EQ(r.patches.size(), 4u);
+  EXPECT_EQ(embedding_problems(r), "");
+  if (r.patches.size() != 4u) {
+    ADD_FAILURE() << r.patches.size() << " patches";
+    return false;
+  }
   auto side_between = [](const Patch& patch, int a, int b) -> const std::vector<int>* {
     for (int s = 0; s < 4; ++s) {
       const auto& v = patch.sides[s].vertices;
@@ -384,7 +387,8 @@ TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
     EXPECT_EQ(c[2], t.p[3 - (a + 2 * b)]) << "patch " << index;
   }
   // Side 0 is of the same kind (P0-P1/P2-P3 "horizontal" or P0-P2/P1-P3 "vertical") in all patches, so the
-  // 4 squares tile a 2x2 periodic grid with translations. Here: sides 0 and 2 of patch 0 vs 1 and 3 of patch 1.
+  // 4 squares tile a 2x2 periodic grid with translations. Here: sides 0 and 2 of patch 0 vs 1 and 3 of
+  // patch 1.
   auto horizontal = [&](const PatchSide& s) {
     const std::set<int> ends = {s.vertices.front(), s.vertices.back()};
     return ends == std::set<int>{t.p[0], t.p[1]} || ends == std::set<int>{t.p[2], t.p[3]};
@@ -414,12 +418,21 @@ TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
   EXPECT_EQ(r.split_vertices, 8u);
   // Symmetric torus, symmetric grid: equal areas.
   EXPECT_GT(partition_stats(r).area_balance, 0.999);
+  return transposed;
+}
+
+TEST(PartitionGenus1, TorusGridGivesFourQuadsInTheDocumentedOrder) {
+  const TorusSetup t = torus_setup(24, 12);
+  const bool transposed = check_torus_grid(t);
+  // Mirroring the placement transposes the layout and nothing else.
+  EXPECT_NE(check_torus_grid(mirrored(t)), transposed);
 }
 
 TEST(PartitionGenus1, CoarseTorusStillValid) {
   const TorusSetup t = torus_setup(8, 8);
   const PartitionResult r = partition_mesh(t.mesh, t.p, t.aux);
   EXPECT_EQ(test::check_partition(t.mesh, t.p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
 }
 
 TEST(PartitionGenus1, ContractibleEdgePairIsRejected) {
@@ -436,6 +449,7 @@ TEST(PartitionGenus1, ChosenPointsPartitionATorus) {
   ASSERT_EQ(pts.auxiliary_points.size(), 8u);
   const PartitionResult r = partition_mesh(m, pts.partition_points, pts.auxiliary_points);
   EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
   EXPECT_GT(partition_stats(r).area_balance, 0.6);
 }
 

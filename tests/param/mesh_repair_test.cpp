@@ -45,15 +45,7 @@ TEST(MeshRepair, ClosesAnOpenTubeKeepingOriginalVerticesInOrder) {
 }
 
 TEST(MeshRepair, SplitsPinchVertexAndCleansJunk) {
-  TriMesh a = test::tetrahedron();
-  TriMesh b = test::tetrahedron();
-  for (auto& p : b.positions) p += Eigen::Vector3d(2, 2, 2);
-  TriMesh m = test::join(a, b);
-  for (auto& t : m.triangles) {
-    for (int& v : t) {
-      if (v == 4) v = 0;
-    }
-  }
+  TriMesh m = test::pinched_tetrahedra();
   m.positions.push_back(m.positions[1]);      // a duplicate of vertex 1 ...
   m.triangles.push_back({0, 2, 8});           // ... used by a duplicate of face {0,1,2} -> merged and dropped
   m.triangles.push_back({1, 1, 2});           // repeated index

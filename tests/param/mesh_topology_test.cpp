@@ -49,16 +49,7 @@ TEST(MeshTopology, NonManifoldEdgeIsCountedAndGenusUndefined) {
 }
 
 TEST(MeshTopology, PinchVertexIsNonManifoldButGenusIsThatOfTheSplitSurface) {
-  // Two tetrahedra sharing one vertex (the first one's vertex 0).
-  TriMesh a = test::tetrahedron();
-  TriMesh b = test::tetrahedron();
-  for (auto& p : b.positions) p += Eigen::Vector3d(2, 2, 2);
-  TriMesh m = test::join(a, b);
-  for (auto& t : m.triangles) {
-    for (int& v : t) {
-      if (v == 4) v = 0;  // glue b's vertex 0 onto a's vertex 0
-    }
-  }
+  TriMesh m = test::pinched_tetrahedra();
   const TopologyReport r = analyze_topology(m);
   EXPECT_EQ(r.non_manifold_vertices, 1u);
   EXPECT_EQ(r.non_manifold_edges, 0u);

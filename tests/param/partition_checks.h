@@ -6,6 +6,8 @@
 #include "param/mesh_partition.h"
 #include "param/mesh_topology.h"
 
+#include <Eigen/SparseCholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -13,6 +15,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace geomip::test {
@@ -25,9 +28,86 @@ inline double surface_area(const TriMesh& m) {
   return a;
 }
 
-/// Every documented property of `r` = partition_mesh(input, points, aux). Returns "" when all hold, else a
-/// description of the first problems found.
-inline std::string check_partition(const TriMesh& input, const std::vector<int>& points, const PartitionResult& r) {
+/// Result of embedding one patch on the unit square with Tutte's uniform barycentric map (boundary by arc
+/// length along the 4 sides, corner s at (0,0), (1,0), (1,1), (0,1)).
+struct SquareEmbedding {
+  std::size_t flipped = 0;  ///< triangles with signed parameter area <= 0 (none if the patch is fit for §3.3)
+};
+
+/// Tutte's theorem (with Floater's 2003 condition) makes this map bijective on a disk with a convex boundary
+/// when no interior edge joins two boundary vertices on one side of the square: the partition must allow it.
+/// Exact in theory; in floating point, long thin parts (a horse's legs) shrink below double precision, so
+/// use it on well-conditioned meshes and rely on the combinatorial check of check_partition() elsewhere.
+inline SquareEmbedding tutte_square_embedding(const PartitionResult& r, int p) {
+  const TriMesh& m = r.mesh;
+  const Patch& patch = r.patches[p];
+  std::unordered_map<int, Eigen::Vector2d> uv;  // boundary vertices
+  for (int s = 0; s < 4; ++s) {
+    const auto& v = patch.sides[s].vertices;
+    const Eigen::Vector2d corner[5] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}};
+    std::vector<double> arc(v.size(), 0.0);
+    for (std::size_t i = 1; i < v.size(); ++i)
+      arc[i] = arc[i - 1] + (m.positions[v[i]] - m.positions[v[i - 1]]).norm();
+    for (std::size_t i = 0; i + 1 < v.size(); ++i) {
+      const double t = arc.back() > 0.0 ? arc[i] / arc.back() : 0.0;
+      uv[v[i]] = (1.0 - t) * corner[s] + t * corner[s + 1];
+    }
+  }
+  std::unordered_map<int, int> index;  // interior vertices
+  std::vector<int> interior;
+  std::vector<std::set<int>> neighbours;
+  auto id = [&](int v) {
+    auto [it, fresh] = index.emplace(v, static_cast<int>(interior.size()));
+    if (fresh) {
+      interior.push_back(v);
+      neighbours.emplace_back();
+    }
+    return it->second;
+  };
+  for (int f : patch.faces) {
+    const auto& t = m.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      if (!uv.count(t[k])) {
+        const int i = id(t[k]);
+        neighbours[i].insert(t[(k + 1) % 3]);
+        neighbours[i].insert(t[(k + 2) % 3]);
+      }
+    }
+  }
+  const int n = static_cast<int>(interior.size());
+  if (n > 0) {
+    std::vector<Eigen::Triplet<double>> trip;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 2);
+    for (int i = 0; i < n; ++i) {
+      trip.emplace_back(i, i, static_cast<double>(neighbours[i].size()));
+      for (int u : neighbours[i]) {
+        const auto b = uv.find(u);
+        if (b != uv.end()) {
+          rhs.row(i) += b->second.transpose();
+        } else {
+          trip.emplace_back(i, index.at(u), -1.0);
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> a(n, n);
+    a.setFromTriplets(trip.begin(), trip.end());
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(a);
+    const Eigen::MatrixXd x = solver.solve(rhs);
+    for (int i = 0; i < n; ++i) uv[interior[i]] = x.row(i).transpose();
+  }
+  SquareEmbedding e;
+  for (int f : patch.faces) {
+    const auto& t = m.triangles[f];
+    const Eigen::Vector2d &a = uv.at(t[0]), &b = uv.at(t[1]), &c = uv.at(t[2]);
+    if (!((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x() > 0.0)) ++e.flipped;
+  }
+  return e;
+}
+
+/// Every documented property of `r` = partition_mesh(input, points, aux), and Floater's condition for a
+/// one-to-one square embedding. Returns "" when all hold, else a description of the problems.
+inline std::string check_partition(const TriMesh& input, const std::vector<int>& points,
+                                   const PartitionResult& r) {
   std::ostringstream err;
   const TriMesh& m = r.mesh;
   const int nf = static_cast<int>(m.triangles.size());
@@ -69,7 +149,8 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
   }
   for (int f = 0; f < nf; ++f) {
     if (owner[f] < 0) err << "face " << f << " in no patch; ";
-    if (f < static_cast<int>(r.face_patch.size()) && r.face_patch[f] != owner[f]) err << "face_patch[" << f << "]; ";
+    if (f < static_cast<int>(r.face_patch.size()) && r.face_patch[f] != owner[f])
+      err << "face_patch[" << f << "]; ";
     if (err.tellp() > 2000) return err.str();
   }
 
@@ -77,7 +158,8 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
   const std::set<int> point_set(points.begin(), points.end());
   for (std::size_t p = 0; p < np; ++p) {
     const auto& c = r.patches[p].corners;
-    if (std::set<int>(c.begin(), c.end()) != point_set) err << "patch " << p << " corners are not the 4 points; ";
+    if (std::set<int>(c.begin(), c.end()) != point_set)
+      err << "patch " << p << " corners are not the 4 points; ";
     // Genus 0: P0; genus 1: patch 2a+b starts at P_{a+2b}.
     const int first = in_topo.genus == 0 ? points[0] : points[p / 2 + 2 * (p % 2)];
     if (c[0] != first) err << "patch " << p << " corner 0 is not the documented one; ";
@@ -97,6 +179,7 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
     for (int k = 0; k < 3; ++k) mesh_halfedges.insert(key(t[k], t[(k + 1) % 3]));
   }
   std::set<int> cut_vertices;
+  std::set<std::uint64_t> cut_halfedges;  // both directions
   for (std::size_t p = 0; p < np; ++p) {
     const Patch& patch = r.patches[p];
     std::set<std::uint64_t> side_halfedges;
@@ -108,13 +191,17 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
         continue;
       }
       for (std::size_t i = 0; i + 1 < v.size(); ++i) {
-        if (!mesh_halfedges.count(key(v[i], v[i + 1]))) err << "patch " << p << " side " << s << " not an edge path; ";
+        if (!mesh_halfedges.count(key(v[i], v[i + 1])))
+          err << "patch " << p << " side " << s << " not an edge path; ";
         side_halfedges.insert(key(v[i], v[i + 1]));
+        cut_halfedges.insert(key(v[i], v[i + 1]));
+        cut_halfedges.insert(key(v[i + 1], v[i]));
       }
       loop.insert(loop.end(), v.begin(), v.end() - 1);
       cut_vertices.insert(v.begin(), v.end());
     }
-    if (std::set<int>(loop.begin(), loop.end()).size() != loop.size()) err << "patch " << p << " loop not simple; ";
+    if (std::set<int>(loop.begin(), loop.end()).size() != loop.size())
+      err << "patch " << p << " loop not simple; ";
     // Disk: boundary half-edges of the patch's faces are exactly the sides' (same direction: CCW), V−E+F = 1.
     std::map<std::uint64_t, int> edge_use;
     std::set<int> verts;
@@ -166,6 +253,18 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
     if (!l.reversed) err << "a link is not reversed on an oriented surface; ";
     std::reverse(a.begin(), a.end());
     if (a != b) err << "glued sides differ; ";
+  }
+  // Fit for the square embedding of §3.3 (Floater's condition): no interior edge joins two cut vertices.
+  for (int f = 0; f < nf; ++f) {
+    const auto& t = m.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a < b && cut_vertices.count(a) && cut_vertices.count(b) && !cut_halfedges.count(key(a, b))) {
+        err << "edge (" << a << "," << b << ") joins two cut vertices across a patch; ";
+        f = nf;
+        break;
+      }
+    }
   }
   return err.str();
 }

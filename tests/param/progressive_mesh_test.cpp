@@ -11,12 +11,14 @@
 #include <map>
 #include <random>
 #include <set>
+#include <string>
+#include <tuple>
 
 namespace geomip {
 namespace {
 
-/// The (n+1)×(n+1) grid lifted to a bump of height `height`, with interior vertices jittered in the plane so
-/// that collapses are not all ties.
+/// The (n+1)×(n+1) grid lifted to a bump of height `height` plus low waves, with interior vertices jittered
+/// in the plane so that collapses are not all ties.
 TriMesh bump(int n, double height, unsigned seed = 1) {
   TriMesh m = test::grid(n);
   std::mt19937 rng(seed);
@@ -26,7 +28,8 @@ TriMesh bump(int n, double height, unsigned seed = 1) {
       auto& p = m.positions[j * (n + 1) + i];
       if (i > 0 && i < n && j > 0 && j < n) p += Eigen::Vector3d(jitter(rng), jitter(rng), 0);
       const double r2 = (p.x() - 0.5) * (p.x() - 0.5) + (p.y() - 0.45) * (p.y() - 0.45);
-      p.z() = height * std::exp(-r2 / 0.04);
+      // The waves make the sides curved in 3D, so that flat (collinear) triangles do not shield the locks.
+      p.z() = height * std::exp(-r2 / 0.04) + 0.05 * (std::sin(7 * p.x()) + std::cos(5 * p.y()));
     }
   }
   return m;
@@ -71,13 +74,14 @@ struct Fixture {
   ProgressiveMesh pm;
 };
 
-Fixture make_bump(int n, std::size_t target = 0) {
+Fixture make_bump(int n, std::size_t target = 0, double max_normal_deviation = 90.0) {
   Fixture f;
   f.patch = bump(n, 0.35);
   f.sides = patch_sides(f.patch, grid_corners(n));
   f.features = {(n / 2) * (n + 1) + n / 2, (n / 4) * (n + 1) + 3 * n / 4, (3 * n / 4) * (n + 1) + n / 3};
   ProgressiveMeshOptions options;
   options.target_vertices = target;
+  options.max_normal_deviation_degrees = max_normal_deviation;
   f.pm = progressive_mesh(f.patch, f.sides, f.features, options);
   return f;
 }
@@ -156,8 +160,8 @@ TEST(ProgressiveMesh, BaseBoundaryVisitsEachSideInOrder) {
   EXPECT_EQ(steps, next.size()) << "the base mesh has more than one boundary loop";
 }
 
-TEST(ProgressiveMesh, BaseMeshIsADiskWithoutFlatTriangles) {
-  const Fixture f = make_bump(30);
+/// The base mesh is a disk with no triangle and no interior edge on one side.
+void expect_disk_without_flat_triangles(const Fixture& f) {
   TriMesh base{f.patch.positions, f.pm.base_triangles};
   const TopologyReport topo = analyze_topology(base);
   EXPECT_TRUE(topo.manifold);
@@ -178,6 +182,53 @@ TEST(ProgressiveMesh, BaseMeshIsADiskWithoutFlatTriangles) {
         EXPECT_EQ(mask[a] & mask[b], 0) << "interior edge " << a << "-" << b << " on one side";
       }
     }
+  }
+}
+
+TEST(ProgressiveMesh, BaseMeshIsADiskWithoutFlatTriangles) {
+  // Down to 100 vertices, to 5 (as far as the locks allow), and without the normal test (only the locks keep
+  // the sides straight and chord-free then).
+  for (const auto& [n, target, normals] :
+       {std::tuple<int, std::size_t, double>{30, 0, 90.0}, {16, 5, 90.0}, {24, 12, 180.0}, {24, 40, 180.0}}) {
+    SCOPED_TRACE("n " + std::to_string(n) + ", target " + std::to_string(target));
+    expect_disk_without_flat_triangles(make_bump(n, target, normals));
+  }
+}
+
+TEST(ProgressiveMesh, NoLevelHasAnInteriorEdgeOnOneSide) {
+  // Replays the collapses fine to coarse and checks every edge each collapse creates: an interior edge
+  // between two vertices of one side would make a flat triangle at that level of the coarse-to-fine pass.
+  for (const auto& [n, target, normals] :
+       {std::tuple<int, std::size_t, double>{30, 0, 90.0}, {16, 5, 90.0}, {24, 12, 180.0}}) {
+    SCOPED_TRACE("n " + std::to_string(n) + ", target " + std::to_string(target));
+    const Fixture f = make_bump(n, target, normals);
+    const std::vector<int> mask = side_masks(f.patch.num_vertices(), f.sides);
+    std::vector<std::array<int, 3>> tris = f.patch.triangles;
+    std::map<std::pair<int, int>, int> faces_on_edge;
+    auto count_edges = [&](const std::array<int, 3>& t, int delta) {
+      for (int i = 0; i < 3; ++i) {
+        faces_on_edge[{std::min(t[i], t[(i + 1) % 3]), std::max(t[i], t[(i + 1) % 3])}] += delta;
+      }
+    };
+    for (const auto& t : tris) count_edges(t, 1);
+    std::size_t violations = 0;
+    for (const auto& c : f.pm.collapses) {
+      for (int id : {c.left_triangle, c.right_triangle}) {
+        if (id >= 0) count_edges(tris[id], -1);
+      }
+      for (int id : c.moved_triangles) {
+        count_edges(tris[id], -1);
+        std::replace(tris[id].begin(), tris[id].end(), c.removed, c.kept);
+        count_edges(tris[id], 1);
+      }
+      for (int id : c.moved_triangles) {
+        for (int i = 0; i < 3; ++i) {
+          const int a = tris[id][i], b = tris[id][(i + 1) % 3];
+          if ((mask[a] & mask[b]) != 0 && faces_on_edge[{std::min(a, b), std::max(a, b)}] == 2) ++violations;
+        }
+      }
+    }
+    EXPECT_EQ(violations, 0u);
   }
 }
 
@@ -221,6 +272,33 @@ TEST(ProgressiveMesh, StopsWhenOnlyLockedCollapsesRemain) {
   TriMesh base{f.patch.positions, f.pm.base_triangles};
   const TopologyReport topo = analyze_topology(base);
   EXPECT_TRUE(topo.manifold && topo.components == 1 && topo.boundary_loops == 1 && topo.genus == 0);
+}
+
+TEST(ProgressiveMesh, NeverCollapsesIntoAChordOnOneSide) {
+  // A square pyramid: 12 boundary vertices (corners and two more per side, all features) around one apex.
+  // Collapsing the apex into any boundary vertex would join it by an interior edge to a vertex of its own
+  // side that is not its boundary neighbour, and flatten the triangles in between: no collapse is legal.
+  TriMesh fan;
+  const Eigen::Vector2d corner[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (int k = 0; k < 4; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector2d q = corner[k] + (i / 3.0) * (corner[(k + 1) % 4] - corner[k]);
+      fan.positions.emplace_back(q.x(), q.y(), 0.0);
+    }
+  }
+  fan.positions.emplace_back(0.5, 0.5, 0.3);
+  for (int i = 0; i < 12; ++i) fan.triangles.push_back({i, (i + 1) % 12, 12});
+  const PatchSides sides = patch_sides(fan, {0, 3, 6, 9});
+  std::vector<int> features;
+  for (int i = 0; i < 12; ++i) {
+    if (i % 3 != 0) features.push_back(i);
+  }
+  ProgressiveMeshOptions options;
+  options.target_vertices = 5;
+  options.max_normal_deviation_degrees = 180.0;  // only the locks decide
+  const ProgressiveMesh pm = progressive_mesh(fan, sides, features, options);
+  EXPECT_TRUE(pm.collapses.empty());
+  EXPECT_EQ(pm.base_vertices.size(), 13u);
 }
 
 TEST(ProgressiveMesh, RejectsInvalidPatches) {

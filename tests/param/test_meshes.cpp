@@ -76,9 +76,8 @@ TriMesh grid(int n) {
   return g;
 }
 
-TriMesh sphere(int levels) {
-  TriMesh m = cube();
-  for (auto& p : m.positions) p -= Eigen::Vector3d::Constant(0.5);
+TriMesh subdivide(const TriMesh& mesh, int levels) {
+  TriMesh m = mesh;
   for (int l = 0; l < levels; ++l) {
     std::map<std::pair<int, int>, int> mid;
     auto midpoint = [&](int a, int b) {
@@ -98,7 +97,26 @@ TriMesh sphere(int levels) {
     }
     m.triangles = std::move(finer);
   }
+  return m;
+}
+
+TriMesh sphere(int levels) {
+  TriMesh c = cube();
+  for (auto& p : c.positions) p -= Eigen::Vector3d::Constant(0.5);
+  TriMesh m = subdivide(c, levels);
   for (auto& p : m.positions) p.normalize();
+  return m;
+}
+
+TriMesh pinched_tetrahedra() {
+  TriMesh b = tetrahedron();
+  for (auto& p : b.positions) p += Eigen::Vector3d(2, 2, 2);
+  TriMesh m = join(tetrahedron(), b);
+  for (auto& t : m.triangles) {
+    for (int& v : t) {
+      if (v == 4) v = 0;  // glue the second tetrahedron's vertex 0 onto the first one's
+    }
+  }
   return m;
 }
 

@@ -17,6 +17,10 @@ TriMesh torus(int n, int m);
 TriMesh open_cylinder(int n, int m);
 /// Flat (n+1)×(n+1) grid on the unit square in z = 0: a disk with one boundary loop.
 TriMesh grid(int n);
+/// 1-to-4 midpoint subdivision, `levels` times (positions not moved).
+TriMesh subdivide(const TriMesh& mesh, int levels);
+/// Two tetrahedra sharing one vertex (a "pinch"): 7 referenced vertices, 8 faces, vertex 4 unreferenced.
+TriMesh pinched_tetrahedra();
 /// Unit sphere around the origin: a cube subdivided `levels` times (1-to-4) and projected, 12·4^levels triangles.
 TriMesh sphere(int levels);
 /// Index of the vertex nearest to `p` (brute force).

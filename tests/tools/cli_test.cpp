@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -338,6 +339,50 @@ TEST_F(CliGimage, BadInputsExitTwo) {
   EXPECT_FALSE(fs::exists(out));
   for (const char* args : {"gimage --help", "remesh --help"}) EXPECT_EQ(geomip(args).exit_code, 0) << args;
   EXPECT_EQ(geomip("gimage '" + spot_ + "' -o '" + out + "'").exit_code, 2);  // --level is required
+}
+
+TEST_F(Cli, EvalReportsMetroDistancesAndInfinitePsnrForIdenticalMeshes) {
+  // A unit square and a copy 0.25 above it: every distance is 0.25, PSNR = 20·log10(√2 / 0.25).
+  const std::string square = file("square.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+  const std::string lifted =
+      file("lifted.obj", "v 0 0 0.25\nv 1 0 0.25\nv 1 1 0.25\nv 0 1 0.25\nf 1 2 4\nf 2 3 4\n");
+  const Outcome r = geomip("eval --json --samples 5000 '" + square + "' '" + lifted + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"hausdorff_pct", "rms_pct", "psnr_db", "hausdorff", "rms", "bbox_diagonal",
+                          "original_to_approx", "approx_to_original", "seed"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_NEAR(j["hausdorff"].get<double>(), 0.25, 1e-12);
+  EXPECT_NEAR(j["rms"].get<double>(), 0.25, 1e-12);
+  EXPECT_NEAR(j["bbox_diagonal"].get<double>(), std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(j["hausdorff_pct"].get<double>(), 25 / std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(j["psnr_db"].get<double>(), 20 * std::log10(std::sqrt(2.0) / 0.25), 1e-9);
+  for (const char* side : {"original_to_approx", "approx_to_original"}) {
+    EXPECT_EQ(j[side]["face_samples"], 5000) << side;
+    EXPECT_EQ(j[side]["vertex_samples"], 4) << side;
+    EXPECT_EQ(j[side]["samples"], 5004) << side;
+  }
+  // Text form of the same.
+  const Outcome text = geomip("eval --samples 5000 '" + square + "' '" + lifted + "'");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("PSNR: 15.05 dB"), std::string::npos) << text.out;
+
+  // Identical surfaces: PSNR is +inf, "inf" in text and null in JSON.
+  const Outcome same = geomip("eval --json '" + square + "' '" + square + "'");
+  ASSERT_EQ(same.exit_code, 0) << same.err;
+  const auto k = nlohmann::json::parse(same.out);
+  EXPECT_TRUE(k["psnr_db"].is_null());
+  EXPECT_EQ(k["hausdorff"], 0.0);
+  EXPECT_NE(geomip("eval '" + square + "' '" + square + "'").out.find("PSNR: inf dB"), std::string::npos);
+
+  // Bad input: one line, exit 2, naming the file.
+  const std::string missing = dir_ + "/missing.obj";
+  expect_bad_input("eval '" + square + "' '" + missing + "'", missing);
+  const std::string flat = file("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+  expect_bad_input("eval '" + flat + "' '" + square + "'", flat);
+  EXPECT_EQ(geomip("eval '" + square + "'").exit_code, 2);  // APPROX missing
+  EXPECT_EQ(geomip("eval --help").exit_code, 0);
 }
 
 }  // namespace

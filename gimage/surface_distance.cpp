@@ -1,0 +1,281 @@
+// Metro-style surface distance (see surface_distance.h). CGAL's AABB tree lives here only.
+#include "gimage/surface_distance.h"
+
+#include "param/errors.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace geomip {
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using Point = Kernel::Point_3;
+using Triangle = Kernel::Triangle_3;
+using TriangleIterator = std::vector<Triangle>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+
+constexpr const char* kFunction = "measure_surface_distance";
+/// Samples per unit of work: chunks are fixed, so the reduction order (and the result) does not depend on the
+/// number of threads.
+constexpr std::size_t kChunk = 4096;
+constexpr std::size_t kAutoSamplesPerFace = 10;
+constexpr std::size_t kAutoMinSamples = 10000;
+constexpr std::size_t kAutoMaxSamples = 1000000;
+
+Point to_point(const Eigen::Vector3d& p) {
+  return Point(p.x(), p.y(), p.z());
+}
+
+double triangle_area(const TriMesh& mesh, const std::array<int, 3>& t) {
+  const Eigen::Vector3d& a = mesh.positions[t[0]];
+  return 0.5 * (mesh.positions[t[1]] - a).cross(mesh.positions[t[2]] - a).norm();
+}
+
+/// Checks the preconditions of one input mesh; `which` is "original" or "approx".
+void validate(const TriMesh& mesh, const char* which) {
+  auto fail = [&](const std::string& problem) {
+    throw InvalidInput(std::string(kFunction) + ": " + which + " mesh " + problem);
+  };
+  if (mesh.triangles.empty()) fail("has no triangles");
+  const int n = static_cast<int>(mesh.positions.size());
+  bool has_area = false;
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    for (int v : mesh.triangles[f]) {
+      if (v < 0 || v >= n) {
+        fail("triangle " + std::to_string(f) + " has vertex index " + std::to_string(v) +
+             " out of range [0, " + std::to_string(n) + ")");
+      }
+      if (!mesh.positions[v].allFinite())
+        fail("vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+    has_area = has_area || triangle_area(mesh, mesh.triangles[f]) > 0;
+  }
+  if (!has_area) fail("has no triangle of nonzero area");
+}
+
+/// The searched side of a mesh: its nonzero-area triangles in an AABB tree with the kd-tree of distance
+/// hints built. Not copyable: the tree refers into `triangles_`.
+class SearchSurface {
+ public:
+  explicit SearchSurface(const TriMesh& mesh) {
+    triangles_.reserve(mesh.triangles.size());
+    for (const auto& t : mesh.triangles) {
+      if (triangle_area(mesh, t) > 0) {
+        triangles_.emplace_back(to_point(mesh.positions[t[0]]), to_point(mesh.positions[t[1]]),
+                                to_point(mesh.positions[t[2]]));
+      }
+    }
+    tree_.insert(triangles_.cbegin(), triangles_.cend());
+    tree_.build();
+    tree_.accelerate_distance_queries();
+  }
+  SearchSurface(const SearchSurface&) = delete;
+  SearchSurface& operator=(const SearchSurface&) = delete;
+
+  const Tree& tree() const { return tree_; }
+
+ private:
+  std::vector<Triangle> triangles_;
+  Tree tree_;
+};
+
+/// Deterministic uniform doubles in [0, 1) from a 64-bit Mersenne twister (53 random bits each), the same on
+/// every standard library (std::uniform_real_distribution is not).
+class Uniform {
+ public:
+  explicit Uniform(std::uint64_t seed) : engine_(seed) {}
+  double operator()() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+struct Samples {
+  std::vector<Point> points;
+  std::size_t vertices = 0, edges = 0, faces = 0;
+};
+
+std::size_t face_sample_count(const TriMesh& mesh, const SurfaceDistanceOptions& options) {
+  if (options.face_samples > 0) return options.face_samples;
+  return std::clamp(kAutoSamplesPerFace * mesh.num_triangles(), kAutoMinSamples, kAutoMaxSamples);
+}
+
+/// Metro's sampling of one surface: referenced vertices, then points evenly spaced by length along the unique
+/// edges (random phase), then area-uniform random points on the faces, emitted face by face so that
+/// consecutive queries are close (the previous closest point is a good hint).
+Samples sample_surface(const TriMesh& mesh, const SurfaceDistanceOptions& options, std::uint64_t stream) {
+  Samples s;
+  Uniform uniform(options.seed ^ (0x9e3779b97f4a7c15ull * (stream + 1)));
+
+  if (options.sample_vertices) {
+    std::vector<char> referenced(mesh.positions.size(), 0);
+    for (const auto& t : mesh.triangles) {
+      for (int v : t) referenced[v] = 1;
+    }
+    for (std::size_t v = 0; v < referenced.size(); ++v) {
+      if (referenced[v]) s.points.push_back(to_point(mesh.positions[v]));
+    }
+    s.vertices = s.points.size();
+  }
+
+  if (options.edge_samples > 0) {
+    std::vector<std::pair<int, int>> edges;
+    edges.reserve(3 * mesh.triangles.size());
+    for (const auto& t : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) edges.emplace_back(std::minmax(t[k], t[(k + 1) % 3]));
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    double total = 0;
+    for (const auto& [a, b] : edges) total += (mesh.positions[b] - mesh.positions[a]).norm();
+    if (total > 0) {
+      const double step = total / static_cast<double>(options.edge_samples);
+      double next = uniform() * step;  // arc length (over all edges) of the next sample
+      double start = 0;
+      for (const auto& [a, b] : edges) {
+        const double length = (mesh.positions[b] - mesh.positions[a]).norm();
+        while (next < start + length && s.edges < options.edge_samples) {
+          const double t = (next - start) / length;
+          s.points.push_back(to_point((1 - t) * mesh.positions[a] + t * mesh.positions[b]));
+          ++s.edges;
+          next += step;
+        }
+        start += length;
+      }
+    }
+  }
+
+  const std::size_t n = face_sample_count(mesh, options);
+  std::vector<double> cumulative(mesh.triangles.size());
+  double total_area = 0;
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    total_area += triangle_area(mesh, mesh.triangles[f]);
+    cumulative[f] = total_area;
+  }
+  // n i.i.d. area-uniform face choices, sorted so that they come face by face.
+  std::vector<double> picks(n);
+  for (double& x : picks) x = uniform() * total_area;
+  std::sort(picks.begin(), picks.end());
+  s.points.reserve(s.points.size() + n);
+  std::size_t f = 0;
+  for (double x : picks) {
+    while (f + 1 < cumulative.size() && cumulative[f] <= x) ++f;
+    const auto& t = mesh.triangles[f];
+    double u = uniform(), v = uniform();
+    if (u + v > 1) {
+      u = 1 - u;
+      v = 1 - v;
+    }
+    const Eigen::Vector3d& a = mesh.positions[t[0]];
+    s.points.push_back(to_point(a + u * (mesh.positions[t[1]] - a) + v * (mesh.positions[t[2]] - a)));
+  }
+  s.faces = n;
+  return s;
+}
+
+struct Accumulator {
+  double max = 0, sum = 0, sum_squares = 0;
+};
+
+/// Distances from every sample to `target`, reduced to max / mean / RMS. Distances at or below `noise_floor`
+/// count as 0.
+OneSidedDistance one_sided(const Samples& samples, const SearchSurface& target, double noise_floor,
+                           unsigned threads) {
+  const std::size_t n = samples.points.size();
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<Accumulator> partial(chunks);
+  std::atomic<std::size_t> next_chunk{0};
+  auto work = [&] {
+    for (std::size_t c = next_chunk++; c < chunks; c = next_chunk++) {
+      Accumulator acc;
+      const std::size_t end = std::min(n, (c + 1) * kChunk);
+      Point hint = target.tree().closest_point(samples.points[c * kChunk]);
+      for (std::size_t i = c * kChunk; i < end; ++i) {
+        const Point& p = samples.points[i];
+        hint = target.tree().closest_point(p, hint);
+        double d = std::sqrt(CGAL::squared_distance(p, hint));
+        if (d <= noise_floor) d = 0;
+        acc.max = std::max(acc.max, d);
+        acc.sum += d;
+        acc.sum_squares += d * d;
+      }
+      partial[c] = acc;
+    }
+  };
+  const unsigned pool = static_cast<unsigned>(std::min<std::size_t>(std::max(1u, threads), chunks));
+  std::vector<std::thread> workers;
+  for (unsigned t = 1; t < pool; ++t) workers.emplace_back(work);
+  work();
+  for (auto& w : workers) w.join();
+
+  Accumulator total;
+  for (const Accumulator& a : partial) {
+    total.max = std::max(total.max, a.max);
+    total.sum += a.sum;
+    total.sum_squares += a.sum_squares;
+  }
+  OneSidedDistance r;
+  r.max = total.max;
+  r.mean = n ? total.sum / static_cast<double>(n) : 0;
+  r.rms = n ? std::sqrt(total.sum_squares / static_cast<double>(n)) : 0;
+  r.vertex_samples = samples.vertices;
+  r.edge_samples = samples.edges;
+  r.face_samples = samples.faces;
+  return r;
+}
+
+double max_abs_coordinate(const TriMesh& mesh) {
+  double m = 0;
+  for (const auto& t : mesh.triangles) {
+    for (int v : t) m = std::max(m, mesh.positions[v].cwiseAbs().maxCoeff());
+  }
+  return m;
+}
+
+}  // namespace
+
+SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh& approx,
+                                         const SurfaceDistanceOptions& options) {
+  validate(original, "original");
+  validate(approx, "approx");
+  const unsigned threads =
+      options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const double noise_floor = 64 * std::numeric_limits<double>::epsilon() *
+                             std::max(max_abs_coordinate(original), max_abs_coordinate(approx));
+
+  SurfaceDistance r;
+  {
+    const SearchSurface approx_surface(approx);
+    r.original_to_approx =
+        one_sided(sample_surface(original, options, 0), approx_surface, noise_floor, threads);
+  }
+  {
+    const SearchSurface original_surface(original);
+    r.approx_to_original =
+        one_sided(sample_surface(approx, options, 1), original_surface, noise_floor, threads);
+  }
+  r.hausdorff = std::max(r.original_to_approx.max, r.approx_to_original.max);
+  r.rms = std::max(r.original_to_approx.rms, r.approx_to_original.rms);
+  r.bbox_diagonal = referenced_bounding_box(original).diagonal();
+  r.hausdorff_pct = 100 * r.hausdorff / r.bbox_diagonal;
+  r.rms_pct = 100 * r.rms / r.bbox_diagonal;
+  r.psnr_db = r.rms > 0 ? 20 * std::log10(r.bbox_diagonal / r.rms) : std::numeric_limits<double>::infinity();
+  return r;
+}
+
+}  // namespace geomip

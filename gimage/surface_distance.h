@@ -1,0 +1,82 @@
+// Metro-style surface distance between two triangle meshes: sampled one-sided distances both ways, symmetric
+// Hausdorff and RMS, and the PSNR used by the consistent mesh parameterization paper (§5) to judge remeshes.
+//
+// Cignoni, Rocchini, Scopigno, "Metro: measuring error on simplified surfaces", Computer Graphics Forum
+// 17(2), 1998. Each surface is sampled (all its vertices plus area-uniform random points on its faces,
+// optionally points along its edges); for every sample the exact distance to the closest point of the OTHER
+// surface is taken (an AABB tree over its triangles). Like Metro and MeshLab's "Hausdorff Distance" filter
+// (Metro's code), the mean and RMS are plain averages over all samples: the face samples are area-uniform, so
+// their average estimates the area integral, and the vertex (and edge) samples enter with the same weight as
+// any other sample (a slight bias that Metro accepts for finding the maxima, which sit on vertices and
+// edges).
+#pragma once
+
+#include "param/mesh.h"
+
+#include <cstddef>
+#include <cstdint>
+
+namespace geomip {
+
+struct SurfaceDistanceOptions {
+  /// Area-uniform random samples on the faces of EACH surface. 0 (default) = automatic: 10 per face of the
+  /// sampled surface, at least 10,000 and at most 1,000,000 (Metro takes 10·max(#faces) for both surfaces;
+  /// 10 per own face keeps a coarse approximation cheap, and its RMS within about ±2% over seeds).
+  std::size_t face_samples = 0;
+  /// Sample every referenced vertex of each surface (Metro -v; on by default, as in MeshLab's filter).
+  bool sample_vertices = true;
+  /// Points spaced uniformly by length along the unique edges of each surface (Metro -e); 0 (default) = none.
+  std::size_t edge_samples = 0;
+  /// Seed of the random face samples: the same seed gives bit-identical results, whatever `threads` is.
+  std::uint64_t seed = 0x5eed;
+  /// Worker threads for the distance queries; 0 = std::thread::hardware_concurrency().
+  unsigned threads = 0;
+};
+
+/// One-sided distance from the samples of surface `from` to the surface `to`, in the meshes' units.
+struct OneSidedDistance {
+  double max = 0;   ///< largest sample distance (one-sided Hausdorff distance, as sampled)
+  double mean = 0;  ///< average sample distance
+  double rms = 0;   ///< sqrt of the average squared sample distance
+  std::size_t vertex_samples = 0;
+  std::size_t edge_samples = 0;
+  std::size_t face_samples = 0;
+  std::size_t samples() const { return vertex_samples + edge_samples + face_samples; }
+};
+
+/// Result of `measure_surface_distance()`. Distances in the meshes' units; "_pct" in percent of
+/// `bbox_diagonal`.
+struct SurfaceDistance {
+  OneSidedDistance original_to_approx;  ///< samples on the original, distances to the approximation
+  OneSidedDistance approx_to_original;  ///< samples on the approximation, distances to the original
+  double hausdorff = 0;                 ///< symmetric Hausdorff distance: max of the two one-sided maxima
+  double rms = 0;            ///< symmetric RMS distance: the larger of the two one-sided RMS (Metro)
+  double bbox_diagonal = 0;  ///< diagonal of the ORIGINAL's bounding box (its referenced vertices)
+  double hausdorff_pct = 0;  ///< 100·hausdorff / bbox_diagonal
+  double rms_pct = 0;        ///< 100·rms / bbox_diagonal
+  /// 20·log10(bbox_diagonal / rms) in dB; +infinity when rms == 0 (identical surfaces).
+  double psnr_db = 0;
+};
+
+/// Measures the distance between the surface `original` and its approximation `approx` as Metro does
+/// (see the top of this file), both ways, and the PSNR of the consistent-parameterization paper (§5):
+/// PSNR = 20·log10(peak / d), peak = `original`'s bounding-box diagonal, d = symmetric RMS distance.
+///
+/// Distances are exact point-to-triangle distances (CGAL AABB tree, double precision, one tree per mesh
+/// built once). Triangles of zero area are not searched (their points lie on their edges, which other
+/// triangles normally share) and get no face samples; their vertices are still sampled. Distances below the
+/// floating-point resolution of the coordinates (64 ulps of the largest |coordinate| of both meshes) are
+/// reported as 0, so identical meshes measure exactly 0 and a PSNR of +infinity.
+///
+/// Cost: O((F₀ + F₁) log F) for the trees plus one closest-point query per sample (about 1–2.5 µs each);
+/// the Stanford bunny (69,451 faces) against bunny-small (6,966 faces) with the default sampling (802k
+/// samples) takes about one second.
+///
+/// \param original the reference surface (#V×3 positions, #F triangles); its bounding box gives the peak.
+/// \param approx the approximation (remesh, decoded mesh), in the same coordinate frame.
+/// \pre both meshes have at least one triangle of nonzero area, indices in range, finite coordinates.
+/// \throw InvalidInput naming `measure_surface_distance` and the mesh when a precondition fails.
+SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh& approx,
+                                         const SurfaceDistanceOptions& options = {});
+
+}  // namespace geomip

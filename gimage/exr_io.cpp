@@ -130,6 +130,22 @@ std::vector<SideLink> adjacency_from_text(const std::string& text) {
   return links;
 }
 
+std::vector<GeometryImage> finest_grids(const GeometryImageFile& file) {
+  std::vector<GeometryImage> grids;
+  for (std::size_t p = 0; p < file.parts.size(); ++p) {
+    GeometryImage g;
+    g.level = file.info.level;
+    if (g.level < 0 || g.level > kMaxGeometryImageLevel || file.parts[p].empty() ||
+        file.parts[p][0].width != g.size() || file.parts[p][0].height != g.size()) {
+      throw InvalidInput("finest_grids: part " + std::to_string(p) + " is not a (2^" +
+                         std::to_string(g.level) + "+1)² grid");
+    }
+    g.values = file.parts[p][0].rgb;
+    grids.push_back(std::move(g));
+  }
+  return grids;
+}
+
 GeometryImage nested_grid(const GeometryImage& image, int level) {
   if (level < 0 || level > image.level) {
     throw InvalidInput("nested_grid: level " + std::to_string(level) + " is outside [0, " +

@@ -67,6 +67,10 @@ struct GeometryImageFile {
 ///   or the adjacency attribute is malformed.
 GeometryImageFile read_geometry_image_exr(const std::string& path);
 
+/// The finest MIP level of every part of `file` as GeometryImages (what write_geometry_image_exr() wrote).
+/// \throw InvalidInput when a part's finest level is not square of size 2^n + 1 for the file's level n.
+std::vector<GeometryImage> finest_grids(const GeometryImageFile& file);
+
 /// The nested grid of `image` at a coarser level: every 2^(image.level − level)-th sample.
 /// \throw InvalidInput when level is negative or above image.level.
 GeometryImage nested_grid(const GeometryImage& image, int level);

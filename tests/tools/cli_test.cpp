@@ -5,8 +5,8 @@
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <nlohmann/json.hpp>
+#include <sys/wait.h>
 
 #include <cmath>
 #include <filesystem>
@@ -66,7 +66,7 @@ TEST_F(Cli, HelpOnEveryCommand) {
     EXPECT_EQ(r.exit_code, 0) << args;
     EXPECT_NE(r.out.find("Usage"), std::string::npos) << args;
   }
-  EXPECT_EQ(geomip("").exit_code, 2);              // no subcommand
+  EXPECT_EQ(geomip("").exit_code, 2);             // no subcommand
   EXPECT_EQ(geomip("frobnicate x").exit_code, 2);  // unknown subcommand
   EXPECT_EQ(geomip("info").exit_code, 2);          // missing argument
 }
@@ -76,9 +76,9 @@ TEST_F(Cli, InfoJsonHasTheDocumentedKeys) {
   const Outcome r = geomip("info --json '" + mesh + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  for (const char* key :
-       {"vertices", "faces", "components", "boundary_loops", "genus", "manifold", "non_manifold_edges",
-        "non_manifold_vertices", "degenerate_faces", "unreferenced_vertices", "bbox_diagonal"}) {
+  for (const char* key : {"vertices", "faces", "components", "boundary_loops", "genus", "manifold",
+                          "non_manifold_edges", "non_manifold_vertices", "degenerate_faces",
+                          "unreferenced_vertices", "bbox_diagonal"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["vertices"], 2930);
@@ -123,7 +123,7 @@ TEST_F(Cli, RepairWritesAtomicallyAndNeverLeavesPartialFiles) {
   EXPECT_EQ(slurp(out), "precious");
   // Output into a missing directory: a clear error, nothing written.
   const Outcome bad_dir = geomip("repair '" + std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj' -o '" + dir_ +
-                                 "/no/such/dir/x.obj'");
+                             "/no/such/dir/x.obj'");
   EXPECT_NE(bad_dir.exit_code, 0);
   EXPECT_NE(bad_dir.err.find("does not exist"), std::string::npos) << bad_dir.err;
   // Unsupported output format is rejected before any work.
@@ -171,8 +171,7 @@ class CliParam : public Cli {
     return file(name, "{\"models\": [" + models_json + "]}");
   }
   std::string model(const std::string& points, const std::string& features = "[]") {
-    return "{\"mesh\": \"" + spot_ + "\", \"partition_points\": " + points + ", \"features\": " + features +
-           "}";
+    return "{\"mesh\": \"" + spot_ + "\", \"partition_points\": " + points + ", \"features\": " + features + "}";
   }
 };
 
@@ -235,9 +234,8 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
   expect_two(corr("dup.json", model("[10, 10, 200, 300]")), "distinct");
   expect_two(corr("range.json", model("[10, 20, 30, 99999]")), "99999");
   expect_two(corr("three.json", model("[10, 20, 30]")), "4 points");
-  expect_two(
-      corr("features.json", model("[0, 1000, 2000, 2900]", "[5]") + "," + model("[0, 1000, 2000, 2900]")),
-      "features");
+  expect_two(corr("features.json", model("[0, 1000, 2000, 2900]", "[5]") + "," + model("[0, 1000, 2000, 2900]")),
+             "features");
   expect_two(file("garbage.json", "{not json"), "JSON");
   expect_two(dir_ + "/missing.json", "no such file");
   // Several meshes without a correspondence file.
@@ -267,8 +265,7 @@ class CliGimage : public Cli {
     }
     std::string points = "[";
     const Eigen::Vector3d corners[4] = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
-    for (int k = 0; k < 4; ++k)
-      points += (k ? ", " : "") + std::to_string(test::nearest_vertex(a, corners[k]));
+    for (int k = 0; k < 4; ++k) points += (k ? ", " : "") + std::to_string(test::nearest_vertex(a, corners[k]));
     points += "]";
     return file("pair.json", "{\"models\": [{\"mesh\": \"a.obj\", \"partition_points\": " + points +
                                  "}, {\"mesh\": \"b.obj\", \"partition_points\": " + points + "}]}");
@@ -339,10 +336,10 @@ TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
 TEST_F(CliGimage, BadInputsExitTwo) {
   const std::string out = dir_ + "/out";
   for (const std::string& args : {"gimage '" + spot_ + "' --level 11 -o '" + out + "'",
-                                  "gimage '" + spot_ + "' --level 4 --normal-level 3 -o '" + out + "'",
-                                  "remesh '" + spot_ + "' --level -1 -o '" + out + "'",
-                                  "remesh '" + dir_ + "/missing.obj' --level 2 -o '" + out + "'",
-                                  "remesh '" + spot_ + "' '" + spot_ + "' --level 2 -o '" + out + "'"}) {
+                                 "gimage '" + spot_ + "' --level 4 --normal-level 3 -o '" + out + "'",
+                                 "remesh '" + spot_ + "' --level -1 -o '" + out + "'",
+                                 "remesh '" + dir_ + "/missing.obj' --level 2 -o '" + out + "'",
+                                 "remesh '" + spot_ + "' '" + spot_ + "' --level 2 -o '" + out + "'"}) {
     const Outcome r = geomip(args);
     EXPECT_FALSE(r.crashed) << args;
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;

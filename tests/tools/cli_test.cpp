@@ -396,3 +396,35 @@ TEST_F(Cli, EvalReportsMetroDistancesAndInfinitePsnrForIdenticalMeshes) {
 
 }  // namespace
 }  // namespace geomip
+
+namespace geomip {
+namespace {
+
+// The consistent set of issue #3: horse, cow, pig and spot with corresponding partition points and eight
+// features (feet, ears, eyes) from tests/data/animals.corr.json.
+TEST_F(Cli, AnimalsGetIdenticalFeatureCoordinates) {
+  GEOMIP_REQUIRE_SHARED_MESH(horse, "horse.obj");
+  const std::string corr = std::string(GEOMIP_SOURCE_DIR) + "/tests/data/animals.corr.json";
+  const std::string out = dir_ + "/animals";
+  const Outcome r = geomip("param --json --points '" + corr + "' -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<nlohmann::json> models;
+  for (const char* stem : {"horse", "cow", "pig", "spot"}) {
+    models.push_back(nlohmann::json::parse(slurp(out + "/" + stem + ".param.json")));
+    EXPECT_EQ(models.back()["flipped_triangles"], 0) << stem;
+    EXPECT_EQ(models.back()["seam_mismatches"], 0) << stem;
+    ASSERT_EQ(models.back()["features"].size(), 8u) << stem;
+  }
+  for (std::size_t k = 0; k < 8; ++k) {
+    const auto& f0 = models[0]["features"][k];
+    for (std::size_t m = 1; m < models.size(); ++m) {
+      const auto& f = models[m]["features"][k];
+      EXPECT_EQ(f["patch"], f0["patch"]) << "feature " << k << " model " << m;
+      EXPECT_LE(std::abs(f["u"].get<double>() - f0["u"].get<double>()), 1e-9) << "feature " << k << " model " << m;
+      EXPECT_LE(std::abs(f["v"].get<double>() - f0["v"].get<double>()), 1e-9) << "feature " << k << " model " << m;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace geomip

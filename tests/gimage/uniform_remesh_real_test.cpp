@@ -6,6 +6,7 @@
 #include "param/mesh_topology.h"
 #include "tests/gimage/gimage_fixtures.h"
 #include "tests/gimage/remesh_checks.h"
+#include "tools/model_inputs.h"
 
 #include <gtest/gtest.h>
 
@@ -48,6 +49,27 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<const char*>& param_info) {
       return std::string(param_info.param).substr(0, std::string(param_info.param).find('.'));
     });
+
+// The consistent set of issue #3 (horse, cow, pig, spot; tests/data/animals.corr.json), prepared as the
+// commands do: one face list at every level M1..M8, each remesh watertight, oriented and genus 0.
+TEST(RealRemeshConsistentSet, AnimalsShareOneFaceListAtEveryLevel) {
+  GEOMIP_REQUIRE_SHARED_MESH(horse, "horse.obj");
+  const auto models = tools::prepare_models(
+      {}, std::string(GEOMIP_SOURCE_DIR) + "/tests/data/animals.corr.json", "uniform_remesh_real_test", true);
+  ASSERT_EQ(models.inputs.size(), 4u);
+  const auto params = parameterize_consistently(models.inputs, test::quick_options());
+  std::vector<GeometryImages> images;
+  for (const auto& m : params) images.push_back(resample_geometry(m, 8, {false, -1}));
+  for (int level = 1; level <= 8; ++level) {
+    const UniformRemeshResult first = uniform_remesh(images[0], level);
+    for (std::size_t k = 0; k < images.size(); ++k) {
+      const UniformRemeshResult r = k == 0 ? first : uniform_remesh(images[k], level);
+      EXPECT_EQ(r.mesh.triangles, first.mesh.triangles) << models.inputs[k].name << " M" << level;
+      if (level <= 6)
+        test::expect_watertight_oriented(r.mesh, 0, models.inputs[k].name + " M" + std::to_string(level));
+    }
+  }
+}
 
 }  // namespace
 }  // namespace geomip

@@ -89,9 +89,10 @@ GeometryImages resample_geometry(const ModelParameterization& model, int level,
 /// Point location of the grid samples of one patch, as resample_geometry() does it.
 struct GridLocation {
   int level = 0;
-  std::vector<int> triangle;  ///< per sample (j·(2^level+1) + i): the claiming triangle, -1 for none
-  std::vector<std::uint8_t>
-      claims;  ///< per sample: how many triangles claim it (1 for a valid patch; saturates)
+  /// Per sample (j·(2^level+1) + i): the claiming triangle, -1 for none.
+  std::vector<int> triangle;
+  /// Per sample: how many triangles claim it (1 for a valid patch; saturates at 255).
+  std::vector<std::uint8_t> claims;
 };
 
 /// Which (u,v) triangle of `patch` contains each sample (i, j) = (u, v)·2^level. Exact orientation tests; a

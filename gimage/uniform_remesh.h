@@ -37,8 +37,8 @@ UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches,
                                                 const std::vector<SideLink>& adjacency, int level);
 
 /// Uniform remesh of `images` at `level` ≤ the images' level: the connectivity above with the positions of
-/// the nested level-`level` grid samples (every 2^(n−level)-th sample of the level-n images). \throw
-/// InvalidInput when there are no images, they differ in level, `level` is above it or negative, or
+/// the nested level-`level` grid samples (every 2^(n−level)-th sample of the level-n images).
+/// \throw InvalidInput when there are no images, they differ in level, `level` is above it or negative, or
 ///   the adjacency does not fit.
 UniformRemeshResult uniform_remesh(const GeometryImages& images, int level);
 

@@ -2,13 +2,9 @@
 // DIR/<stem>.param.obj (per-patch texture coordinates) and DIR/<stem>.param.json (layout and figures).
 #include "param/consistent_parameterization.h"
 #include "param/errors.h"
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
-#include "param/partition_points.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
-#include "tools/correspondence.h"
+#include "tools/model_inputs.h"
 #include "tools/progress.h"
 
 #include <nlohmann/json.hpp>
@@ -31,57 +27,6 @@ struct ParamArgs {
   bool quiet = false;
   bool no_baseline = false;
 };
-
-// The mesh ready for partitioning: repaired when open, non-manifold or degenerate (with a note on stderr).
-TriMesh prepare_mesh(const std::string& path, const TriMesh& input, bool quiet) {
-  const TopologyReport r = analyze_topology(input);
-  if (r.boundary_loops == 0 && r.manifold && r.degenerate_faces == 0) return input;
-  const RepairResult repaired = repair_mesh(input);
-  if (!quiet) {
-    std::cerr << "geomip param: " << path << ": " << (r.boundary_loops ? "open" : "non-manifold or degenerate")
-              << " mesh repaired first (as `geomip repair`): " << repaired.filled_holes << " holes filled, "
-              << repaired.split_non_manifold_vertices << " vertices split, " << repaired.removed_degenerate_faces
-              << " degenerate faces removed\n";
-  }
-  return repaired.mesh;
-}
-
-// A point of CORR.json as a position of the input file, then the nearest vertex of the prepared mesh (the
-// same vertex when the mesh was not repaired, its surviving copy when it was).
-int resolve_point(const PointSpec& p, const TriMesh& input, const TriMesh& mesh, const std::string& what,
-                  const std::string& file) {
-  Eigen::Vector3d target = p.position;
-  if (p.index >= 0) {
-    if (p.index >= static_cast<long long>(input.positions.size())) {
-      throw InvalidInput(file + ": " + what + " is vertex " + std::to_string(p.index) + ", but the mesh has " +
-                         std::to_string(input.positions.size()) + " vertices");
-    }
-    if (&input == &mesh) return static_cast<int>(p.index);
-    target = input.positions[p.index];
-  }
-  std::vector<char> referenced(mesh.positions.size(), 0);
-  for (const auto& t : mesh.triangles) referenced[t[0]] = referenced[t[1]] = referenced[t[2]] = 1;
-  int best = -1;
-  double best_d = std::numeric_limits<double>::infinity();
-  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-    if (!referenced[v]) continue;
-    const double d = (mesh.positions[v] - target).squaredNorm();
-    if (d < best_d) {
-      best_d = d;
-      best = static_cast<int>(v);
-    }
-  }
-  return best;
-}
-
-std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMesh& input, const TriMesh& mesh,
-                                const std::string& what, const std::string& file) {
-  std::vector<int> ids;
-  for (std::size_t i = 0; i < specs.size(); ++i) {
-    ids.push_back(resolve_point(specs[i], input, mesh, what + "[" + std::to_string(i) + "]", file));
-  }
-  return ids;
-}
 
 nlohmann::json stretch_json(const StretchValues& s) { return {{"l2", s.l2}, {"linf", s.linf}}; }
 
@@ -171,45 +116,10 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
 }
 
 int run_param(const ParamArgs& args) {
-  std::vector<ModelSpec> specs;
-  std::string points_file = args.points;
-  if (!args.points.empty()) {
-    if (!args.meshes.empty()) {
-      throw InvalidInput("give either meshes or --points CORR.json (which names the meshes), not both");
-    }
-    specs = read_correspondence(args.points);
-  } else {
-    if (args.meshes.size() > 1) {
-      throw InvalidInput("several meshes need --points CORR.json: their partition points must correspond");
-    }
-    if (args.meshes.empty()) throw InvalidInput("no mesh given (a MESH or --points CORR.json)");
-    specs.push_back(ModelSpec{args.meshes[0], {}, {}, {}});
-  }
+  const PreparedModels models = prepare_models(args.meshes, args.points, "geomip param", args.quiet || args.json);
   std::filesystem::create_directories(args.output);
-
-  std::vector<ParameterizationInput> inputs;
-  std::vector<std::string> paths;
-  for (const auto& spec : specs) {
-    const TriMesh input = read_mesh(spec.mesh);
-    ParameterizationInput in;
-    in.mesh = prepare_mesh(spec.mesh, input, args.quiet || args.json);
-    in.name = std::filesystem::path(spec.mesh).stem().string();
-    // Point indices refer to the file as written; after a repair they are matched by position.
-    const bool repaired = in.mesh.positions.size() != input.positions.size() || in.mesh.triangles != input.triangles;
-    const TriMesh& source = repaired ? input : in.mesh;
-    const std::string where = points_file.empty() ? spec.mesh : points_file;
-    if (spec.partition_points.empty()) {
-      const PartitionPoints chosen = choose_partition_points(in.mesh);
-      in.partition_points = chosen.partition_points;
-      in.auxiliary_points = chosen.auxiliary_points;
-    } else {
-      in.partition_points = resolve_points(spec.partition_points, source, in.mesh, "partition_points", where);
-      in.auxiliary_points = resolve_points(spec.auxiliary_points, source, in.mesh, "auxiliary_points", where);
-      in.features = resolve_points(spec.features, source, in.mesh, "features", where);
-    }
-    inputs.push_back(std::move(in));
-    paths.push_back(spec.mesh);
-  }
+  const std::vector<ParameterizationInput>& inputs = models.inputs;
+  const std::vector<std::string>& paths = models.paths;
 
   ParameterizationOptions options;
   options.measure_mvc_baseline = !args.no_baseline;

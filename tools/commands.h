@@ -20,6 +20,8 @@ using CommandRunner = std::function<int()>;
 CommandRunner add_info_command(CLI::App& app);
 CommandRunner add_repair_command(CLI::App& app);
 CommandRunner add_param_command(CLI::App& app);
+CommandRunner add_gimage_command(CLI::App& app);
+CommandRunner add_remesh_command(CLI::App& app);
 CommandRunner add_eval_command(CLI::App& app);
 
 }  // namespace geomip::tools

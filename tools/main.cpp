@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
   add(add_info_command(app));
   add(add_repair_command(app));
   add(add_param_command(app));
+  add(add_gimage_command(app));
+  add(add_remesh_command(app));
   add(add_eval_command(app));
 
   try {

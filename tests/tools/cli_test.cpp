@@ -1,4 +1,7 @@
 // End-to-end tests of the geomip program: exit codes, one-line errors, JSON keys, atomic outputs.
+#include "gimage/exr_io.h"
+#include "param/mesh_io.h"
+#include "param/mesh_topology.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>
@@ -247,6 +250,105 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
 
 namespace geomip {
 namespace {
+
+class CliGimage : public Cli {
+ protected:
+  std::string spot_ = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
+  // Two spheres, the second deformed, with corresponding partition points, and their CORR.json.
+  std::string sphere_pair() {
+    const TriMesh a = test::sphere(3);
+    TriMesh b = a;
+    for (auto& p : b.positions) p = Eigen::Vector3d(1.6 * p.x() + 0.2 * p.y() * p.y(), p.y(), 0.7 * p.z());
+    for (const auto& [name, mesh] : {std::pair<std::string, const TriMesh*>{"a", &a}, {"b", &b}}) {
+      std::ofstream out(dir_ + "/" + name + ".obj");
+      write_mesh(*mesh, out, MeshFormat::kObj);
+    }
+    std::string points = "[";
+    const Eigen::Vector3d corners[4] = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
+    for (int k = 0; k < 4; ++k) points += (k ? ", " : "") + std::to_string(test::nearest_vertex(a, corners[k]));
+    points += "]";
+    return file("pair.json", "{\"models\": [{\"mesh\": \"a.obj\", \"partition_points\": " + points +
+                                 "}, {\"mesh\": \"b.obj\", \"partition_points\": " + points + "}]}");
+  }
+};
+
+TEST_F(CliGimage, GimageWritesOnePyramidPerPatch) {
+  const std::string out = dir_ + "/out";
+  const Outcome r = geomip("gimage --json '" + spot_ + "' --level 4 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["models"].size(), 1u);
+  EXPECT_EQ(j["models"][0]["patches"], 2);
+  EXPECT_EQ(j["models"][0]["normal_level"], 5);
+  const GeometryImageFile g = read_geometry_image_exr(out + "/spot.geometry.exr");
+  ASSERT_EQ(g.parts.size(), 2u);
+  EXPECT_EQ(g.info.level, 4);
+  EXPECT_EQ(g.info.kind, "geometry");
+  EXPECT_EQ(g.info.adjacency.size(), 8u);
+  EXPECT_NE(g.info.source_mesh.find("spot.obj"), std::string::npos);
+  ASSERT_EQ(g.parts[0].size(), 6u);  // 17, 9, 5, 3, 2, 1
+  EXPECT_EQ(g.parts[0][0].width, 17);
+  EXPECT_EQ(g.parts[0][3].width, 3);
+  const GeometryImageFile n = read_geometry_image_exr(out + "/spot.normals.exr");
+  EXPECT_EQ(n.info.kind, "normals");
+  EXPECT_EQ(n.parts[1][0].width, 33);
+  for (float v : n.parts[1][0].rgb) EXPECT_LE(std::abs(v), 1.001f);
+  for (const auto& e : fs::directory_iterator(out)) {
+    EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
+  }
+}
+
+TEST_F(CliGimage, RemeshWritesWatertightObjAndPly) {
+  const std::string out = dir_ + "/out";
+  const Outcome r = geomip("remesh --quiet '" + spot_ + "' --level 3 -o '" + out + "' --ply");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* ext : {".obj", ".ply"}) {
+    const TriMesh m = read_mesh(out + "/spot.M3" + ext);
+    EXPECT_EQ(m.triangles.size(), 256u) << ext;  // 2 patches · 4^3 quads · 2
+    const TopologyReport t = analyze_topology(m);
+    EXPECT_EQ(t.boundary_loops, 0u) << ext;
+    EXPECT_TRUE(t.manifold) << ext;
+    EXPECT_EQ(t.genus, 0) << ext;
+  }
+}
+
+TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
+  const std::string corr = sphere_pair();
+  const std::string out = dir_ + "/out";
+  const Outcome r = geomip("remesh --quiet --points '" + corr + "' --level 4 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const TriMesh a = read_mesh(out + "/a.M4.obj");
+  const TriMesh b = read_mesh(out + "/b.M4.obj");
+  EXPECT_EQ(a.triangles.size(), 1024u);  // 2 patches · 4^4 quads · 2
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_NE(a.positions, b.positions);
+  // gimage on the same set: one pair of files per model, the same layout in both.
+  const Outcome g = geomip("gimage --quiet --points '" + corr + "' --level 3 -o '" + out + "'");
+  ASSERT_EQ(g.exit_code, 0) << g.err;
+  const GeometryImageFile ga = read_geometry_image_exr(out + "/a.geometry.exr");
+  const GeometryImageFile gb = read_geometry_image_exr(out + "/b.geometry.exr");
+  EXPECT_EQ(adjacency_to_text(ga.info.adjacency), adjacency_to_text(gb.info.adjacency));
+  EXPECT_EQ(ga.parts.size(), 2u);
+  EXPECT_EQ(gb.parts.size(), 2u);
+  EXPECT_TRUE(fs::exists(out + "/b.normals.exr"));
+}
+
+TEST_F(CliGimage, BadInputsExitTwo) {
+  const std::string out = dir_ + "/out";
+  for (const std::string& args : {"gimage '" + spot_ + "' --level 11 -o '" + out + "'",
+                                 "gimage '" + spot_ + "' --level 4 --normal-level 3 -o '" + out + "'",
+                                 "remesh '" + spot_ + "' --level -1 -o '" + out + "'",
+                                 "remesh '" + dir_ + "/missing.obj' --level 2 -o '" + out + "'",
+                                 "remesh '" + spot_ + "' '" + spot_ + "' --level 2 -o '" + out + "'"}) {
+    const Outcome r = geomip(args);
+    EXPECT_FALSE(r.crashed) << args;
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  for (const char* args : {"gimage --help", "remesh --help"}) EXPECT_EQ(geomip(args).exit_code, 0) << args;
+  EXPECT_EQ(geomip("gimage '" + spot_ + "' -o '" + out + "'").exit_code, 2);  // --level is required
+}
 
 TEST_F(Cli, EvalReportsMetroDistancesAndInfinitePsnrForIdenticalMeshes) {
   // A unit square and a copy 0.25 above it: every distance is 0.25, PSNR = 20·log10(√2 / 0.25).

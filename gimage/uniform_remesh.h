@@ -1,0 +1,45 @@
+// Uniform consistent remeshing (§4 of ../shared/seed/consistent-mesh-parameterizations.txt, "Uniform
+// remeshing"; Gu et al. 2002's geometry image triangulation): the level-K grid of every patch triangulated,
+// (2^K)² quads per patch (genus 0: 2·4^K quads), each split in two along a fixed diagonal rule, seam samples
+// welded by the patch layout (SideLinks), not by position.
+//
+// The face list and the vertex numbering depend only on K and the layout (number of patches and their
+// adjacency): every model of a consistent set gets the identical face list.
+#pragma once
+
+#include "gimage/resample.h"
+#include "param/mesh.h"
+#include "param/mesh_partition.h"
+
+#include <vector>
+
+namespace geomip {
+
+struct UniformRemeshResult {
+  /// Vertices: one per distinct sample (seam samples once); triangles counter-clockwise in (u,v), so outward
+  /// when the parameterization is (patches map to the square without a flip). 2·(2^K)² triangles per patch.
+  TriMesh mesh;
+  /// Per patch, the mesh vertex of each level-K sample (i, j), at grid_vertex[p][j·(2^K+1) + i].
+  std::vector<std::vector<int>> grid_vertex;
+};
+
+/// The connectivity alone: vertex numbering and triangles of the level-`level` remesh of a layout of
+/// `num_patches` patches glued by `adjacency` (adjacency[4·p + s] = side s of patch p; empty = no gluing).
+///
+/// Quad (i, j) of patch p, corners a = (i, j), b = (i+1, j), c = (i+1, j+1), d = (i, j+1), is split along a–c
+/// when (i + j + p) is even, along b–d otherwise: the 4-8 pattern within a patch; alternating the rule
+/// between patches makes genus-0 level 0 a tetrahedron rather than four triangles on one diagonal. A genus-1
+/// layout at level 0 has only 4 vertices and repeats edges; use level ≥ 1 there.
+/// Vertices are numbered in order of first appearance over patches, rows j, columns i.
+/// \throw InvalidInput for a level outside [0, kMaxGeometryImageLevel] or an adjacency of the wrong size or
+///   out of range.
+UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches,
+                                                const std::vector<SideLink>& adjacency, int level);
+
+/// Uniform remesh of `images` at `level` ≤ the images' level: the connectivity above with the positions of
+/// the nested level-`level` grid samples (every 2^(n−level)-th sample of the level-n images).
+/// \throw InvalidInput when there are no images, they differ in level, `level` is above it or negative, or
+///   the adjacency does not fit.
+UniformRemeshResult uniform_remesh(const GeometryImages& images, int level);
+
+}  // namespace geomip

@@ -1,0 +1,25 @@
+// The models of `geomip param|gimage|remesh MESH... [--points CORR.json]`: meshes read, repaired when open or
+// non-manifold (with a note on stderr), partition points resolved from CORR.json or chosen automatically —
+// ready for parameterize_consistently(). One function so the three commands parameterize identically.
+#pragma once
+
+#include "param/consistent_parameterization.h"
+
+#include <string>
+#include <vector>
+
+namespace geomip::tools {
+
+struct PreparedModels {
+  std::vector<ParameterizationInput> inputs;  ///< name = the mesh file's stem
+  std::vector<std::string> paths;             ///< the mesh files, as given or as named in CORR.json
+};
+
+/// `meshes`: one mesh (automatic partition points) or none when `points_file` names them. `command` prefixes
+/// the repair note ("geomip param"); `quiet` silences it.
+/// \throw InvalidInput when both or neither are given, several meshes come without CORR.json, a file is
+///   unreadable, or a point is out of range.
+PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file,
+                              const std::string& command, bool quiet);
+
+}  // namespace geomip::tools

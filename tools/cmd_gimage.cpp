@@ -21,13 +21,9 @@ namespace geomip::tools {
 namespace {
 
 struct GimageArgs {
-  std::vector<std::string> meshes;
-  std::string points;
-  std::string output;
+  ModelArgs common;
   int level = 0;
   int normal_level = -1;
-  bool json = false;
-  bool quiet = false;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -45,12 +41,12 @@ int run_gimage(const GimageArgs& args) {
                        std::to_string(args.level) + ", " + std::to_string(kMaxGeometryImageLevel) + "]");
   }
   const PreparedModels models =
-      prepare_models(args.meshes, args.points, "geomip gimage", args.quiet || args.json);
-  std::filesystem::create_directories(args.output);
+      prepare_models(args.common.meshes, args.common.points, "geomip gimage", args.common.quiet || args.common.json);
+  std::filesystem::create_directories(args.common.output);
 
   ParameterizationOptions options;
   options.measure_mvc_baseline = false;
-  ProgressBar bar("gimage", !args.quiet && !args.json);
+  ProgressBar bar("gimage", !args.common.quiet && !args.common.json);
   options.progress = bar.callback();
   auto t0 = std::chrono::steady_clock::now();
   const std::vector<ModelParameterization> result = parameterize_consistently(models.inputs, options);
@@ -64,7 +60,7 @@ int run_gimage(const GimageArgs& args) {
     resample.normal_level = args.normal_level;
     const GeometryImages images = resample_geometry(result[i], args.level, resample);
     const double resample_seconds = seconds_since(t0);
-    const std::string stem = (std::filesystem::path(args.output) / models.inputs[i].name).string();
+    const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string();
     GeometryImageFileInfo info;
     info.source_mesh = models.paths[i];
     info.adjacency = images.adjacency;
@@ -75,7 +71,7 @@ int run_gimage(const GimageArgs& args) {
     const double write_seconds = seconds_since(t0);
     const auto geometry_bytes = std::filesystem::file_size(stem + ".geometry.exr");
     const auto normals_bytes = std::filesystem::file_size(stem + ".normals.exr");
-    if (args.json) {
+    if (args.common.json) {
       summary.push_back({{"mesh", models.paths[i]},
                          {"geometry", stem + ".geometry.exr"},
                          {"normals", stem + ".normals.exr"},
@@ -87,7 +83,7 @@ int run_gimage(const GimageArgs& args) {
                          {"uncovered_samples", images.uncovered_samples},
                          {"resample_seconds", resample_seconds},
                          {"write_seconds", write_seconds}});
-    } else if (!args.quiet) {
+    } else if (!args.common.quiet) {
       std::printf(
           "gimage %s → %s.geometry.exr (%zu patches, %d², %.1f KiB), %s.normals.exr (%d², %.1f KiB); "
           "resampled in %.3f s\n",
@@ -96,9 +92,9 @@ int run_gimage(const GimageArgs& args) {
           resample_seconds);
     }
   }
-  if (args.json) {
+  if (args.common.json) {
     std::cout << nlohmann::json{{"models", summary}, {"param_seconds", param_seconds}}.dump(2) << "\n";
-  } else if (!args.quiet) {
+  } else if (!args.common.quiet) {
     std::printf("parameterization %.2f s\n", param_seconds);
   }
   return kExitOk;
@@ -114,15 +110,10 @@ CommandRunner add_gimage_command(CLI::App& app) {
       "(2^N+1)² grid and write DIR/<stem>.geometry.exr (float32 xyz) and DIR/<stem>.normals.exr (half "
       "normals), "
       "one tiled MIP pyramid per patch whose level l is the nested (2^(N-l)+1)² grid.");
-  cmd->add_option("mesh", args->meshes, "One mesh (partition points chosen automatically)");
-  cmd->add_option("--points", args->points,
-                  "Correspondence file naming the meshes, their partition/auxiliary points and features");
+  add_model_options(cmd, args->common);
   cmd->add_option("--level", args->level, "Grid level N in [0, 10]: (2^N+1)² samples per patch")->required();
   cmd->add_option("--normal-level", args->normal_level,
                   "Normal map level in [N, 10] (default N+1, at most 10)");
-  cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
-  cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
-  cmd->add_flag("-q,--quiet", args->quiet, "No progress bar, no report");
   return [args] { return run_gimage(*args); };
 }
 

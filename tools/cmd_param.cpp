@@ -20,11 +20,7 @@ namespace geomip::tools {
 namespace {
 
 struct ParamArgs {
-  std::vector<std::string> meshes;
-  std::string points;
-  std::string output;
-  bool json = false;
-  bool quiet = false;
+  ModelArgs common;
   bool no_baseline = false;
 };
 
@@ -116,14 +112,14 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
 }
 
 int run_param(const ParamArgs& args) {
-  const PreparedModels models = prepare_models(args.meshes, args.points, "geomip param", args.quiet || args.json);
-  std::filesystem::create_directories(args.output);
+  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param", args.common.quiet || args.common.json);
+  std::filesystem::create_directories(args.common.output);
   const std::vector<ParameterizationInput>& inputs = models.inputs;
   const std::vector<std::string>& paths = models.paths;
 
   ParameterizationOptions options;
   options.measure_mvc_baseline = !args.no_baseline;
-  ProgressBar bar("param", !args.quiet && !args.json);
+  ProgressBar bar("param", !args.common.quiet && !args.common.json);
   options.progress = bar.callback();
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<ModelParameterization> result = parameterize_consistently(inputs, options);
@@ -132,16 +128,16 @@ int run_param(const ParamArgs& args) {
 
   nlohmann::json summary = nlohmann::json::array();
   for (std::size_t i = 0; i < result.size(); ++i) {
-    const std::string stem = (std::filesystem::path(args.output) / inputs[i].name).string();
+    const std::string stem = (std::filesystem::path(args.common.output) / inputs[i].name).string();
     write_file_atomically(stem + ".param.obj",
                           [&](std::ostream& out) { write_param_obj(out, result[i], paths[i]); });
     nlohmann::json j = param_json(result[i], paths[i], inputs[i].partition_points, inputs[i].auxiliary_points);
     j["seconds"]["total_all_models"] = seconds;
     write_file_atomically(stem + ".param.json", [&](std::ostream& out) { out << j.dump(2) << "\n"; });
-    if (args.json) {
+    if (args.common.json) {
       summary.push_back({{"mesh", paths[i]}, {"obj", stem + ".param.obj"}, {"json", stem + ".param.json"},
                          {"patches", j["patches"].size()}, {"flipped_triangles", j["flipped_triangles"]}});
-    } else if (!args.quiet) {
+    } else if (!args.common.quiet) {
       std::cout << "param " << paths[i] << " → " << stem << ".param.obj\n";
       for (const auto& p : result[i].patches) {
         std::printf("  patch: %zu vertices, L2 stretch %.4f, Linf %.3f", p.vertices.size(), p.stretch.l2,
@@ -151,9 +147,9 @@ int run_param(const ParamArgs& args) {
       }
     }
   }
-  if (args.json) {
+  if (args.common.json) {
     std::cout << nlohmann::json{{"models", summary}, {"seconds", seconds}}.dump(2) << "\n";
-  } else if (!args.quiet) {
+  } else if (!args.common.quiet) {
     std::printf("%.2f s\n", seconds);
   }
   return kExitOk;
@@ -168,13 +164,8 @@ CommandRunner add_param_command(CLI::App& app) {
       "Consistent parameterization (paper §3): partition into quad patches, progressive mesh, mean-value "
       "embedding, stretch optimization, feature alignment, coarse-to-fine. Writes DIR/<stem>.param.obj and "
       "DIR/<stem>.param.json per model. Open or non-manifold meshes are repaired first.");
-  cmd->add_option("mesh", args->meshes, "One mesh (partition points chosen automatically)");
-  cmd->add_option("--points", args->points,
-                  "Correspondence file naming the meshes, their partition/auxiliary points and features");
-  cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
+  add_model_options(cmd, args->common);
   cmd->add_flag("--no-baseline", args->no_baseline, "Skip the full-patch MVC embedding used as stretch baseline");
-  cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
-  cmd->add_flag("-q,--quiet", args->quiet, "No progress bar, no report");
   return [args] { return run_param(*args); };
 }
 

@@ -24,13 +24,9 @@ namespace geomip::tools {
 namespace {
 
 struct RemeshArgs {
-  std::vector<std::string> meshes;
-  std::string points;
-  std::string output;
+  ModelArgs common;
   int level = 0;
   bool ply = false;
-  bool json = false;
-  bool quiet = false;
 };
 
 int run_remesh(const RemeshArgs& args) {
@@ -39,12 +35,12 @@ int run_remesh(const RemeshArgs& args) {
                        std::to_string(kMaxGeometryImageLevel) + "]");
   }
   const PreparedModels models =
-      prepare_models(args.meshes, args.points, "geomip remesh", args.quiet || args.json);
-  std::filesystem::create_directories(args.output);
+      prepare_models(args.common.meshes, args.common.points, "geomip remesh", args.common.quiet || args.common.json);
+  std::filesystem::create_directories(args.common.output);
 
   ParameterizationOptions options;
   options.measure_mvc_baseline = false;
-  ProgressBar bar("remesh", !args.quiet && !args.json);
+  ProgressBar bar("remesh", !args.common.quiet && !args.common.json);
   options.progress = bar.callback();
   auto t0 = std::chrono::steady_clock::now();
   const std::vector<ModelParameterization> result = parameterize_consistently(models.inputs, options);
@@ -60,7 +56,7 @@ int run_remesh(const RemeshArgs& args) {
         uniform_remesh(resample_geometry(result[i], args.level, resample), args.level);
     const double remesh_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const std::string stem = (std::filesystem::path(args.output) / models.inputs[i].name).string() + ".M" +
+    const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() + ".M" +
                              std::to_string(args.level);
     write_file_atomically(stem + ".obj",
                           [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kObj); });
@@ -68,7 +64,7 @@ int run_remesh(const RemeshArgs& args) {
       write_file_atomically(stem + ".ply",
                             [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kPly); });
     }
-    if (args.json) {
+    if (args.common.json) {
       nlohmann::json j{{"mesh", models.paths[i]},
                        {"obj", stem + ".obj"},
                        {"level", args.level},
@@ -77,15 +73,15 @@ int run_remesh(const RemeshArgs& args) {
                        {"remesh_seconds", remesh_seconds}};
       if (args.ply) j["ply"] = stem + ".ply";
       summary.push_back(j);
-    } else if (!args.quiet) {
+    } else if (!args.common.quiet) {
       std::printf("remesh %s → %s.obj: %zu vertices, %zu faces (resampled and remeshed in %.3f s)\n",
                   models.paths[i].c_str(), stem.c_str(), remesh.mesh.positions.size(),
                   remesh.mesh.triangles.size(), remesh_seconds);
     }
   }
-  if (args.json) {
+  if (args.common.json) {
     std::cout << nlohmann::json{{"models", summary}, {"param_seconds", param_seconds}}.dump(2) << "\n";
-  } else if (!args.quiet) {
+  } else if (!args.common.quiet) {
     std::printf("parameterization %.2f s\n", param_seconds);
   }
   return kExitOk;
@@ -101,14 +97,9 @@ CommandRunner add_remesh_command(CLI::App& app) {
       "level-K grid and triangulate it, seams welded: DIR/<stem>.M<K>.obj, watertight and oriented, with one "
       "face "
       "list for all models of a consistent set.");
-  cmd->add_option("mesh", args->meshes, "One mesh (partition points chosen automatically)");
-  cmd->add_option("--points", args->points,
-                  "Correspondence file naming the meshes, their partition/auxiliary points and features");
+  add_model_options(cmd, args->common);
   cmd->add_option("--level", args->level, "Level K in [0, 10]: (2^K)² quads per patch")->required();
-  cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
   cmd->add_flag("--ply", args->ply, "Also write DIR/<stem>.M<K>.ply (binary)");
-  cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
-  cmd->add_flag("-q,--quiet", args->quiet, "No progress bar, no report");
   return [args] { return run_remesh(*args); };
 }
 

@@ -112,4 +112,13 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
   return models;
 }
 
+void add_model_options(CLI::App* cmd, ModelArgs& args) {
+  cmd->add_option("mesh", args.meshes, "One mesh (partition points chosen automatically)");
+  cmd->add_option("--points", args.points,
+                  "Correspondence file naming the meshes, their partition/auxiliary points and features");
+  cmd->add_option("-o,--output", args.output, "Output directory (created if missing)")->required();
+  cmd->add_flag("--json", args.json, "Machine-readable summary on stdout");
+  cmd->add_flag("-q,--quiet", args.quiet, "No progress bar, no report");
+}
+
 }  // namespace geomip::tools

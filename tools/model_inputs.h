@@ -5,6 +5,8 @@
 
 #include "param/consistent_parameterization.h"
 
+#include <CLI/CLI.hpp>
+
 #include <string>
 #include <vector>
 
@@ -14,6 +16,18 @@ struct PreparedModels {
   std::vector<ParameterizationInput> inputs;  ///< name = the mesh file's stem
   std::vector<std::string> paths;             ///< the mesh files, as given or as named in CORR.json
 };
+
+/// The options every model-consuming command shares: MESH..., --points, -o, --json, --quiet.
+struct ModelArgs {
+  std::vector<std::string> meshes;
+  std::string points;
+  std::string output;
+  bool json = false;
+  bool quiet = false;
+};
+
+/// Registers ModelArgs' options on `cmd` (same names and help in every command).
+void add_model_options(CLI::App* cmd, ModelArgs& args);
 
 /// `meshes`: one mesh (automatic partition points) or none when `points_file` names them. `command` prefixes
 /// the repair note ("geomip param"); `quiet` silences it.

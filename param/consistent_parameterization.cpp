@@ -259,6 +259,7 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
         pw.features.push_back(static_cast<int>(v));
         pw.feature_index.push_back(k);
       }
+      report(options, "progressive mesh", (i + (p + 0.5) / double(w.partition.patches.size())) / total_steps);
       t0 = Clock::now();
       pw.pm = progressive_mesh(pw.local, pw.sides, pw.features, options.progressive_mesh);
       o.seconds.progressive_mesh += seconds_since(t0);
@@ -365,9 +366,15 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
       // Insert vertex by vertex; whenever the level has grown by `level_growth`, optimize it globally.
       std::size_t next_level = pw.pm.base_vertices.size();
       std::size_t level_vertices = next_level;
+      const double patch_share = 2.0 / (total_steps * static_cast<double>(w.patches.size()));
+      const double patch_start = (models.size() + 2.0 * i) / total_steps + patch_share * static_cast<double>(p);
       while (!c2f.finished()) {
         c2f.split_next(optimize);
         ++level_vertices;
+        if ((c2f.splits_done() & 1023u) == 0) {
+          report(options, "coarse-to-fine",
+                 patch_start + patch_share * static_cast<double>(c2f.splits_done()) / double(c2f.num_splits()));
+        }
         if (options.level_sweeps > 0 && level_vertices >= next_level * options.level_growth && !c2f.finished()) {
           optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices));
           next_level = level_vertices;

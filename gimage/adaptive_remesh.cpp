@@ -14,26 +14,24 @@
 namespace geomip {
 namespace {
 
-/// Largest distance of `points` to their least-squares plane (through the centroid, normal = the smallest
-/// eigenvector of the covariance).
-double plane_fit_max_distance(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d* extra_begin,
-                              std::size_t extra_count) {
-  // Fit through `points`, or, when extra_count > 0, through the extra points (the corner samples) only.
-  const Eigen::Vector3d* fit = extra_count > 0 ? extra_begin : points.data();
-  const std::size_t count = extra_count > 0 ? extra_count : points.size();
+/// The least-squares plane of `points` (count > 0): through the centroid, normal = the covariance's smallest
+/// eigenvector.
+struct Plane {
+  Eigen::Vector3d point, normal;
+  double distance(const Eigen::Vector3d& x) const { return std::abs((x - point).dot(normal)); }
+};
+
+Plane fit_plane(const Eigen::Vector3d* points, std::size_t count) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < count; ++k) centroid += fit[k];
+  for (std::size_t k = 0; k < count; ++k) centroid += points[k];
   centroid /= static_cast<double>(count);
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (std::size_t k = 0; k < count; ++k) {
-    const Eigen::Vector3d d = fit[k] - centroid;
+    const Eigen::Vector3d d = points[k] - centroid;
     cov += d * d.transpose();
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
-  const Eigen::Vector3d normal = solver.eigenvectors().col(0).normalized();
-  double worst = 0;
-  for (const auto& p : points) worst = std::max(worst, std::abs((p - centroid).dot(normal)));
-  return worst;
+  return {centroid, solver.eigenvectors().col(0).normalized()};
 }
 
 void check_adjacency(const std::vector<SideLink>& adjacency, std::size_t patches, const char* fn) {
@@ -166,7 +164,8 @@ std::vector<AdaptiveQuadtree::Leaf> AdaptiveQuadtree::leaves() const {
   return out;
 }
 
-AdaptiveQuadErrors adaptive_quad_errors(const ModelParameterization& model, const GeometryImages& images) {
+AdaptiveQuadErrors adaptive_quad_errors(const ModelParameterization& model, const GeometryImages& images,
+                                        const AdaptiveErrorOptions& options) {
   if (images.geometry.size() != model.patches.size() || images.geometry.empty()) {
     throw InvalidInput("adaptive_quad_errors: need one geometry image per patch");
   }
@@ -220,38 +219,51 @@ AdaptiveQuadErrors adaptive_quad_errors(const ModelParameterization& model, cons
       const int span = 1 << (n - d);
       auto& errors = result.errors[p][d];
       errors.assign(static_cast<std::size_t>(side) * side, 0.0);
+      // The run of `items` in each quad.
       const int shift = 2 * (n - d);
+      std::vector<std::pair<std::size_t, std::size_t>> runs(static_cast<std::size_t>(side) * side, {0, 0});
       for (std::size_t a = 0; a < items.size();) {
         const std::uint32_t key = items[a].morton >> shift;
         std::size_t b = a;
-        points.clear();
-        while (b < items.size() && (items[b].morton >> shift) == key) {
-          points.push_back(model.mesh.positions[items[b].vertex]);
-          ++b;
-        }
-        // Decode the quad (i, j) from the Morton key.
-        int i = 0, j = 0;
+        while (b < items.size() && (items[b].morton >> shift) == key) ++b;
+        int i = 0, j = 0;  // the quad, decoded from the Morton key
         for (int bit = 0; bit < d; ++bit) {
           i |= static_cast<int>((key >> (2 * bit)) & 1u) << bit;
           j |= static_cast<int>((key >> (2 * bit + 1)) & 1u) << bit;
         }
-        double e;
-        if (points.size() > 3) {
-          e = plane_fit_max_distance(points, nullptr, 0);
-        } else {
-          const std::array<Eigen::Vector3d, 4> corners = {
-              image.sample(i * span, j * span).cast<double>(), image.sample((i + 1) * span, j * span).cast<double>(),
-              image.sample((i + 1) * span, (j + 1) * span).cast<double>(),
-              image.sample(i * span, (j + 1) * span).cast<double>()};
-          // Few vertices say little about the surface (three always fit a plane exactly): measure the quad's
-          // level-n samples too.
-          for (int y = j * span; y <= (j + 1) * span; ++y) {
-            for (int x = i * span; x <= (i + 1) * span; ++x) points.push_back(image.sample(x, y).cast<double>());
-          }
-          e = plane_fit_max_distance(points, corners.data(), corners.size());
-        }
-        errors[static_cast<std::size_t>(j) * side + i] = e / diagonal;
+        runs[static_cast<std::size_t>(j) * side + i] = {a, b};
         a = b;
+      }
+      for (int j = 0; j < side; ++j) {
+        for (int i = 0; i < side; ++i) {
+          const auto [a, b] = runs[static_cast<std::size_t>(j) * side + i];
+          points.clear();
+          for (std::size_t k = a; k < b; ++k) points.push_back(model.mesh.positions[items[k].vertex]);
+          Plane plane;
+          if (points.size() > 3) {
+            plane = fit_plane(points.data(), points.size());
+          } else {
+            const std::array<Eigen::Vector3d, 4> corners = {
+                image.sample(i * span, j * span).cast<double>(),
+                image.sample((i + 1) * span, j * span).cast<double>(),
+                image.sample((i + 1) * span, (j + 1) * span).cast<double>(),
+                image.sample(i * span, (j + 1) * span).cast<double>()};
+            plane = fit_plane(corners.data(), corners.size());
+          }
+          double e = 0;
+          for (const auto& x : points) e = std::max(e, plane.distance(x));
+          if (options.measure_samples || points.size() <= 3) {
+            // The quad's level-n samples, which its triangles stand for: needed where it holds few vertices
+            // (three always lie on their plane); optional elsewhere, where (u,v) triangles larger than the quad
+            // make most of its surface an interpolation of vertices outside it.
+            for (int y = j * span; y <= (j + 1) * span; ++y) {
+              for (int x = i * span; x <= (i + 1) * span; ++x) {
+                e = std::max(e, plane.distance(image.sample(x, y).cast<double>()));
+              }
+            }
+          }
+          errors[static_cast<std::size_t>(j) * side + i] = e / diagonal;
+        }
       }
     }
   }

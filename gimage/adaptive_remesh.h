@@ -31,6 +31,13 @@ struct AdaptiveQuadErrors {
   std::vector<std::vector<std::vector<double>>> errors;
 };
 
+struct AdaptiveErrorOptions {
+  /// Also measure every quad's (2^(n−d)+1)² level-n samples against its plane, not only its vertices (a
+  /// stricter bound than the paper's: it sees surface that the quad's triangles stand for but whose vertices
+  /// lie outside the quad, where the (u,v) triangles are large). Off = eq. 4–5 as published.
+  bool measure_samples = false;
+};
+
 /// One model's quad errors, eq. 4–5 of the paper: for quad q, the vertices of the patch (positions of
 /// `model.mesh`) whose (u,v) lie in q — half-open cells [i, i+1)·2^−d, closed at u = 1 and v = 1 — get a least
 /// squares plane (through their centroid, normal = the covariance's smallest eigenvector); E_N(q) is their
@@ -42,7 +49,8 @@ struct AdaptiveQuadErrors {
 /// \param images  resample_geometry(model, n): n is the maximum depth.
 /// \throw InvalidInput when `images` does not have one geometry image per patch, all of one level, or the
 ///   mesh's bounding box is a point.
-AdaptiveQuadErrors adaptive_quad_errors(const ModelParameterization& model, const GeometryImages& images);
+AdaptiveQuadErrors adaptive_quad_errors(const ModelParameterization& model, const GeometryImages& images,
+                                        const AdaptiveErrorOptions& options = {});
 
 /// The leaves of the quadtrees of all patches, as a depth per finest cell.
 struct AdaptiveQuadtree {

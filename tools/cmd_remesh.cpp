@@ -30,6 +30,7 @@ struct RemeshArgs {
   int level = -1;  ///< -1: no uniform remesh
   double adaptive = -1;  ///< ε; < 0: no adaptive remesh
   int max_depth = 8;
+  bool measure_samples = false;
   bool ply = false;
 };
 
@@ -99,11 +100,13 @@ int run_remesh(const RemeshArgs& args) {
     std::vector<AdaptiveQuadErrors> errors;
     for (const auto& model : result) {
       images.push_back(resample_geometry(model, args.max_depth, resample));
-      errors.push_back(adaptive_quad_errors(model, images.back()));
+      AdaptiveErrorOptions error_options;
+      error_options.measure_samples = args.measure_samples;
+      errors.push_back(adaptive_quad_errors(model, images.back(), error_options));
     }
-    AdaptiveRemeshOptions options;
-    options.epsilon = args.adaptive;
-    const AdaptiveQuadtree tree = adaptive_quadtree(errors, images[0].adjacency, options);
+    AdaptiveRemeshOptions tree_options;
+    tree_options.epsilon = args.adaptive;
+    const AdaptiveQuadtree tree = adaptive_quadtree(errors, images[0].adjacency, tree_options);
     const std::size_t leaves = tree.leaves().size();
     for (std::size_t i = 0; i < result.size(); ++i) {
       const TriMesh mesh = adaptive_remesh(images[i], tree);
@@ -152,6 +155,9 @@ CommandRunner add_remesh_command(CLI::App& app) {
                   "diagonal): DIR/<stem>.adaptive.obj, one face list for a consistent set")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--max-depth", args->max_depth, "Adaptive: maximum quadtree depth N in [0, 10] (default 8)");
+  cmd->add_flag("--measure-samples", args->measure_samples,
+                "Adaptive: measure each quad's geometry image samples too, not only the mesh vertices in it "
+                "(stricter than the paper's eq. 4-5)");
   cmd->add_flag("--ply", args->ply, "Also write DIR/<stem>.M<K>.ply (binary)");
   return [args] { return run_remesh(*args); };
 }

@@ -219,6 +219,30 @@ TEST(AdaptiveRemesh, EpsilonZeroIsUniformAndLargerEpsilonHasFewerFaces) {
   EXPECT_LT(previous, finest.triangles.size());
 }
 
+TEST(AdaptiveRemesh, MeasuringSamplesNeverLowersTheError) {
+  const ModelParameterization& m = bumped_sphere();
+  const GeometryImages g = resample_geometry(m, 5, {false, -1});
+  const AdaptiveQuadErrors vertices = adaptive_quad_errors(m, g);
+  AdaptiveErrorOptions strict;
+  strict.measure_samples = true;
+  const AdaptiveQuadErrors samples = adaptive_quad_errors(m, g, strict);
+  std::size_t higher = 0;
+  for (std::size_t p = 0; p < 2; ++p) {
+    for (int d = 0; d <= 5; ++d) {
+      for (std::size_t q = 0; q < vertices.errors[p][d].size(); ++q) {
+        ASSERT_GE(samples.errors[p][d][q], vertices.errors[p][d][q]);
+        higher += samples.errors[p][d][q] > vertices.errors[p][d][q];
+      }
+    }
+  }
+  EXPECT_GT(higher, 0u);
+  AdaptiveRemeshOptions options;
+  options.epsilon = 0.004;
+  const AdaptiveQuadtree tree = adaptive_quadtree({samples}, g.adjacency, options);
+  expect_tiling_and_restricted(tree);
+  test::expect_watertight_oriented(adaptive_remesh(g, tree), 0, "bumped sphere, samples measured");
+}
+
 TEST(AdaptiveRemesh, RejectsMismatchedInputs) {
   const ModelParameterization& m = test::parameterized("sphere");
   const GeometryImages g = resample_geometry(m, 3, {false, -1});

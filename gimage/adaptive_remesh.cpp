@@ -187,9 +187,11 @@ AdaptiveQuadErrors adaptive_quad_errors(const ModelParameterization& model, cons
   for (std::size_t p = 0; p < model.patches.size(); ++p) {
     const PatchParameterization& patch = model.patches[p];
     if (patch.uv.size() != patch.vertices.size()) {
-      throw InvalidInput("adaptive_quad_errors: patch " + std::to_string(p) + " has uv and vertex arrays of different sizes");
+      throw InvalidInput("adaptive_quad_errors: patch " + std::to_string(p) +
+                         " has uv and vertex arrays of different sizes");
     }
-    // Finest cell of each vertex; vertices sorted by cell in Morton order so every quad's vertices form one run.
+    // Finest cell of each vertex; vertices sorted by cell in Morton order so every quad's vertices form one
+    // run.
     struct Item {
       std::uint32_t morton;
       int vertex;
@@ -254,8 +256,8 @@ AdaptiveQuadErrors adaptive_quad_errors(const ModelParameterization& model, cons
           for (const auto& x : points) e = std::max(e, plane.distance(x));
           if (options.measure_samples || points.size() <= 3) {
             // The quad's level-n samples, which its triangles stand for: needed where it holds few vertices
-            // (three always lie on their plane); optional elsewhere, where (u,v) triangles larger than the quad
-            // make most of its surface an interpolation of vertices outside it.
+            // (three always lie on their plane); optional elsewhere, where (u,v) triangles larger than the
+            // quad make most of its surface an interpolation of vertices outside it.
             for (int y = j * span; y <= (j + 1) * span; ++y) {
               for (int x = i * span; x <= (i + 1) * span; ++x) {
                 e = std::max(e, plane.distance(image.sample(x, y).cast<double>()));
@@ -278,11 +280,13 @@ std::size_t restrict_quadtree(AdaptiveQuadtree& tree) {
       // The tree may have changed in this pass: skip leaves that are no longer leaves.
       const int cells = 1 << tree.max_depth;
       const int span = 1 << (tree.max_depth - leaf.depth);
-      if (tree.depth[leaf.patch][static_cast<std::size_t>(leaf.j * span) * cells + leaf.i * span] != leaf.depth) {
+      if (tree.depth[leaf.patch][static_cast<std::size_t>(leaf.j * span) * cells + leaf.i * span] !=
+          leaf.depth) {
         continue;
       }
       bool split = false;
-      for (int side = 0; side < 4 && !split; ++side) split = max_neighbour_depth(tree, leaf, side) > leaf.depth + 1;
+      for (int side = 0; side < 4 && !split; ++side)
+        split = max_neighbour_depth(tree, leaf, side) > leaf.depth + 1;
       if (split) {
         set_leaf_depth(tree, leaf.patch, leaf.depth, leaf.i, leaf.j, leaf.depth + 1);
         ++splits;
@@ -294,7 +298,8 @@ std::size_t restrict_quadtree(AdaptiveQuadtree& tree) {
 }
 
 AdaptiveQuadtree adaptive_quadtree(const std::vector<AdaptiveQuadErrors>& errors,
-                                   const std::vector<SideLink>& adjacency, const AdaptiveRemeshOptions& options) {
+                                   const std::vector<SideLink>& adjacency,
+                                   const AdaptiveRemeshOptions& options) {
   if (errors.empty()) throw InvalidInput("adaptive_quadtree: no models");
   if (!(options.epsilon >= 0)) throw InvalidInput("adaptive_quadtree: epsilon must be >= 0");
   const int n = errors[0].max_depth;
@@ -314,7 +319,8 @@ AdaptiveQuadtree adaptive_quadtree(const std::vector<AdaptiveQuadErrors>& errors
       }
     }
   }
-  if (n < 0 || n > kMaxGeometryImageLevel) throw InvalidInput("adaptive_quadtree: maximum depth out of range");
+  if (n < 0 || n > kMaxGeometryImageLevel)
+    throw InvalidInput("adaptive_quadtree: maximum depth out of range");
   check_adjacency(adjacency, patches, "adaptive_quadtree");
   AdaptiveQuadtree tree;
   tree.max_depth = n;
@@ -335,7 +341,8 @@ AdaptiveQuadtree adaptive_quadtree(const std::vector<AdaptiveQuadErrors>& errors
     stack.pop_back();
     if (d >= n) continue;
     double e = 0;
-    for (const auto& model : errors) e = std::max(e, model.errors[p][d][static_cast<std::size_t>(j) * (1u << d) + i]);
+    for (const auto& model : errors)
+      e = std::max(e, model.errors[p][d][static_cast<std::size_t>(j) * (1u << d) + i]);
     if (e > options.epsilon) {
       set_leaf_depth(tree, p, d, i, j, d + 1);
       for (int c = 0; c < 4; ++c) stack.push_back({p, d + 1, 2 * i + (c & 1), 2 * j + (c >> 1)});

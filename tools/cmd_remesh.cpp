@@ -1,8 +1,8 @@
 // geomip remesh MESH... [--points CORR.json] [--level K] [--adaptive EPS [--max-depth N]] -o DIR [--ply]:
 // consistent parameterization (as `geomip param`), then the uniform level-K remesh of every model,
-// DIR/<stem>.M<K>.obj (and .ply) (gimage/uniform_remesh.h), and/or the adaptive remesh DIR/<stem>.adaptive.obj
-// (gimage/adaptive_remesh.h): watertight, consistently oriented, one face list for all models of a consistent
-// set.
+// DIR/<stem>.M<K>.obj (and .ply) (gimage/uniform_remesh.h), and/or the adaptive remesh
+// DIR/<stem>.adaptive.obj (gimage/adaptive_remesh.h): watertight, consistently oriented, one face list for
+// all models of a consistent set.
 #include "gimage/adaptive_remesh.h"
 #include "gimage/resample.h"
 #include "gimage/uniform_remesh.h"
@@ -27,7 +27,7 @@ namespace {
 
 struct RemeshArgs {
   ModelArgs common;
-  int level = -1;  ///< -1: no uniform remesh
+  int level = -1;        ///< -1: no uniform remesh
   double adaptive = -1;  ///< ε; < 0: no adaptive remesh
   int max_depth = 8;
   bool measure_samples = false;
@@ -46,8 +46,8 @@ int run_remesh(const RemeshArgs& args) {
     throw InvalidInput("--max-depth " + std::to_string(args.max_depth) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
   }
-  const PreparedModels models =
-      prepare_models(args.common.meshes, args.common.points, "geomip remesh", args.common.quiet || args.common.json);
+  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip remesh",
+                                               args.common.quiet || args.common.json);
   std::filesystem::create_directories(args.common.output);
 
   ParameterizationOptions options;
@@ -68,8 +68,8 @@ int run_remesh(const RemeshArgs& args) {
         uniform_remesh(resample_geometry(result[i], args.level, resample), args.level);
     const double remesh_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() + ".M" +
-                             std::to_string(args.level);
+    const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() +
+                             ".M" + std::to_string(args.level);
     write_file_atomically(stem + ".obj",
                           [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kObj); });
     if (args.ply) {
@@ -140,7 +140,8 @@ int run_remesh(const RemeshArgs& args) {
   } else if (!args.common.quiet) {
     std::printf("parameterization %.2f s\n", param_seconds);
     if (adaptive) {
-      std::printf("adaptive: resampling, quad errors and the shared quadtree %.3f s\n", adaptive_tree_seconds);
+      std::printf("adaptive: resampling, quad errors and the shared quadtree %.3f s\n",
+                  adaptive_tree_seconds);
     }
   }
   return kExitOk;
@@ -153,7 +154,8 @@ CommandRunner add_remesh_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "remesh",
       "Consistent remeshing (paper §4): parameterize as `geomip param`, resample every patch on its level-K "
-      "grid and triangulate it, seams welded: DIR/<stem>.M<K>.obj; and/or (--adaptive EPS) split a quadtree per "
+      "grid and triangulate it, seams welded: DIR/<stem>.M<K>.obj; and/or (--adaptive EPS) split a quadtree "
+      "per "
       "patch until the plane-fit error is below EPS, restricted and crack-free: DIR/<stem>.adaptive.obj. "
       "Watertight and oriented, with one face list for all models of a consistent set.");
   add_model_options(cmd, args->common);
@@ -162,7 +164,8 @@ CommandRunner add_remesh_command(CLI::App& app) {
                   "Adaptive remesh (paper §4, eq. 4-6) with error bound EPS (fraction of the bounding-box "
                   "diagonal): DIR/<stem>.adaptive.obj, one face list for a consistent set")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--max-depth", args->max_depth, "Adaptive: maximum quadtree depth N in [0, 10] (default 8)");
+  cmd->add_option("--max-depth", args->max_depth,
+                  "Adaptive: maximum quadtree depth N in [0, 10] (default 8)");
   cmd->add_flag("--measure-samples", args->measure_samples,
                 "Adaptive: measure each quad's geometry image samples too, not only the mesh vertices in it "
                 "(stricter than the paper's eq. 4-5)");

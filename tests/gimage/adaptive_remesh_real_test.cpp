@@ -1,6 +1,6 @@
-// Real meshes (../shared/meshes): adaptive remeshes at ε = 0.002, N = 8 are watertight, oriented and restricted
-// (no T-vertices), far smaller than M8; the animals consistent set (tests/data/animals.corr.json) shares one
-// adaptive face list.
+// Real meshes (../shared/meshes): adaptive remeshes at ε = 0.002, N = 8 are watertight, oriented and
+// restricted (no T-vertices), far smaller than M8; the animals consistent set (tests/data/animals.corr.json)
+// shares one adaptive face list.
 #include "gimage/adaptive_remesh.h"
 #include "gimage/uniform_remesh.h"
 #include "param/mesh_io.h"
@@ -19,7 +19,8 @@ TEST(RealAdaptiveRemesh, BunnyIsWatertightAndSmallerForLargerEpsilon) {
   GEOMIP_REQUIRE_SHARED_MESH(path, "bunny.obj");
   TriMesh mesh = read_mesh(path);
   mesh = repair_mesh(mesh).mesh;
-  const auto model = parameterize_consistently({test::automatic_input(mesh, "bunny")}, test::quick_options())[0];
+  const auto model =
+      parameterize_consistently({test::automatic_input(mesh, "bunny")}, test::quick_options())[0];
   const GeometryImages g = resample_geometry(model, 8, {false, -1});
   const AdaptiveQuadErrors e = adaptive_quad_errors(model, g);
   std::size_t previous = std::size_t{2} * 2 * (1u << 16);  // uniform M8: 2 patches · 4^8 quads · 2
@@ -35,8 +36,9 @@ TEST(RealAdaptiveRemesh, BunnyIsWatertightAndSmallerForLargerEpsilon) {
 
 TEST(RealAdaptiveRemesh, AnimalsShareOneAdaptiveFaceList) {
   GEOMIP_REQUIRE_SHARED_MESH(horse, "horse.obj");
-  const auto models = tools::prepare_models(
-      {}, std::string(GEOMIP_SOURCE_DIR) + "/tests/data/animals.corr.json", "adaptive_remesh_real_test", true);
+  const auto models =
+      tools::prepare_models({}, std::string(GEOMIP_SOURCE_DIR) + "/tests/data/animals.corr.json",
+                            "adaptive_remesh_real_test", true);
   ASSERT_EQ(models.inputs.size(), 4u);
   const auto params = parameterize_consistently(models.inputs, test::quick_options());
   std::vector<GeometryImages> images;

@@ -131,8 +131,8 @@ TEST(AdaptiveRemesh, FlatRegionNeverSplits) {
   options.epsilon = 1e-6;
   options.restrict_levels = false;
   const AdaptiveQuadtree tree = adaptive_quadtree({e}, g.adjacency, options);
-  // Every quad with ≥ 4 vertices (fewer are measured with the samples), all on the flat disk: error ~0, and it
-  // is a leaf or inside one.
+  // Every quad with ≥ 4 vertices (fewer are measured with the samples), all on the flat disk: error ~0, and
+  // it is a leaf or inside one.
   std::size_t flat_quads = 0;
   const int cells = 1 << kLevel;
   for (std::size_t p = 0; p < m.patches.size(); ++p) {
@@ -197,8 +197,8 @@ TEST(AdaptiveRemesh, EpsilonZeroIsUniformAndLargerEpsilonHasFewerFaces) {
   const GeometryImages coarse = resample_geometry(m, 3, {false, -1});
   AdaptiveRemeshOptions options;
   options.epsilon = 0;
-  const TriMesh zero =
-      adaptive_remesh(coarse, adaptive_quadtree({adaptive_quad_errors(m, coarse)}, coarse.adjacency, options));
+  const TriMesh zero = adaptive_remesh(
+      coarse, adaptive_quadtree({adaptive_quad_errors(m, coarse)}, coarse.adjacency, options));
   const UniformRemeshResult uniform = uniform_remesh(coarse, 3);
   EXPECT_EQ(zero.triangles.size(), uniform.mesh.triangles.size());
   EXPECT_EQ(zero.positions.size(), uniform.mesh.positions.size());

@@ -451,6 +451,13 @@ TEST_F(CliGimage, AdaptiveRemeshIsWatertightSharedAndCoarserForLargerEps) {
     EXPECT_GT(a.triangles.size(), previous) << "smaller eps, more faces";
     previous = a.triangles.size();
   }
+  // --measure-samples bounds the error of more points: never fewer faces.
+  const std::string strict = dir_ + "/strict";
+  ASSERT_EQ(geomip("remesh --quiet --points '" + corr +
+                   "' --adaptive 0.005 --max-depth 6 --measure-samples -o '" + strict + "'")
+                .exit_code,
+            0);
+  EXPECT_GE(read_mesh(strict + "/a.adaptive.obj").triangles.size(), previous);
   const std::string out = dir_ + "/bad";
   EXPECT_EQ(geomip("remesh '" + spot_ + "' --adaptive -1 -o '" + out + "'").exit_code, 2);
   EXPECT_EQ(geomip("remesh '" + spot_ + "' --adaptive 0.01 --max-depth 11 -o '" + out + "'").exit_code, 2);

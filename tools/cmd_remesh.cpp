@@ -1,7 +1,9 @@
-// geomip remesh MESH... [--points CORR.json] --level K -o DIR [--ply]: consistent parameterization (as
-// `geomip param`), then the uniform level-K remesh of every model, DIR/<stem>.M<K>.obj (and .ply):
-// watertight, consistently oriented, one face list for all models of a consistent set
-// (gimage/uniform_remesh.h).
+// geomip remesh MESH... [--points CORR.json] [--level K] [--adaptive EPS [--max-depth N]] -o DIR [--ply]:
+// consistent parameterization (as `geomip param`), then the uniform level-K remesh of every model,
+// DIR/<stem>.M<K>.obj (and .ply) (gimage/uniform_remesh.h), and/or the adaptive remesh
+// DIR/<stem>.adaptive.obj (gimage/adaptive_remesh.h): watertight, consistently oriented, one face list for
+// all models of a consistent set.
+#include "gimage/adaptive_remesh.h"
 #include "gimage/resample.h"
 #include "gimage/uniform_remesh.h"
 #include "param/consistent_parameterization.h"
@@ -25,17 +27,27 @@ namespace {
 
 struct RemeshArgs {
   ModelArgs common;
-  int level = 0;
+  int level = -1;        ///< -1: no uniform remesh
+  double adaptive = -1;  ///< ε; < 0: no adaptive remesh
+  int max_depth = 8;
+  bool measure_samples = false;
   bool ply = false;
 };
 
 int run_remesh(const RemeshArgs& args) {
-  if (args.level < 0 || args.level > kMaxGeometryImageLevel) {
-    throw InvalidInput("--level " + std::to_string(args.level) + " is outside [0, " +
+  const bool uniform = args.level != -1 || args.adaptive < 0;
+  const bool adaptive = args.adaptive >= 0;
+  if (uniform && (args.level < 0 || args.level > kMaxGeometryImageLevel)) {
+    throw InvalidInput(args.level == -1 ? std::string("give --level K and/or --adaptive EPS")
+                                        : "--level " + std::to_string(args.level) + " is outside [0, " +
+                                              std::to_string(kMaxGeometryImageLevel) + "]");
+  }
+  if (adaptive && (args.max_depth < 0 || args.max_depth > kMaxGeometryImageLevel)) {
+    throw InvalidInput("--max-depth " + std::to_string(args.max_depth) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
   }
-  const PreparedModels models =
-      prepare_models(args.common.meshes, args.common.points, "geomip remesh", args.common.quiet || args.common.json);
+  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip remesh",
+                                               args.common.quiet || args.common.json);
   std::filesystem::create_directories(args.common.output);
 
   ParameterizationOptions options;
@@ -48,7 +60,7 @@ int run_remesh(const RemeshArgs& args) {
   bar.finish();
 
   nlohmann::json summary = nlohmann::json::array();
-  for (std::size_t i = 0; i < result.size(); ++i) {
+  for (std::size_t i = 0; i < result.size() && uniform; ++i) {
     t0 = std::chrono::steady_clock::now();
     ResampleOptions resample;
     resample.normals = false;
@@ -56,8 +68,8 @@ int run_remesh(const RemeshArgs& args) {
         uniform_remesh(resample_geometry(result[i], args.level, resample), args.level);
     const double remesh_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() + ".M" +
-                             std::to_string(args.level);
+    const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() +
+                             ".M" + std::to_string(args.level);
     write_file_atomically(stem + ".obj",
                           [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kObj); });
     if (args.ply) {
@@ -79,10 +91,58 @@ int run_remesh(const RemeshArgs& args) {
                   remesh.mesh.triangles.size(), remesh_seconds);
     }
   }
+  double adaptive_tree_seconds = 0;  // resampling, quad errors and the shared tree, all models
+  if (adaptive) {
+    // One quadtree for the whole set: the maximum of the models' quad errors (eq. 6).
+    t0 = std::chrono::steady_clock::now();
+    ResampleOptions resample;
+    resample.normals = false;
+    std::vector<GeometryImages> images;
+    std::vector<AdaptiveQuadErrors> errors;
+    for (const auto& model : result) {
+      images.push_back(resample_geometry(model, args.max_depth, resample));
+      AdaptiveErrorOptions error_options;
+      error_options.measure_samples = args.measure_samples;
+      errors.push_back(adaptive_quad_errors(model, images.back(), error_options));
+    }
+    AdaptiveRemeshOptions tree_options;
+    tree_options.epsilon = args.adaptive;
+    const AdaptiveQuadtree tree = adaptive_quadtree(errors, images[0].adjacency, tree_options);
+    const std::size_t leaves = tree.leaves().size();
+    adaptive_tree_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (std::size_t i = 0; i < result.size(); ++i) {
+      t0 = std::chrono::steady_clock::now();
+      const TriMesh mesh = adaptive_remesh(images[i], tree);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const std::string path =
+          (std::filesystem::path(args.common.output) / models.inputs[i].name).string() + ".adaptive.obj";
+      write_file_atomically(path, [&](std::ostream& out) { write_mesh(mesh, out, MeshFormat::kObj); });
+      if (args.common.json) {
+        summary.push_back(nlohmann::json{{"mesh", models.paths[i]},
+                                         {"obj", path},
+                                         {"adaptive", args.adaptive},
+                                         {"max_depth", args.max_depth},
+                                         {"leaves", leaves},
+                                         {"vertices", mesh.positions.size()},
+                                         {"faces", mesh.triangles.size()},
+                                         {"remesh_seconds", seconds}});
+      } else if (!args.common.quiet) {
+        std::printf("remesh %s → %s: %zu vertices, %zu faces (eps %g, %zu leaves; triangulated in %.3f s)\n",
+                    models.paths[i].c_str(), path.c_str(), mesh.positions.size(), mesh.triangles.size(),
+                    args.adaptive, leaves, seconds);
+      }
+    }
+  }
   if (args.common.json) {
-    std::cout << nlohmann::json{{"models", summary}, {"param_seconds", param_seconds}}.dump(2) << "\n";
+    nlohmann::json j{{"models", summary}, {"param_seconds", param_seconds}};
+    if (adaptive) j["adaptive_tree_seconds"] = adaptive_tree_seconds;
+    std::cout << j.dump(2) << "\n";
   } else if (!args.common.quiet) {
     std::printf("parameterization %.2f s\n", param_seconds);
+    if (adaptive) {
+      std::printf("adaptive: resampling, quad errors and the shared quadtree %.3f s\n",
+                  adaptive_tree_seconds);
+    }
   }
   return kExitOk;
 }
@@ -93,12 +153,22 @@ CommandRunner add_remesh_command(CLI::App& app) {
   auto args = std::make_shared<RemeshArgs>();
   CLI::App* cmd = app.add_subcommand(
       "remesh",
-      "Uniform consistent remeshing (paper §4): parameterize as `geomip param`, resample every patch on its "
-      "level-K grid and triangulate it, seams welded: DIR/<stem>.M<K>.obj, watertight and oriented, with one "
-      "face "
-      "list for all models of a consistent set.");
+      "Consistent remeshing (paper §4): parameterize as `geomip param`, resample every patch on its level-K "
+      "grid and triangulate it, seams welded: DIR/<stem>.M<K>.obj; and/or (--adaptive EPS) split a quadtree "
+      "per "
+      "patch until the plane-fit error is below EPS, restricted and crack-free: DIR/<stem>.adaptive.obj. "
+      "Watertight and oriented, with one face list for all models of a consistent set.");
   add_model_options(cmd, args->common);
-  cmd->add_option("--level", args->level, "Level K in [0, 10]: (2^K)² quads per patch")->required();
+  cmd->add_option("--level", args->level, "Level K in [0, 10]: (2^K)² quads per patch");
+  cmd->add_option("--adaptive", args->adaptive,
+                  "Adaptive remesh (paper §4, eq. 4-6) with error bound EPS (fraction of the bounding-box "
+                  "diagonal): DIR/<stem>.adaptive.obj, one face list for a consistent set")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--max-depth", args->max_depth,
+                  "Adaptive: maximum quadtree depth N in [0, 10] (default 8)");
+  cmd->add_flag("--measure-samples", args->measure_samples,
+                "Adaptive: measure each quad's geometry image samples too, not only the mesh vertices in it "
+                "(stricter than the paper's eq. 4-5)");
   cmd->add_flag("--ply", args->ply, "Also write DIR/<stem>.M<K>.ply (binary)");
   return [args] { return run_remesh(*args); };
 }

@@ -426,5 +426,43 @@ TEST_F(Cli, AnimalsGetIdenticalFeatureCoordinates) {
   }
 }
 
+TEST_F(CliGimage, AdaptiveRemeshIsWatertightSharedAndCoarserForLargerEps) {
+  const std::string corr = sphere_pair();
+  std::size_t previous = 0;
+  for (const char* eps : {"0.02", "0.005"}) {
+    const std::string out = dir_ + "/out" + eps;
+    const Outcome r =
+        geomip("remesh --json --points '" + corr + "' --adaptive " + eps + " --max-depth 6 -o '" + out + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["models"].size(), 2u);
+    EXPECT_FALSE(fs::exists(out + "/a.M0.obj"));  // no uniform remesh unless --level is given
+    const TriMesh a = read_mesh(out + "/a.adaptive.obj");
+    const TriMesh b = read_mesh(out + "/b.adaptive.obj");
+    EXPECT_EQ(a.triangles, b.triangles);
+    EXPECT_NE(a.positions, b.positions);
+    EXPECT_EQ(j["models"][0]["faces"].get<std::size_t>(), a.triangles.size());
+    for (const TriMesh* m : {&a, &b}) {
+      const TopologyReport t = analyze_topology(*m);
+      EXPECT_EQ(t.boundary_loops, 0u);
+      EXPECT_TRUE(t.manifold);
+      EXPECT_EQ(t.genus, 0);
+    }
+    EXPECT_GT(a.triangles.size(), previous) << "smaller eps, more faces";
+    previous = a.triangles.size();
+  }
+  // --measure-samples bounds the error of more points: never fewer faces.
+  const std::string strict = dir_ + "/strict";
+  ASSERT_EQ(geomip("remesh --quiet --points '" + corr +
+                   "' --adaptive 0.005 --max-depth 6 --measure-samples -o '" + strict + "'")
+                .exit_code,
+            0);
+  EXPECT_GE(read_mesh(strict + "/a.adaptive.obj").triangles.size(), previous);
+  const std::string out = dir_ + "/bad";
+  EXPECT_EQ(geomip("remesh '" + spot_ + "' --adaptive -1 -o '" + out + "'").exit_code, 2);
+  EXPECT_EQ(geomip("remesh '" + spot_ + "' --adaptive 0.01 --max-depth 11 -o '" + out + "'").exit_code, 2);
+  EXPECT_EQ(geomip("remesh '" + spot_ + "' -o '" + out + "'").exit_code, 2);  // neither --level nor --adaptive
+}
+
 }  // namespace
 }  // namespace geomip

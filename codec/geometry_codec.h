@@ -1,0 +1,108 @@
+// Progressive wavelet coding of one model's geometry images (or normal maps): a set of (2^n+1)² grids of
+// 3-channel floats, one per patch, glued along their sides by seams.
+//
+// Pipeline (encoder): quantize each channel to integers on a fixed step (uniform over the model) → integer
+// lifting wavelet transform per patch (wavelet.h), whose coarse band after k steps is exactly the nested
+// (2^(n−k)+1)² grid → embedded bit-plane coding of the coefficients (bitplane_coder.h) driven by the
+// context-adaptive binary arithmetic coder (arithmetic_coder.h). Every sample shared by several patches (seam
+// sides, corners) is coded once, by its owner (the lowest patch·grid index among the copies); the decoder
+// copies it to the other patches before the inverse transform, so every decoded prefix is watertight with
+// bit-identical seam samples.
+//
+// The output is a list of segments, one per bit-plane pass, coarsest information first. Segments are
+// self-delimiting only through their sizes (stored by the container, pack.h); a decoder given the first k
+// complete segments plus a byte prefix of segment k+1 reconstructs the best approximation those bytes allow.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "codec/status.h"
+
+namespace geomip::codec {
+
+/// How two patch sides are glued (same convention as geomip::SideLink in param/mesh_partition.h, repeated
+/// here so codec/ builds without param/). Side s of a (2^n+1)² grid, parameter k ∈ [0, 2^n]:
+/// s = 0: (i, j) = (k, 0); s = 1: (2^n, k); s = 2: (2^n − k, 2^n); s = 3: (0, 2^n − k). `reversed`: sample k of
+/// this side is sample 2^n − k of the other side.
+struct PatchSeam {
+  int patch = 0;
+  int side = 0;
+  int other_patch = 0;
+  int other_side = 0;
+  bool reversed = true;
+};
+
+/// A (2^level+1)² grid of 3-channel floats, row-major: values[3·(j·size + i) + c].
+struct Grid3 {
+  int level = 0;
+  std::vector<float> values;
+  int size() const { return (1 << level) + 1; }
+};
+
+enum class WaveletFilter : std::uint8_t {
+  kLinear = 0,  ///< interpolating, 2-point prediction (Deslauriers–Dubuc order 2)
+  kCubic = 1,   ///< interpolating, 4-point prediction (Deslauriers–Dubuc order 4)
+};
+
+struct GeometryCodecOptions {
+  /// Quantization: the step is (largest bounding-box extent of all patches) / 2^quantization_bits.
+  int quantization_bits = 16;
+  WaveletFilter filter = WaveletFilter::kCubic;
+  /// Wavelet steps; -1 = all the way down to the 2×2 grid of corners (level 0).
+  int steps = -1;
+};
+
+/// The small fixed parameters the decoder needs besides the segments (stored in the pack manifest).
+/// serialize()/parse() give a compact byte form; parse() never trusts bytes.
+struct GeometryCodecHeader {
+  int level = 0;        ///< grid level n of every patch
+  int num_patches = 0;  ///< patches per model
+  int steps = 0;        ///< wavelet steps actually applied
+  WaveletFilter filter = WaveletFilter::kCubic;
+  double origin[3] = {0, 0, 0};  ///< dequantized value = origin + step · integer
+  double step = 1;
+  int top_bitplane = 0;  ///< most significant (weighted) bit-plane coded; one segment per plane down to 0
+  std::vector<PatchSeam> seams;
+
+  std::vector<std::uint8_t> serialize() const;
+  /// Parses `bytes` exactly (all of them); kCorrupt on any inconsistency (level > 12, seams out of range, ...).
+  static Status parse(std::span<const std::uint8_t> bytes, GeometryCodecHeader& out);
+};
+
+struct EncodedGeometry {
+  GeometryCodecHeader header;
+  std::vector<std::vector<std::uint8_t>> segments;  ///< one per bit-plane, most significant first
+};
+
+/// Encodes the patches (all of one level, same number as seams describe; seam samples must be bit-identical in
+/// the glued patches — resample_geometry() guarantees it). Throws std::invalid_argument on bad input (sizes
+/// differ, NaN, level > 12): this is the encoder, its inputs come from the program, not from bytes.
+EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::vector<PatchSeam>& seams,
+                                const GeometryCodecOptions& options = {});
+
+struct GeometryDecodeOptions {
+  /// Zero the details of the finest `drop_finest_steps` wavelet steps (0 = keep all). The result stays on the
+  /// full grid: the coarser level interpolated by the wavelet's own subdivision (for band-wise morphing).
+  int drop_finest_steps = 0;
+};
+
+struct DecodedGeometry {
+  std::vector<Grid3> patches;  ///< header.num_patches grids of header.level, in the encoder's units
+  std::size_t segments_complete = 0;  ///< complete segments decoded
+  bool partial = false;               ///< a byte prefix of one more segment was also used
+  /// Finest wavelet level that received any non-zero detail (0..level): the level of detail these bytes give.
+  int detail_level = 0;
+};
+
+/// Decodes `segments` (complete, in order); `partial_tail`, if not empty, is a byte prefix of the next segment.
+/// Never throws on bytes: returns kOk, or kCorrupt (bytes that cannot come from the encoder — the result is
+/// then the best reconstruction up to that point, still watertight). A partial tail is not an error.
+Status decode_geometry(const GeometryCodecHeader& header,
+                       std::span<const std::span<const std::uint8_t>> segments,
+                       std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,
+                       const GeometryDecodeOptions& options = {});
+
+}  // namespace geomip::codec

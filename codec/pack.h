@@ -1,0 +1,136 @@
+// The .gip pack: one static, streamable file holding the progressively coded geometry images (and normal
+// maps) of one or more consistent models.
+//
+// Layout (all integers little-endian; varint = unsigned LEB128):
+//   [fixed header, kPackHeaderSize bytes]
+//     magic "GEOMIPK\x1a" (8) | format version u16 | flags u16 | manifest size u32 | manifest CRC32 u32
+//   [manifest, manifest-size bytes]
+//     models (name, normalization transform, geometry / normal codec headers, hole masks), seams, and the
+//     chunk table: for each chunk its model, kind (geometry / normals), bit-plane pass, size and CRC32.
+//     Chunk offsets follow from the sizes: chunk 0 starts right after the manifest.
+//   [chunks, in table order]
+//     ordered coarse → fine across all models (pass 0 of every model, then pass 1, ...; normal-map passes
+//     trail the geometry passes), so any byte prefix of the file is a coarser level of detail of every model.
+//
+// Designed for HTTP range requests: read kPackHeaderSize bytes, then the manifest, then chunks in order.
+// Decoders never throw or assert on bytes; they return a Status.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "codec/geometry_codec.h"
+#include "codec/status.h"
+
+namespace geomip::codec {
+
+inline constexpr std::size_t kPackHeaderSize = 20;
+inline constexpr std::uint16_t kPackVersion = 1;
+
+enum class ChunkKind : std::uint8_t { kGeometry = 0, kNormals = 1 };
+
+struct ChunkInfo {
+  int model = 0;
+  ChunkKind kind = ChunkKind::kGeometry;
+  int pass = 0;             ///< bit-plane pass of that model's stream (0 = most significant)
+  std::uint64_t offset = 0; ///< from the start of the file (derived from the sizes)
+  std::uint32_t size = 0;
+  std::uint32_t crc32 = 0;
+};
+
+struct PackModelInfo {
+  std::string name;  ///< source mesh name (file stem)
+  /// Row-major 4×4 transform from model units to the normalized frame the viewer uses (unit bounding box,
+  /// centred); identity when not known.
+  std::array<double, 16> normalization{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  GeometryCodecHeader geometry;
+  bool has_normals = false;
+  GeometryCodecHeader normals;  ///< valid when has_normals
+  /// Per patch, per quad of the geometry grid (2^level × 2^level, row-major), 1 = the quad covers a filled hole
+  /// of the source mesh (geomip repair) and is left out of decoded meshes. Empty = no holes.
+  std::vector<std::vector<std::uint8_t>> hole_mask;
+};
+
+struct PackInfo {
+  std::uint16_t version = kPackVersion;
+  std::vector<PackModelInfo> models;
+  std::vector<ChunkInfo> chunks;
+  std::size_t manifest_end = 0;  ///< kPackHeaderSize + manifest size: where chunk 0 starts
+  std::uint64_t file_size() const {
+    return chunks.empty() ? manifest_end : chunks.back().offset + chunks.back().size;
+  }
+};
+
+/// Reads the fixed header only: the number of bytes the manifest ends at. kTruncated if fewer than
+/// kPackHeaderSize bytes, kCorrupt on a bad magic, kUnsupportedVersion on another format version.
+Status read_pack_header(std::span<const std::uint8_t> bytes, std::size_t& manifest_end);
+
+/// Reads header + manifest (verifying its CRC). kTruncated if `bytes` ends before the manifest does.
+Status read_pack_info(std::span<const std::uint8_t> bytes, PackInfo& out);
+
+// ---- writing -------------------------------------------------------------------------------------------
+
+struct PackModelInput {
+  std::string name;
+  std::array<double, 16> normalization{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  std::vector<Grid3> geometry;  ///< per patch
+  std::vector<Grid3> normals;   ///< per patch, or empty (geometry-only pack)
+  std::vector<PatchSeam> seams;
+  std::vector<std::vector<std::uint8_t>> hole_mask;  ///< as PackModelInfo::hole_mask; may be empty
+};
+
+struct PackWriteOptions {
+  GeometryCodecOptions geometry;  ///< defaults: 16 bits, cubic interpolating wavelet
+  GeometryCodecOptions normals{.quantization_bits = 10, .filter = WaveletFilter::kCubic, .steps = -1};
+  bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
+  /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.
+  int normals_delay = 4;
+};
+
+/// Encodes and lays out a pack in memory. Throws std::invalid_argument on bad input (models whose patch
+/// layouts differ, NaN, ...).
+std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, const PackWriteOptions& options = {});
+
+// ---- decoding ------------------------------------------------------------------------------------------
+
+struct PackDecodeOptions {
+  /// Use only the first max_bytes bytes of the buffer (as if only they had arrived).
+  std::size_t max_bytes = std::numeric_limits<std::size_t>::max();
+  bool normals = true;        ///< decode normal maps when the pack has them
+  bool partial_chunks = true; ///< also use a byte prefix of the first incomplete chunk (embedded streams)
+  int drop_finest_steps = 0;  ///< see GeometryDecodeOptions
+};
+
+struct DecodedModel {
+  std::string name;
+  std::array<double, 16> normalization{};
+  std::vector<Grid3> geometry;                        ///< per patch, model units
+  std::vector<Grid3> normals;                         ///< per patch (empty when not decoded / not in pack)
+  std::vector<PatchSeam> seams;
+  std::vector<std::vector<std::uint8_t>> hole_mask;   ///< as PackModelInfo::hole_mask
+  int detail_level = 0;                               ///< finest level that received detail
+  std::size_t geometry_passes = 0;                    ///< complete geometry passes decoded
+};
+
+struct PackDecodeResult {
+  /// kOk: every chunk decoded. kTruncated: the bytes end early; `models` hold what the prefix gives (empty if
+  /// it ends inside the manifest). kCorrupt: a chunk failed its CRC (decoding stopped at the last good pass of
+  /// every model) or the manifest is damaged. kUnsupportedVersion: another format version.
+  Status status = Status::kOk;
+  PackInfo info;
+  std::vector<DecodedModel> models;
+  std::size_t chunks_decoded = 0;  ///< complete, CRC-checked chunks used
+  std::size_t bytes_used = 0;      ///< bytes of the buffer that contributed
+};
+
+PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDecodeOptions& options = {});
+
+/// CRC-32 (IEEE 802.3, zlib's crc32).
+std::uint32_t crc32(std::span<const std::uint8_t> bytes);
+
+}  // namespace geomip::codec

@@ -86,7 +86,7 @@ struct PackModelInput {
 
 struct PackWriteOptions {
   GeometryCodecOptions geometry;  ///< defaults: 16 bits, cubic interpolating wavelet
-  GeometryCodecOptions normals{.quantization_bits = 10, .filter = WaveletFilter::kCubic, .steps = -1};
+  GeometryCodecOptions normal_codec{.quantization_bits = 10, .filter = WaveletFilter::kCubic, .steps = -1};
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.
   int normals_delay = 4;

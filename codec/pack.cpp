@@ -1,0 +1,375 @@
+#include "codec/pack.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <tuple>
+
+#include "codec/byte_io.h"
+
+namespace geomip::codec {
+namespace {
+
+using detail::ByteReader;
+using detail::ByteWriter;
+
+constexpr std::uint8_t kMagic[8] = {'G', 'E', 'O', 'M', 'I', 'P', 'K', 0x1a};
+
+// Limits that keep a decoder of hostile bytes within bounded memory and time.
+constexpr std::size_t kMaxModels = 64;
+constexpr std::size_t kMaxNameSize = 4096;
+constexpr std::size_t kMaxManifestSize = 64u << 20;
+constexpr int kMaxPackLevel = 11;
+constexpr std::uint64_t kMaxSamplesPerPack = std::uint64_t{1} << 25;
+constexpr std::uint64_t kMaxPasses = 64;
+
+enum NormalizationForm : std::uint8_t { kIdentity = 0, kScaleTranslate = 1, kFull = 2 };
+
+bool is_identity(const std::array<double, 16>& m) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      if (m[4 * r + c] != (r == c ? 1.0 : 0.0)) return false;
+  return true;
+}
+bool is_scale_translate(const std::array<double, 16>& m) {
+  return m[1] == 0 && m[2] == 0 && m[4] == 0 && m[6] == 0 && m[8] == 0 && m[9] == 0 && m[12] == 0 &&
+         m[13] == 0 && m[14] == 0 && m[15] == 1 && m[0] == m[5] && m[0] == m[10];
+}
+
+void write_normalization(ByteWriter& w, const std::array<double, 16>& m) {
+  if (is_identity(m)) {
+    w.u8(kIdentity);
+  } else if (is_scale_translate(m)) {
+    w.u8(kScaleTranslate);
+    for (double v : {m[0], m[3], m[7], m[11]}) w.f64(v);
+  } else {
+    w.u8(kFull);
+    for (double v : m) w.f64(v);
+  }
+}
+
+bool read_normalization(ByteReader& r, std::array<double, 16>& m) {
+  std::uint8_t form;
+  if (!r.u8(form)) return false;
+  m = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  if (form == kIdentity) return true;
+  if (form == kScaleTranslate) {
+    double s, tx, ty, tz;
+    if (!(r.f64(s) && r.f64(tx) && r.f64(ty) && r.f64(tz))) return false;
+    m[0] = m[5] = m[10] = s;
+    m[3] = tx, m[7] = ty, m[11] = tz;
+  } else if (form == kFull) {
+    for (double& v : m)
+      if (!r.f64(v)) return false;
+  } else {
+    return false;
+  }
+  return std::all_of(m.begin(), m.end(), [](double v) { return std::isfinite(v); });
+}
+
+// Hole mask of one patch: run lengths of alternating 0/1 quads, starting with a (possibly empty) 0 run.
+void write_mask(ByteWriter& w, const std::vector<std::uint8_t>& mask) {
+  std::vector<std::uint64_t> runs;
+  std::uint8_t current = 0;
+  std::uint64_t run = 0;
+  for (std::uint8_t v : mask) {
+    const std::uint8_t bit = v ? 1 : 0;
+    if (bit != current) {
+      runs.push_back(run);
+      run = 0;
+      current = bit;
+    }
+    ++run;
+  }
+  runs.push_back(run);
+  w.varint(runs.size());
+  for (std::uint64_t r : runs) w.varint(r);
+}
+
+bool read_mask(ByteReader& r, std::uint64_t quads, std::vector<std::uint8_t>& mask) {
+  std::uint64_t count;
+  if (!r.bounded(count, std::min<std::uint64_t>(quads + 1, r.remaining()))) return false;
+  mask.assign(static_cast<std::size_t>(quads), 0);
+  std::uint64_t at = 0;
+  for (std::uint64_t k = 0; k < count; ++k) {
+    std::uint64_t run;
+    if (!r.bounded(run, quads - at)) return false;
+    if (k % 2 == 1) std::fill_n(mask.begin() + static_cast<std::ptrdiff_t>(at), run, std::uint8_t{1});
+    at += run;
+  }
+  return at == quads;
+}
+
+// The canonical chunk order: by stage (geometry pass p → p, normal pass p → p + delay), then geometry before
+// normals, then model.
+struct ChunkKey {
+  int stage, kind, model, pass;
+};
+std::vector<ChunkKey> chunk_order(const std::vector<int>& geometry_passes, const std::vector<int>& normal_passes,
+                                  int normals_delay) {
+  std::vector<ChunkKey> keys;
+  for (std::size_t m = 0; m < geometry_passes.size(); ++m) {
+    for (int p = 0; p < geometry_passes[m]; ++p) keys.push_back({p, 0, static_cast<int>(m), p});
+    for (int p = 0; p < normal_passes[m]; ++p) keys.push_back({p + normals_delay, 1, static_cast<int>(m), p});
+  }
+  std::stable_sort(keys.begin(), keys.end(), [](const ChunkKey& a, const ChunkKey& b) {
+    return std::tie(a.stage, a.kind, a.model) < std::tie(b.stage, b.kind, b.model);
+  });
+  return keys;
+}
+
+int passes_of(const GeometryCodecHeader& h) { return h.top_bitplane + 1; }
+
+std::uint64_t samples_of(const GeometryCodecHeader& h) {
+  const std::uint64_t n = (std::uint64_t{1} << h.level) + 1;
+  return n * n * static_cast<std::uint64_t>(h.num_patches);
+}
+
+Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_end, PackInfo& out) {
+  ByteReader r(bytes);
+  std::uint64_t model_count, normals_delay;
+  if (!r.bounded(model_count, kMaxModels) || model_count == 0 || !r.bounded(normals_delay, kMaxPasses))
+    return Status::kCorrupt;
+  out.models.assign(static_cast<std::size_t>(model_count), {});
+  std::vector<int> geometry_passes, normal_passes;
+  std::uint64_t samples = 0;
+  for (PackModelInfo& model : out.models) {
+    std::vector<std::uint8_t> header;
+    std::uint8_t has_normals;
+    if (!r.string(model.name, kMaxNameSize) || !read_normalization(r, model.normalization) ||
+        !r.bytes(header, 1 << 20) || GeometryCodecHeader::parse(header, model.geometry) != Status::kOk ||
+        !r.u8(has_normals) || has_normals > 1)
+      return Status::kCorrupt;
+    if (model.geometry.level > kMaxPackLevel || passes_of(model.geometry) < 1 ||
+        passes_of(model.geometry) > static_cast<int>(kMaxPasses))
+      return Status::kCorrupt;
+    samples += samples_of(model.geometry);
+    model.has_normals = has_normals == 1;
+    if (model.has_normals) {
+      if (!r.bytes(header, 1 << 20) || GeometryCodecHeader::parse(header, model.normals) != Status::kOk ||
+          model.normals.level > kMaxPackLevel || model.normals.num_patches != model.geometry.num_patches ||
+          passes_of(model.normals) < 1 || passes_of(model.normals) > static_cast<int>(kMaxPasses))
+        return Status::kCorrupt;
+      samples += samples_of(model.normals);
+    }
+    if (samples > kMaxSamplesPerPack) return Status::kCorrupt;
+    std::uint64_t mask_patches;
+    if (!r.bounded(mask_patches, static_cast<std::uint64_t>(model.geometry.num_patches))) return Status::kCorrupt;
+    if (mask_patches != 0 && mask_patches != static_cast<std::uint64_t>(model.geometry.num_patches))
+      return Status::kCorrupt;
+    model.hole_mask.resize(static_cast<std::size_t>(mask_patches));
+    const std::uint64_t quads = std::uint64_t{1} << (2 * model.geometry.level);
+    for (auto& mask : model.hole_mask)
+      if (!read_mask(r, quads, mask)) return Status::kCorrupt;
+    geometry_passes.push_back(passes_of(model.geometry));
+    normal_passes.push_back(model.has_normals ? passes_of(model.normals) : 0);
+  }
+  const std::vector<ChunkKey> order = chunk_order(geometry_passes, normal_passes, static_cast<int>(normals_delay));
+  std::uint64_t chunk_count;
+  if (!r.varint(chunk_count) || chunk_count != order.size()) return Status::kCorrupt;
+  out.chunks.resize(order.size());
+  std::uint64_t offset = manifest_end;
+  for (std::size_t c = 0; c < order.size(); ++c) {
+    ChunkInfo& chunk = out.chunks[c];
+    std::uint64_t size;
+    if (!r.bounded(size, 0x7fffffff) || !r.u32(chunk.crc32)) return Status::kCorrupt;
+    chunk.model = order[c].model;
+    chunk.kind = order[c].kind == 0 ? ChunkKind::kGeometry : ChunkKind::kNormals;
+    chunk.pass = order[c].pass;
+    chunk.offset = offset;
+    chunk.size = static_cast<std::uint32_t>(size);
+    offset += size;
+  }
+  if (r.remaining() != 0) return Status::kCorrupt;
+  return Status::kOk;
+}
+
+}  // namespace
+
+std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
+  uLong crc = ::crc32(0L, Z_NULL, 0);
+  std::size_t at = 0;
+  while (at < bytes.size()) {
+    const std::size_t n = std::min<std::size_t>(bytes.size() - at, 1u << 30);
+    crc = ::crc32(crc, bytes.data() + at, static_cast<uInt>(n));
+    at += n;
+  }
+  return static_cast<std::uint32_t>(crc);
+}
+
+Status read_pack_header(std::span<const std::uint8_t> bytes, std::size_t& manifest_end) {
+  const std::size_t n = std::min(bytes.size(), sizeof kMagic);
+  if (!std::equal(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n), kMagic)) return Status::kCorrupt;
+  if (bytes.size() < kPackHeaderSize) return Status::kTruncated;
+  ByteReader r(bytes.subspan(sizeof kMagic));
+  std::uint16_t version, flags;
+  std::uint32_t manifest_size, manifest_crc;
+  r.u16(version), r.u16(flags), r.u32(manifest_size), r.u32(manifest_crc);
+  if (version != kPackVersion) return Status::kUnsupportedVersion;
+  if (flags != 0 || manifest_size > kMaxManifestSize) return Status::kCorrupt;
+  manifest_end = kPackHeaderSize + manifest_size;
+  return Status::kOk;
+}
+
+Status read_pack_info(std::span<const std::uint8_t> bytes, PackInfo& out) {
+  out = {};
+  std::size_t manifest_end = 0;
+  if (Status s = read_pack_header(bytes, manifest_end); s != Status::kOk) return s;
+  if (bytes.size() < manifest_end) return Status::kTruncated;
+  ByteReader r(bytes.subspan(16));
+  std::uint32_t manifest_crc;
+  r.u32(manifest_crc);
+  const auto manifest = bytes.subspan(kPackHeaderSize, manifest_end - kPackHeaderSize);
+  if (crc32(manifest) != manifest_crc) return Status::kCorrupt;
+  out.manifest_end = manifest_end;
+  const Status s = parse_manifest(manifest, manifest_end, out);
+  if (s != Status::kOk) out = {};
+  return s;
+}
+
+std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, const PackWriteOptions& options) {
+  if (models.empty()) throw std::invalid_argument("write_pack: no models");
+  if (models.size() > kMaxModels) throw std::invalid_argument("write_pack: more than 64 models");
+  if (options.normals_delay < 0 || options.normals_delay > static_cast<int>(kMaxPasses))
+    throw std::invalid_argument("write_pack: normals_delay outside [0, 64]");
+  std::vector<EncodedGeometry> geometry(models.size()), normals(models.size());
+  std::vector<int> geometry_passes, normal_passes;
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    const PackModelInput& model = models[m];
+    if (model.name.size() > kMaxNameSize) throw std::invalid_argument("write_pack: model name too long");
+    if (model.geometry.empty()) throw std::invalid_argument("write_pack: model '" + model.name + "' has no patches");
+    if (model.geometry.front().level > kMaxPackLevel)
+      throw std::invalid_argument("write_pack: level above " + std::to_string(kMaxPackLevel));
+    geometry[m] = encode_geometry(model.geometry, model.seams, options.geometry);
+    geometry_passes.push_back(static_cast<int>(geometry[m].segments.size()));
+    const bool with_normals = options.normals && !model.normals.empty();
+    if (with_normals) {
+      if (model.normals.size() != model.geometry.size())
+        throw std::invalid_argument("write_pack: model '" + model.name + "': normal maps and patches differ");
+      normals[m] = encode_geometry(model.normals, model.seams, options.normal_codec);
+    }
+    normal_passes.push_back(with_normals ? static_cast<int>(normals[m].segments.size()) : 0);
+    if (!model.hole_mask.empty()) {
+      const std::size_t quads = std::size_t{1} << (2 * model.geometry.front().level);
+      if (model.hole_mask.size() != model.geometry.size() ||
+          std::any_of(model.hole_mask.begin(), model.hole_mask.end(),
+                      [&](const auto& mask) { return mask.size() != quads; }))
+        throw std::invalid_argument("write_pack: model '" + model.name + "': hole mask does not match the grid");
+    }
+  }
+
+  ByteWriter manifest;
+  manifest.varint(models.size());
+  manifest.varint(static_cast<std::uint64_t>(options.normals_delay));
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    manifest.string(models[m].name);
+    write_normalization(manifest, models[m].normalization);
+    manifest.bytes(geometry[m].header.serialize());
+    manifest.u8(normal_passes[m] > 0 ? 1 : 0);
+    if (normal_passes[m] > 0) manifest.bytes(normals[m].header.serialize());
+    manifest.varint(models[m].hole_mask.size());
+    for (const auto& mask : models[m].hole_mask) write_mask(manifest, mask);
+  }
+  const std::vector<ChunkKey> order = chunk_order(geometry_passes, normal_passes, options.normals_delay);
+  manifest.varint(order.size());
+  auto segment = [&](const ChunkKey& key) -> const std::vector<std::uint8_t>& {
+    const auto& encoded = key.kind == 0 ? geometry[static_cast<std::size_t>(key.model)]
+                                        : normals[static_cast<std::size_t>(key.model)];
+    return encoded.segments[static_cast<std::size_t>(key.pass)];
+  };
+  for (const ChunkKey& key : order) {
+    manifest.varint(segment(key).size());
+    manifest.u32(crc32(segment(key)));
+  }
+
+  ByteWriter file;
+  for (std::uint8_t b : kMagic) file.u8(b);
+  file.u16(kPackVersion);
+  file.u16(0);
+  file.u32(static_cast<std::uint32_t>(manifest.data().size()));
+  file.u32(crc32(manifest.data()));
+  std::vector<std::uint8_t>& out = file.data();
+  out.insert(out.end(), manifest.data().begin(), manifest.data().end());
+  for (const ChunkKey& key : order) out.insert(out.end(), segment(key).begin(), segment(key).end());
+  return std::move(out);
+}
+
+PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDecodeOptions& options) {
+  PackDecodeResult result;
+  const std::span<const std::uint8_t> data = bytes.first(std::min(bytes.size(), options.max_bytes));
+  result.status = read_pack_info(data, result.info);
+  if (result.status != Status::kOk) return result;
+  const PackInfo& info = result.info;
+  result.bytes_used = info.manifest_end;
+
+  // Gather each model's segments: complete CRC-checked chunks in order, then at most one partial chunk.
+  struct Streams {
+    std::vector<std::span<const std::uint8_t>> geometry, normals;
+    std::span<const std::uint8_t> geometry_tail, normals_tail;
+  };
+  std::vector<Streams> streams(info.models.size());
+  for (const ChunkInfo& chunk : info.chunks) {
+    Streams& s = streams[static_cast<std::size_t>(chunk.model)];
+    const bool geometry = chunk.kind == ChunkKind::kGeometry;
+    if (chunk.offset + chunk.size > data.size()) {
+      result.status = Status::kTruncated;
+      if (options.partial_chunks && chunk.offset < data.size() && (geometry || options.normals)) {
+        const auto tail = data.subspan(static_cast<std::size_t>(chunk.offset));
+        (geometry ? s.geometry_tail : s.normals_tail) = tail;
+        result.bytes_used = data.size();
+      }
+      break;
+    }
+    const auto payload = data.subspan(static_cast<std::size_t>(chunk.offset), chunk.size);
+    if (crc32(payload) != chunk.crc32) {
+      result.status = Status::kCorrupt;
+      break;
+    }
+    (geometry ? s.geometry : s.normals).push_back(payload);
+    ++result.chunks_decoded;
+    result.bytes_used = static_cast<std::size_t>(chunk.offset + chunk.size);
+  }
+
+  for (std::size_t m = 0; m < info.models.size(); ++m) {
+    const PackModelInfo& model_info = info.models[m];
+    const Streams& s = streams[m];
+    DecodedModel model;
+    model.name = model_info.name;
+    model.normalization = model_info.normalization;
+    model.seams = model_info.geometry.seams;
+    model.hole_mask = model_info.hole_mask;
+    model.geometry_passes = s.geometry.size();
+    try {
+      DecodedGeometry decoded;
+      const Status g = decode_geometry(model_info.geometry, s.geometry, s.geometry_tail, decoded,
+                                       {.drop_finest_steps = options.drop_finest_steps});
+      if (g != Status::kOk) result.status = Status::kCorrupt;
+      model.geometry = std::move(decoded.patches);
+      model.detail_level = decoded.detail_level;
+      if (options.normals && model_info.has_normals && (!s.normals.empty() || !s.normals_tail.empty())) {
+        DecodedGeometry decoded_normals;
+        if (decode_geometry(model_info.normals, s.normals, s.normals_tail, decoded_normals) != Status::kOk)
+          result.status = Status::kCorrupt;
+        model.normals = std::move(decoded_normals.patches);
+        for (Grid3& grid : model.normals) {
+          for (std::size_t k = 0; k + 2 < grid.values.size(); k += 3) {
+            float* n = grid.values.data() + k;
+            const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            if (len > 0) n[0] /= len, n[1] /= len, n[2] /= len;
+          }
+        }
+      }
+    } catch (const std::exception&) {
+      // decode_geometry does not throw on bytes; a failed allocation on a hostile manifest lands here.
+      result.status = Status::kCorrupt;
+      result.models.clear();
+      return result;
+    }
+    result.models.push_back(std::move(model));
+  }
+  return result;
+}
+
+}  // namespace geomip::codec

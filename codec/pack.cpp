@@ -204,8 +204,8 @@ Status read_pack_header(std::span<const std::uint8_t> bytes, std::size_t& manife
   if (!std::equal(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n), kMagic)) return Status::kCorrupt;
   if (bytes.size() < kPackHeaderSize) return Status::kTruncated;
   ByteReader r(bytes.subspan(sizeof kMagic));
-  std::uint16_t version, flags;
-  std::uint32_t manifest_size, manifest_crc;
+  std::uint16_t version = 0, flags = 0;
+  std::uint32_t manifest_size = 0, manifest_crc = 0;
   r.u16(version), r.u16(flags), r.u32(manifest_size), r.u32(manifest_crc);
   if (version != kPackVersion) return Status::kUnsupportedVersion;
   if (flags != 0 || manifest_size > kMaxManifestSize) return Status::kCorrupt;
@@ -219,7 +219,7 @@ Status read_pack_info(std::span<const std::uint8_t> bytes, PackInfo& out) {
   if (Status s = read_pack_header(bytes, manifest_end); s != Status::kOk) return s;
   if (bytes.size() < manifest_end) return Status::kTruncated;
   ByteReader r(bytes.subspan(16));
-  std::uint32_t manifest_crc;
+  std::uint32_t manifest_crc = 0;
   r.u32(manifest_crc);
   const auto manifest = bytes.subspan(kPackHeaderSize, manifest_end - kPackHeaderSize);
   if (crc32(manifest) != manifest_crc) return Status::kCorrupt;

@@ -278,4 +278,15 @@ SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh&
   return r;
 }
 
+std::vector<double> distances_to_surface(const TriMesh& surface, const std::vector<Eigen::Vector3d>& points) {
+  validate(surface, "surface");
+  const SearchSurface target(surface);
+  std::vector<double> distances(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Point p = to_point(points[i]);
+    distances[i] = std::sqrt(CGAL::squared_distance(p, target.tree().closest_point(p)));
+  }
+  return distances;
+}
+
 }  // namespace geomip

@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace geomip {
 
@@ -78,5 +79,10 @@ struct SurfaceDistance {
 /// \throw InvalidInput naming `measure_surface_distance` and the mesh when a precondition fails.
 SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh& approx,
                                          const SurfaceDistanceOptions& options = {});
+
+/// Distance from each point to the closest point of `surface` (exact point–triangle distance through the same
+/// AABB tree as measure_surface_distance()), in the mesh's units.
+/// \throw InvalidInput as measure_surface_distance() for a bad `surface`.
+std::vector<double> distances_to_surface(const TriMesh& surface, const std::vector<Eigen::Vector3d>& points);
 
 }  // namespace geomip

@@ -18,7 +18,11 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   if (dir.empty()) dir = ".";
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw IoError(path + ": output directory '" + dir.string() + "' does not exist");
-  const fs::path tmp = dir / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  std::string tmp_name = ".";
+  tmp_name += target.filename().string();
+  tmp_name += ".tmp-";
+  tmp_name += std::to_string(::getpid());
+  const fs::path tmp = dir / tmp_name;
   try {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw IoError(path + ": cannot create '" + tmp.string() + "': " + std::strerror(errno));

@@ -23,5 +23,8 @@ CommandRunner add_param_command(CLI::App& app);
 CommandRunner add_gimage_command(CLI::App& app);
 CommandRunner add_remesh_command(CLI::App& app);
 CommandRunner add_eval_command(CLI::App& app);
+CommandRunner add_convert_command(CLI::App& app);
+CommandRunner add_encode_command(CLI::App& app);
+CommandRunner add_decode_command(CLI::App& app);
 
 }  // namespace geomip::tools

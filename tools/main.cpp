@@ -29,6 +29,9 @@ int main(int argc, char** argv) {
   add(add_gimage_command(app));
   add(add_remesh_command(app));
   add(add_eval_command(app));
+  add(add_convert_command(app));
+  add(add_encode_command(app));
+  add(add_decode_command(app));
 
   try {
     app.parse(argc, argv);

@@ -108,6 +108,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
     }
     inputs.push_back(std::move(in));
     paths.push_back(spec.mesh);
+    models.originals.push_back(repaired ? input : TriMesh{});
   }
   return models;
 }

@@ -15,6 +15,9 @@ namespace geomip::tools {
 struct PreparedModels {
   std::vector<ParameterizationInput> inputs;  ///< name = the mesh file's stem
   std::vector<std::string> paths;             ///< the mesh files, as given or as named in CORR.json
+  /// Per model: the mesh as read when it had to be repaired (holes filled, ...), else empty. Commands that
+  /// must give back what the user had (the hole mask of a pack) compare against it.
+  std::vector<TriMesh> originals;
 };
 
 /// The options every model-consuming command shares: MESH..., --points, -o, --json, --quiet.

@@ -1,0 +1,38 @@
+// Which quads of a geometry image cover a hole of the source mesh that `geomip repair` filled.
+//
+// The parameterization needs a closed surface, so an open mesh is repaired (holes triangulated and faired)
+// first, and its geometry images cover the fills too. A user of an open scan expects the holes back: the
+// decoded meshes leave out the quads flagged here (the pack stores the mask; it costs a few bytes per hole).
+#pragma once
+
+#include "param/consistent_parameterization.h"
+#include "param/mesh.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace geomip {
+
+struct HoleMaskOptions {
+  /// A parameterized triangle is a fill triangle when its centroid lies farther than
+  /// relative_tolerance · (its longest edge) from the ORIGINAL surface; triangles of the original (and the
+  /// pieces of those the partition split) lie on it up to rounding.
+  double relative_tolerance = 1e-6;
+};
+
+struct HoleMaskResult {
+  /// Per patch, per quad (i, j) of the level-`level` grid at index j·2^level + i: 1 = all four corner samples
+  /// lie in fill triangles. Empty when no triangle is a fill triangle.
+  std::vector<std::vector<std::uint8_t>> quads;
+  std::size_t fill_triangles = 0;  ///< parameterized triangles found off the original surface
+  std::size_t masked_quads = 0;
+};
+
+/// \param model     the parameterization of the repaired mesh
+/// \param original  the mesh before repair (its triangles define what is "on the surface")
+/// \param level     grid level of the geometry images
+/// \throw InvalidInput for a level outside [0, kMaxGeometryImageLevel] or an original without triangles.
+HoleMaskResult hole_mask(const ModelParameterization& model, const TriMesh& original, int level,
+                         const HoleMaskOptions& options = {});
+
+}  // namespace geomip

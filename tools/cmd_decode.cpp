@@ -1,0 +1,136 @@
+// geomip decode PACK [--bytes N] [--level K] -o MESH: decodes a .gip pack (or only its first N bytes, as if
+// only they had arrived) and writes each model as a mesh.
+#include "codec/pack.h"
+#include "param/errors.h"
+#include "param/mesh_io.h"
+#include "tools/atomic_file.h"
+#include "tools/commands.h"
+#include "tools/pack_models.h"
+#include "tools/pack_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+namespace geomip::tools {
+namespace {
+
+struct DecodeArgs {
+  std::string pack;
+  std::string output;
+  long long bytes = -1;
+  int level = -1;
+  bool json = false;
+  bool quiet = false;
+};
+
+MeshFormat format_of(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".obj" || ext == ".OBJ") return MeshFormat::kObj;
+  if (ext == ".ply" || ext == ".PLY") return MeshFormat::kPly;
+  if (ext == ".off" || ext == ".OFF") return MeshFormat::kOff;
+  throw InvalidInput("-o " + path + ": the extension must be .obj, .ply or .off");
+}
+
+int run_decode(const DecodeArgs& args) {
+  const std::vector<std::uint8_t> bytes = read_pack_file(args.pack);
+  std::size_t manifest_end = 0;
+  const codec::Status header = codec::read_pack_header(bytes, manifest_end);
+  if (header == codec::Status::kCorrupt || (header == codec::Status::kTruncated && bytes.size() < 8))
+    throw InvalidInput(args.pack + ": not a geomip pack (no GEOMIPK header)");
+  codec::PackDecodeOptions options;
+  if (args.bytes >= 0) options.max_bytes = static_cast<std::size_t>(args.bytes);
+  const auto t0 = std::chrono::steady_clock::now();
+  codec::PackDecodeResult decoded = codec::decode_pack(bytes, options);
+  const double decode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+  const bool prefix_asked = args.bytes >= 0 && static_cast<std::size_t>(args.bytes) < bytes.size();
+  if (decoded.status == codec::Status::kTruncated && !prefix_asked) {
+    throw InvalidInput(args.pack + ": the pack is truncated (" + std::to_string(bytes.size()) + " of " +
+                       std::to_string(decoded.info.file_size()) +
+                       " bytes); to decode the coarser model it holds, ask for it with --bytes " +
+                       std::to_string(bytes.size()));
+  }
+  if (decoded.status != codec::Status::kOk && decoded.status != codec::Status::kTruncated) {
+    throw InvalidInput(args.pack + ": " + std::string(codec::status_message(decoded.status)));
+  }
+  if (decoded.models.empty()) {
+    throw InvalidInput(args.pack + ": the first " + std::to_string(args.bytes) +
+                       " bytes end inside the pack's manifest (" + std::to_string(decoded.info.manifest_end) +
+                       " bytes needed before any level of detail)");
+  }
+  const int grid_level = decoded.models.front().geometry.front().level;
+  if (args.level > grid_level)
+    throw InvalidInput("--level " + std::to_string(args.level) + " is above the pack's level " +
+                       std::to_string(grid_level));
+
+  // One model → OUTPUT is the mesh file; several → OUTPUT's stem gets each model's name.
+  std::vector<std::string> paths;
+  const std::filesystem::path out(args.output);
+  const MeshFormat format = format_of(args.output);
+  for (const auto& model : decoded.models) {
+    paths.push_back(decoded.models.size() == 1
+                        ? args.output
+                        : (out.parent_path() / (out.stem().string() + "." + model.name + out.extension().string()))
+                              .string());
+  }
+  nlohmann::json j_models = nlohmann::json::array();
+  for (std::size_t m = 0; m < decoded.models.size(); ++m) {
+    const TriMesh mesh = decoded_mesh(decoded.models[m], args.level);
+    write_file_atomically(paths[m], [&](std::ostream& o) { write_mesh(mesh, o, format); });
+    j_models.push_back({{"name", decoded.models[m].name},
+                        {"mesh", paths[m]},
+                        {"vertices", mesh.num_vertices()},
+                        {"faces", mesh.num_triangles()},
+                        {"detail_level", decoded.models[m].detail_level},
+                        {"geometry_passes", decoded.models[m].geometry_passes}});
+    if (!args.quiet && !args.json) {
+      std::printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",
+                  decoded.models[m].name.c_str(), paths[m].c_str(), mesh.num_triangles(),
+                  args.level < 0 ? grid_level : args.level, decoded.models[m].detail_level,
+                  decoded.models[m].geometry_passes);
+    }
+  }
+  if (args.json) {
+    std::cout << nlohmann::json{{"pack", args.pack},
+                                {"status", std::string(codec::status_message(decoded.status))},
+                                {"pack_bytes", decoded.info.file_size()},
+                                {"bytes_used", decoded.bytes_used},
+                                {"chunks_decoded", decoded.chunks_decoded},
+                                {"chunks", decoded.info.chunks.size()},
+                                {"decode_ms", decode_ms},
+                                {"models", j_models}}
+                     .dump(2)
+              << "\n";
+  } else if (!args.quiet) {
+    std::printf("%zu of %llu bytes used, %zu of %zu chunks complete, decoded in %.1f ms\n", decoded.bytes_used,
+                static_cast<unsigned long long>(decoded.info.file_size()), decoded.chunks_decoded,
+                decoded.info.chunks.size(), decode_ms);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+CommandRunner add_decode_command(CLI::App& app) {
+  auto args = std::make_shared<DecodeArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "decode", "Decode a .gip pack (or its first N bytes) to a mesh per model (OBJ, PLY or OFF by extension).");
+  cmd->add_option("pack", args->pack, "The .gip pack")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "Output mesh; with several models, <stem>.<model>.<ext> beside it")
+      ->required();
+  cmd->add_option("--bytes", args->bytes, "Decode as if only the first N bytes of the file had arrived")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--level", args->level, "Output grid level K (default: the pack's level)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
+  cmd->add_flag("-q,--quiet", args->quiet, "No report");
+  return [args] { return run_decode(*args); };
+}
+
+}  // namespace geomip::tools

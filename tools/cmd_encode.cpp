@@ -1,0 +1,149 @@
+// geomip encode DIR_or_EXR... -o PACK: geometry images written by `geomip gimage` (DIR/<stem>.geometry.exr,
+// and <stem>.normals.exr beside it when present) → a progressive .gip pack. The models of one pack must share
+// their patch layout when they are to be morphed (gimage run on a consistent set).
+#include "codec/pack.h"
+#include "gimage/exr_io.h"
+#include "param/errors.h"
+#include "tools/atomic_file.h"
+#include "tools/commands.h"
+#include "tools/pack_models.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+namespace geomip::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct EncodeArgs {
+  std::vector<std::string> inputs;
+  std::string output;
+  int quantization_bits = 16;
+  bool no_normals = false;
+  bool json = false;
+  bool quiet = false;
+};
+
+constexpr const char* kGeometrySuffix = ".geometry.exr";
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+/// The geometry EXR files named by the arguments: files as given, directories expanded to their
+/// *.geometry.exr in name order.
+std::vector<std::string> geometry_files(const std::vector<std::string>& inputs) {
+  std::vector<std::string> files;
+  for (const std::string& in : inputs) {
+    std::error_code ec;
+    if (fs::is_directory(in, ec)) {
+      std::vector<std::string> found;
+      for (const auto& entry : fs::directory_iterator(in))
+        if (ends_with(entry.path().filename().string(), kGeometrySuffix)) found.push_back(entry.path().string());
+      if (found.empty()) throw InvalidInput(in + ": no *.geometry.exr in this directory (run `geomip gimage`)");
+      std::sort(found.begin(), found.end());
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (!fs::exists(in, ec)) {
+      throw InvalidInput(in + ": no such file or directory");
+    } else {
+      files.push_back(in);
+    }
+  }
+  if (files.empty()) throw InvalidInput("no input: give DIR or FILE.geometry.exr");
+  return files;
+}
+
+GeometryImages load_images(const std::string& geometry_path, bool normals, std::string& name) {
+  const GeometryImageFile file = read_geometry_image_exr(geometry_path);
+  if (file.info.kind != "geometry")
+    throw InvalidInput(geometry_path + ": holds '" + file.info.kind + "', not geometry (give the .geometry.exr)");
+  GeometryImages images;
+  images.geometry = finest_grids(file);
+  images.adjacency = file.info.adjacency;
+  if (images.adjacency.size() != 4 * images.geometry.size())
+    throw InvalidInput(geometry_path + ": its patch adjacency does not list 4 sides per patch");
+  name = fs::path(file.info.source_mesh.empty() ? geometry_path : file.info.source_mesh).stem().string();
+  if (ends_with(geometry_path, kGeometrySuffix) && file.info.source_mesh.empty())
+    name = fs::path(geometry_path.substr(0, geometry_path.size() - 13)).filename().string();
+  if (normals && ends_with(geometry_path, kGeometrySuffix)) {
+    const std::string normals_path =
+        geometry_path.substr(0, geometry_path.size() - std::string(kGeometrySuffix).size()) + ".normals.exr";
+    std::error_code ec;
+    if (fs::exists(normals_path, ec)) {
+      const GeometryImageFile n = read_geometry_image_exr(normals_path);
+      images.normals = finest_grids(n);
+      if (images.normals.size() != images.geometry.size())
+        throw InvalidInput(normals_path + ": a different number of patches than " + geometry_path);
+    }
+  }
+  return images;
+}
+
+int run_encode(const EncodeArgs& args) {
+  if (args.quantization_bits < 8 || args.quantization_bits > 24)
+    throw InvalidInput("--bits " + std::to_string(args.quantization_bits) + " is outside [8, 24]");
+  std::vector<codec::PackModelInput> models;
+  bool any_normals = false;
+  for (const std::string& path : geometry_files(args.inputs)) {
+    std::string name;
+    const GeometryImages images = load_images(path, !args.no_normals, name);
+    any_normals = any_normals || !images.normals.empty();
+    models.push_back(pack_model_input(name, images, nullptr, !args.no_normals));
+  }
+  codec::PackWriteOptions write;
+  write.normals = !args.no_normals;
+  write.geometry.quantization_bits = args.quantization_bits;
+  std::vector<std::uint8_t> pack;
+  try {
+    pack = codec::write_pack(models, write);
+  } catch (const std::invalid_argument& e) {
+    throw InvalidInput(e.what());
+  }
+  write_file_atomically(args.output, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(pack.data()), static_cast<std::streamsize>(pack.size()));
+  });
+  codec::PackInfo info;
+  codec::read_pack_info(pack, info);
+  if (args.json) {
+    std::cout << nlohmann::json{{"pack", args.output},
+                                {"bytes", pack.size()},
+                                {"manifest_bytes", info.manifest_end},
+                                {"chunks", info.chunks.size()},
+                                {"models", models.size()},
+                                {"normals", any_normals && !args.no_normals}}
+                     .dump(2)
+              << "\n";
+  } else if (!args.quiet) {
+    std::printf("encode %zu model(s) → %s: %zu bytes (manifest %zu, %zu chunks)%s\n", models.size(),
+                args.output.c_str(), pack.size(), info.manifest_end, info.chunks.size(),
+                any_normals && !args.no_normals ? ", with normal maps" : ", geometry only");
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+CommandRunner add_encode_command(CLI::App& app) {
+  auto args = std::make_shared<EncodeArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "encode",
+      "Geometry images (`geomip gimage` output: a directory or <stem>.geometry.exr files, normal maps picked "
+      "up beside them) → a progressive .gip pack. Hole masks are not in EXR files: use `geomip convert` for "
+      "open meshes.");
+  cmd->add_option("inputs", args->inputs, "Directories or .geometry.exr files")->required();
+  cmd->add_option("-o,--output", args->output, "Output pack file (.gip)")->required();
+  cmd->add_option("--bits", args->quantization_bits,
+                  "Position quantization bits over the largest bounding-box extent (default 16)");
+  cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack");
+  cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
+  cmd->add_flag("-q,--quiet", args->quiet, "No report");
+  return [args] { return run_encode(*args); };
+}
+
+}  // namespace geomip::tools

@@ -466,3 +466,76 @@ TEST_F(CliGimage, AdaptiveRemeshIsWatertightSharedAndCoarserForLargerEps) {
 
 }  // namespace
 }  // namespace geomip
+
+namespace geomip {
+namespace {
+
+class CliPack : public CliGimage {};
+
+// convert → decode: the whole pack gives the level-N remesh's connectivity (watertight, consistently oriented);
+// a prefix gives a coarser but still watertight model; --json keys; outputs atomic.
+TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
+  const std::string pack = dir_ + "/spot.gip";
+  Outcome r = geomip("convert --json '" + spot_ + "' --level 5 -o '" + pack + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  const std::size_t bytes = j["bytes"];
+  EXPECT_EQ(bytes, fs::file_size(pack));
+  EXPECT_LT(j["manifest_bytes"].get<std::size_t>(), 400u);
+
+  r = geomip("decode --json '" + pack + "' -o '" + dir_ + "/full.obj'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["models"][0]["faces"], 2 * 2 * 32 * 32);
+  const TriMesh full = read_mesh(dir_ + "/full.obj");
+  const TopologyReport t = analyze_topology(full);
+  EXPECT_EQ(t.boundary_loops, 0u);
+  EXPECT_EQ(t.genus, 0);
+  EXPECT_TRUE(t.manifold);
+
+  r = geomip("decode --json '" + pack + "' --bytes " + std::to_string(bytes / 10) + " --level 4 -o '" + dir_ +
+             "/prefix.ply'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["models"][0]["faces"], 2 * 2 * 16 * 16);
+  EXPECT_LT(j["bytes_used"].get<std::size_t>(), bytes);
+  EXPECT_EQ(analyze_topology(read_mesh(dir_ + "/prefix.ply")).boundary_loops, 0u);
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos);
+}
+
+TEST_F(CliPack, EncodeFromGimageDirectory) {
+  ASSERT_EQ(geomip("gimage -q '" + spot_ + "' --level 4 -o '" + dir_ + "/gi'").exit_code, 0);
+  const Outcome r = geomip("encode --json '" + dir_ + "/gi' -o '" + dir_ + "/x.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["normals"], true);
+  const Outcome d = geomip("decode -q '" + dir_ + "/x.gip' -o '" + dir_ + "/x.obj'");
+  ASSERT_EQ(d.exit_code, 0) << d.err;
+  EXPECT_EQ(read_mesh(dir_ + "/x.obj").triangles.size(), 2u * 2 * 16 * 16);
+}
+
+TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {
+  const std::string pack = dir_ + "/spot.gip";
+  ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 --no-normals -o '" + pack + "'").exit_code, 0);
+  const std::string bytes = slurp(pack);
+  const std::string truncated = file("truncated.gip", bytes.substr(0, bytes.size() / 2));
+  std::string flipped_bytes = bytes;
+  flipped_bytes[bytes.size() - 3] ^= 0x20;
+  const std::string flipped = file("flipped.gip", flipped_bytes);
+  const std::string garbage = file("garbage.gip", "this is not a pack at all");
+  const std::string out = dir_ + "/out.obj";
+  expect_bad_input("decode '" + truncated + "' -o '" + out + "'", truncated);
+  expect_bad_input("decode '" + flipped + "' -o '" + out + "'", flipped);
+  expect_bad_input("decode '" + garbage + "' -o '" + out + "'", garbage);
+  expect_bad_input("decode '" + dir_ + "/missing.gip' -o '" + out + "'", dir_ + "/missing.gip");
+  expect_bad_input("decode '" + pack + "' --bytes 10 -o '" + out + "'", pack);  // inside the manifest
+  EXPECT_FALSE(fs::exists(out));
+  // The truncated file decodes when the prefix is asked for on purpose.
+  EXPECT_EQ(geomip("decode -q '" + truncated + "' --bytes " + std::to_string(bytes.size() / 2) + " -o '" + out + "'")
+                .exit_code,
+            0);
+  for (const char* args : {"convert --help", "encode --help", "decode --help"})
+    EXPECT_EQ(geomip(args).exit_code, 0) << args;
+}
+
+}  // namespace
+}  // namespace geomip

@@ -2,14 +2,11 @@
 // consistent parameterization → geometry images (+ normal maps, + hole masks of repaired meshes) → the
 // progressive .gip pack (codec/pack.h), written atomically.
 #include "codec/pack.h"
-#include "gimage/hole_mask.h"
-#include "gimage/resample.h"
-#include "param/consistent_parameterization.h"
 #include "param/errors.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
+#include "tools/convert_pipeline.h"
 #include "tools/model_inputs.h"
-#include "tools/pack_models.h"
 #include "tools/progress.h"
 
 #include <nlohmann/json.hpp>
@@ -48,36 +45,14 @@ int run_convert(const ConvertArgs& args) {
       prepare_models(args.common.meshes, args.common.points, "geomip convert", !report);
 
   ProgressBar bar("convert", report);
-  ParameterizationOptions options;
-  options.measure_mvc_baseline = false;
-  options.progress = [&](const char* stage, double fraction) { bar.update(stage, 0.8 * fraction); };
-  auto t0 = std::chrono::steady_clock::now();
-  const std::vector<ModelParameterization> params = parameterize_consistently(models.inputs, options);
-  const double param_seconds = seconds_since(t0);
-
-  t0 = std::chrono::steady_clock::now();
-  std::vector<codec::PackModelInput> inputs;
-  std::vector<std::size_t> masked_quads;
-  for (std::size_t m = 0; m < params.size(); ++m) {
-    bar.update("resample", 0.8 + 0.1 * static_cast<double>(m) / static_cast<double>(params.size()));
-    ResampleOptions resample;
-    resample.normals = !args.no_normals;
-    resample.normal_level = args.normal_level;
-    const GeometryImages images = resample_geometry(params[m], args.level, resample);
-    HoleMaskResult mask;
-    if (!models.originals[m].triangles.empty()) mask = hole_mask(params[m], models.originals[m], args.level);
-    masked_quads.push_back(mask.masked_quads);
-    inputs.push_back(pack_model_input(models.inputs[m].name, images, &mask, !args.no_normals));
-  }
-  const double resample_seconds = seconds_since(t0);
-
-  bar.update("encode", 0.9);
-  t0 = std::chrono::steady_clock::now();
-  codec::PackWriteOptions write;
-  write.normals = !args.no_normals;
-  write.geometry.quantization_bits = args.quantization_bits;
-  const std::vector<std::uint8_t> pack = codec::write_pack(inputs, write);
-  const double encode_seconds = seconds_since(t0);
+  ConvertOptions options;
+  options.level = args.level;
+  options.normal_level = args.normal_level;
+  options.normals = !args.no_normals;
+  options.quantization_bits = args.quantization_bits;
+  options.progress = bar.callback();
+  const ConvertResult converted = convert_models(models, options);
+  const std::vector<std::uint8_t>& pack = converted.pack;
   write_file_atomically(args.common.output, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(pack.data()), static_cast<std::streamsize>(pack.size()));
   });
@@ -87,8 +62,10 @@ int run_convert(const ConvertArgs& args) {
   codec::read_pack_info(pack, info);
   if (args.common.json) {
     nlohmann::json j_models = nlohmann::json::array();
-    for (std::size_t m = 0; m < inputs.size(); ++m)
-      j_models.push_back({{"mesh", models.paths[m]}, {"name", inputs[m].name}, {"masked_quads", masked_quads[m]}});
+    for (std::size_t m = 0; m < models.inputs.size(); ++m)
+      j_models.push_back({{"mesh", models.paths[m]},
+                          {"name", models.inputs[m].name},
+                          {"masked_quads", converted.masked_quads[m]}});
     std::cout << nlohmann::json{{"pack", args.common.output},
                                 {"bytes", pack.size()},
                                 {"manifest_bytes", info.manifest_end},
@@ -96,18 +73,18 @@ int run_convert(const ConvertArgs& args) {
                                 {"level", args.level},
                                 {"normals", !args.no_normals},
                                 {"models", j_models},
-                                {"param_seconds", param_seconds},
-                                {"resample_seconds", resample_seconds},
-                                {"encode_seconds", encode_seconds},
+                                {"param_seconds", converted.param_seconds},
+                                {"resample_seconds", converted.resample_seconds},
+                                {"encode_seconds", converted.encode_seconds},
                                 {"seconds", seconds_since(t_start)}}
                      .dump(2)
               << "\n";
   } else if (report) {
-    std::printf("convert %zu model(s) → %s: %zu bytes (manifest %zu, %zu chunks), level %d%s\n", inputs.size(),
+    std::printf("convert %zu model(s) → %s: %zu bytes (manifest %zu, %zu chunks), level %d%s\n", models.inputs.size(),
                 args.common.output.c_str(), pack.size(), info.manifest_end, info.chunks.size(), args.level,
                 args.no_normals ? ", geometry only" : ", with normal maps");
-    std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", param_seconds, resample_seconds,
-                encode_seconds);
+    std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
+                converted.resample_seconds, converted.encode_seconds);
   }
   return kExitOk;
 }

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "codec/status.h"
+#include "codec/wavelet.h"  // WaveletFilter
 
 namespace geomip::codec {
 
@@ -40,11 +41,6 @@ struct Grid3 {
   int level = 0;
   std::vector<float> values;
   int size() const { return (1 << level) + 1; }
-};
-
-enum class WaveletFilter : std::uint8_t {
-  kLinear = 0,  ///< interpolating, 2-point prediction (Deslauriers–Dubuc order 2)
-  kCubic = 1,   ///< interpolating, 4-point prediction (Deslauriers–Dubuc order 4)
 };
 
 struct GeometryCodecOptions {

@@ -1,5 +1,9 @@
 # The sources of geomip::codec, shared with the standalone fuzz build (tests/fuzz).
 set(GEOMIP_CODEC_SOURCES
+  arithmetic_coder.cpp
+  bitplane_coder.cpp
+  geometry_codec.cpp
   pack.cpp
   status.cpp
+  wavelet.cpp
 )

@@ -1,0 +1,156 @@
+// Binary adaptive arithmetic coder: an LZMA-style range coder (32-bit low/range, carry propagation through a
+// cached byte and a run of 0xFF bytes, byte-wise output; Martin 1979 "Range encoding", Pavlov's LZMA rc) with
+// adaptive probability models.
+//
+// Model: each Context holds two estimates of P(bit = 0) in 16-bit fixed point, one adapting fast (shift 5)
+// and one slowly (shift 8); the coder uses their average (two-rate mixing, as in e.g. the AV1/Daala
+// multi-speed counters). During the first updates the shifts are smaller (1, 2, 3, ...), so a fresh context
+// learns its skew in a handful of symbols (a cheap approximation of a count-based estimate).
+//
+// Streams: the encoder's finish() flushes minimally: it picks, inside the final interval, the value with the
+// most trailing zero bits and drops trailing zero bytes, because the decoder reads zero bytes past the end of
+// its span. The decoder never reads outside its span and records in exhausted() that it needed a byte beyond
+// it. Prefix property: every symbol decoded while exhausted() is still false is exactly the symbol that was
+// encoded, whatever bytes follow in the real stream; so a decoder given a byte prefix of a stream decodes a
+// correct prefix of the symbols, as long as it stops at the first symbol where exhausted() is true. A
+// complete stream, on the other hand, decodes every symbol the encoder wrote even though the decoder may read
+// (zero) bytes beyond its end near the last symbols.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace geomip::codec {
+
+/// An adaptive binary probability model (the "context" of a symbol). Start each context in its default
+/// state (P(0) = 1/2) in both the encoder and the decoder.
+struct Context {
+  std::uint16_t fast = 1u << 15;  ///< P(bit = 0) · 2^16, fast-adapting estimate
+  std::uint16_t slow = 1u << 15;  ///< P(bit = 0) · 2^16, slow-adapting estimate
+  std::uint8_t count = 0;         ///< updates seen, saturating (drives the warm-up shifts)
+
+  /// P(bit = 0) · 2^16 in [1, 65535].
+  std::uint32_t p0() const { return (static_cast<std::uint32_t>(fast) + slow) >> 1; }
+  void update(int bit) {
+    static constexpr std::uint8_t kFastShift[8] = {1, 2, 3, 4, 5, 5, 5, 5};
+    static constexpr std::uint8_t kSlowShift[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    const int fs = kFastShift[count], ss = kSlowShift[count];
+    if (count < 7) ++count;
+    if (bit) {
+      fast -= fast >> fs;
+      slow -= slow >> ss;
+    } else {
+      fast += (65535u - fast) >> fs;
+      slow += (65535u - slow) >> ss;
+    }
+    // fast, slow stay in [1, 65535] once there: x - (x >> s) >= 1 for x >= 1, and x + ((65535 - x) >> s) <= 65535.
+    if (fast == 0) fast = 1;
+    if (slow == 0) slow = 1;
+  }
+};
+
+/// Encoder: feed symbols, then finish() once to get the bytes.
+class ArithmeticEncoder {
+ public:
+  /// Codes `bit` (0 or 1) with the probability of `context`, then adapts the context.
+  void encode(int bit, Context& context) {
+    const std::uint32_t bound = (range_ >> 16) * context.p0();
+    if (bit == 0) {
+      range_ = bound;
+    } else {
+      low_ += bound;
+      range_ -= bound;
+    }
+    context.update(bit);
+    while (range_ < kTop) {
+      range_ <<= 8;
+      shift_low();
+    }
+  }
+  /// Codes `bit` with probability 1/2 (no context): signs, nearly uniform raw bits.
+  void encode_bypass(int bit) {
+    range_ >>= 1;
+    if (bit) low_ += range_;
+    while (range_ < kTop) {
+      range_ <<= 8;
+      shift_low();
+    }
+  }
+  /// Flushes (minimally, see the file comment) and returns the stream. The encoder is then spent.
+  std::vector<std::uint8_t> finish();
+
+  /// Bytes output so far (without the pending flush): for size estimates.
+  std::size_t bytes_so_far() const { return out_.size() + pending_; }
+
+ private:
+  static constexpr std::uint32_t kTop = 1u << 24;
+  void shift_low();
+
+  std::uint64_t low_ = 0;
+  std::uint32_t range_ = 0xFFFFFFFFu;
+  std::uint8_t cache_ = 0;
+  std::size_t pending_ = 1;  ///< bytes held back: the cache byte plus a run of 0xFF awaiting a possible carry
+  bool first_ = true;        ///< the very first cache byte is always 0 and is not written
+  std::vector<std::uint8_t> out_;
+};
+
+/// Decoder over one stream. Reads zero bytes past the end of `bytes` (never outside the span) and then
+/// reports exhausted().
+class ArithmeticDecoder {
+ public:
+  explicit ArithmeticDecoder(std::span<const std::uint8_t> bytes) : bytes_(bytes) {
+    for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
+  }
+  int decode(Context& context) {
+    const std::uint32_t bound = (range_ >> 16) * context.p0();
+    int bit;
+    if (code_ < bound) {
+      range_ = bound;
+      bit = 0;
+    } else {
+      code_ -= bound;
+      range_ -= bound;
+      bit = 1;
+    }
+    context.update(bit);
+    while (range_ < kTop) {
+      range_ <<= 8;
+      code_ = (code_ << 8) | next_byte();
+    }
+    return bit;
+  }
+  int decode_bypass() {
+    range_ >>= 1;
+    int bit = 0;
+    if (code_ >= range_) {
+      code_ -= range_;
+      bit = 1;
+    }
+    while (range_ < kTop) {
+      range_ <<= 8;
+      code_ = (code_ << 8) | next_byte();
+    }
+    return bit;
+  }
+  /// True once the decoder has needed a byte beyond the end of its span. Symbols decoded while this was
+  /// false are the encoded ones (prefix property, see the file comment).
+  bool exhausted() const { return exhausted_; }
+
+ private:
+  static constexpr std::uint32_t kTop = 1u << 24;
+  std::uint32_t next_byte() {
+    if (pos_ < bytes_.size()) return bytes_[pos_++];
+    exhausted_ = true;
+    return 0;
+  }
+
+  std::span<const std::uint8_t> bytes_;
+  std::size_t pos_ = 0;
+  std::uint32_t code_ = 0;
+  std::uint32_t range_ = 0xFFFFFFFFu;
+  bool exhausted_ = false;
+};
+
+}  // namespace geomip::codec

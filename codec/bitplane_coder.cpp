@@ -1,0 +1,449 @@
+#include "codec/bitplane_coder.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+#include "codec/arithmetic_coder.h"
+
+namespace geomip::codec {
+namespace {
+
+constexpr std::uint8_t kSig = 1;     // node state: known significant
+constexpr std::uint8_t kActive = 2;  // node state: covers at least one coded sample
+constexpr int kMaxQuadLevels = 16;
+
+/// A sample of the significant-sample list. flags: bit c = channel c significant, bit 3 + c = its sign.
+struct Sample {
+  std::uint32_t index;     ///< grid index j·size + i
+  std::uint32_t mag[3];    ///< decoder: known magnitude bits; encoder: unused
+  std::uint8_t q[3];       ///< lowest plain plane known (decoder)
+  std::uint8_t flags;
+};
+
+struct Band {
+  int patch = 0, k = 0, orient = 0;  // orient 0: coarse, 1: row details, 2: column details, 3: diagonal
+  int cls = 0, kcls = 0, offset = 0;
+  int x0 = 0, y0 = 0, dx = 1, dy = 1, w = 0, h = 0;
+  int levels = 0;
+  int lw[kMaxQuadLevels] = {}, lh[kMaxQuadLevels] = {};
+  std::size_t lbase[kMaxQuadLevels] = {};
+  std::vector<std::uint8_t> state;
+  std::vector<std::int8_t> msb;  // encoder: highest set bit of the node's max magnitude, −1 if zero
+  int parent = -1;
+  std::vector<std::uint32_t> lis, lis_next;
+  std::vector<Sample> lsp;
+  std::size_t refine_count = 0;
+
+  std::size_t node(int l, int x, int y) const { return lbase[l] + static_cast<std::size_t>(y) * lw[l] + x; }
+  std::uint32_t grid_index(int x, int y, int size) const {
+    return static_cast<std::uint32_t>((y0 + dy * y) * size + x0 + dx * x);
+  }
+};
+
+inline std::uint32_t pack(int l, int x, int y) {
+  return static_cast<std::uint32_t>(l) << 28 | static_cast<std::uint32_t>(x) << 14 | static_cast<std::uint32_t>(y);
+}
+
+struct Stop {};     // the partial tail is exhausted
+struct Corrupt {};  // bytes that no encoder writes
+
+bool layout_ok(const BitplaneLayout& layout) {
+  return layout.level >= 0 && layout.level <= 12 && layout.steps >= 0 && layout.steps <= layout.level &&
+         layout.num_patches >= 1;
+}
+
+std::vector<Band> make_bands(const BitplaneLayout& layout, const std::vector<std::vector<std::uint8_t>>& coded) {
+  const int size = (1 << layout.level) + 1;
+  const int np = layout.num_patches, steps = layout.steps;
+  std::vector<Band> bands;
+  bands.reserve(static_cast<std::size_t>(np) * (1 + 3 * steps));
+  for (int p = 0; p < np; ++p) {
+    Band b;
+    b.patch = p;
+    b.k = steps + 1;
+    b.orient = 0;
+    b.cls = 0;
+    b.kcls = 2;
+    b.offset = steps;
+    b.dx = b.dy = 1 << steps;
+    b.w = b.h = (size - 1) / b.dx + 1;
+    bands.push_back(std::move(b));
+  }
+  for (int k = steps; k >= 1; --k) {
+    const int s = 1 << (k - 1), intervals = (size - 1) / s;
+    for (int orient = 1; orient <= 3; ++orient) {
+      for (int p = 0; p < np; ++p) {
+        Band b;
+        b.patch = p;
+        b.k = k;
+        b.orient = orient;
+        b.cls = orient == 3 ? 2 : 1;
+        b.kcls = std::min(k - 1, 2);
+        b.offset = k - 1;
+        b.dx = b.dy = 2 * s;
+        const bool odd_x = orient != 2, odd_y = orient != 1;
+        b.x0 = odd_x ? s : 0;
+        b.y0 = odd_y ? s : 0;
+        b.w = odd_x ? intervals / 2 : intervals / 2 + 1;
+        b.h = odd_y ? intervals / 2 : intervals / 2 + 1;
+        if (k < steps) b.parent = np + ((steps - (k + 1)) * 3 + (orient - 1)) * np + p;
+        bands.push_back(std::move(b));
+      }
+    }
+  }
+  for (auto& b : bands) {
+    int w = b.w, h = b.h;
+    std::size_t total = 0;
+    b.levels = 0;
+    while (true) {
+      b.lw[b.levels] = w;
+      b.lh[b.levels] = h;
+      b.lbase[b.levels] = total;
+      total += static_cast<std::size_t>(w) * h;
+      ++b.levels;
+      if (w == 1 && h == 1) break;
+      w = (w + 1) / 2;
+      h = (h + 1) / 2;
+    }
+    b.state.assign(total, 0);
+    const auto& mask = coded[b.patch];
+    for (int y = 0; y < b.h; ++y) {
+      for (int x = 0; x < b.w; ++x) {
+        if (mask[b.grid_index(x, y, size)]) b.state[b.node(0, x, y)] = kActive;
+      }
+    }
+    for (int l = 1; l < b.levels; ++l) {
+      for (int y = 0; y < b.lh[l - 1]; ++y) {
+        for (int x = 0; x < b.lw[l - 1]; ++x) b.state[b.node(l, x >> 1, y >> 1)] |= b.state[b.node(l - 1, x, y)];
+      }
+    }
+    const int top = b.levels - 1;
+    if (b.state[b.node(top, 0, 0)] & kActive) b.lis.push_back(pack(top, 0, 0));
+  }
+  return bands;
+}
+
+constexpr int kNodeContexts = 3 * 3 * 4 * 3 * 2;
+
+/// The shared traversal of encoder and decoder: every decision goes through sym(), so both walk the same path.
+template <bool kDecode>
+class PlaneCoder {
+ public:
+  PlaneCoder(const BitplaneLayout& layout, std::vector<Band>& bands, const std::vector<PatchCoefficients>* coefs)
+      : size_((1 << layout.level) + 1), bands_(bands), coefs_(coefs) {}
+
+  void set_encoder(ArithmeticEncoder* enc) { enc_ = enc; }
+  void set_decoder(ArithmeticDecoder* dec, bool check) {
+    dec_ = dec;
+    check_ = check;
+  }
+
+  /// One weighted bit-plane: sorting pass over every band, then refinement pass over every band.
+  void code_plane(int b) {
+    for (auto& band : bands_) band.refine_count = band.lsp.size();
+    for (std::size_t bi = 0; bi < bands_.size(); ++bi) {
+      Band& band = bands_[bi];
+      const int p = b - band.offset;
+      if (p < 0 || band.lis.empty()) continue;
+      band.lis_next.clear();
+      // lis is swapped only after the loop; process() appends to lis_next only.
+      for (std::size_t n = 0; n < band.lis.size(); ++n) {
+        const std::uint32_t packed = band.lis[n];
+        process(band, static_cast<int>(packed >> 28), static_cast<int>((packed >> 14) & 0x3FFF),
+                static_cast<int>(packed & 0x3FFF), p, false);
+      }
+      std::swap(band.lis, band.lis_next);
+    }
+    for (auto& band : bands_) {
+      const int p = b - band.offset;
+      if (p < 0) continue;
+      refine(band, p);
+    }
+  }
+
+ private:
+  int sym(int bit, Context& ctx) {
+    if constexpr (kDecode) {
+      if (check_ && dec_->exhausted()) throw Stop{};
+      return dec_->decode(ctx);
+    } else {
+      enc_->encode(bit, ctx);
+      return bit;
+    }
+  }
+  int raw(int bit) {
+    if constexpr (kDecode) {
+      if (check_ && dec_->exhausted()) throw Stop{};
+      return dec_->decode_bypass();
+    } else {
+      enc_->encode_bypass(bit);
+      return bit;
+    }
+  }
+
+  int node_context(const Band& band, int l, int x, int y) const {
+    const std::uint8_t* st = band.state.data() + band.lbase[l];
+    const int w = band.lw[l], h = band.lh[l];
+    const std::size_t at = static_cast<std::size_t>(y) * w + x;
+    int nbr = 0;
+    if (x > 0) nbr += st[at - 1] & kSig;
+    if (x + 1 < w) nbr += st[at + 1] & kSig;
+    if (y > 0) nbr += st[at - w] & kSig;
+    if (y + 1 < h) nbr += st[at + w] & kSig;
+    nbr = std::min(nbr, 2);
+    int par = 0;
+    if (band.parent >= 0) {
+      const Band& pb = bands_[band.parent];
+      const int pl = l > 0 ? l - 1 : 0, px = l > 0 ? x : x >> 1, py = l > 0 ? y : y >> 1;
+      if (pl < pb.levels && px < pb.lw[pl] && py < pb.lh[pl]) par = pb.state[pb.node(pl, px, py)] & kSig;
+    }
+    return ((((band.cls * 3 + band.kcls) * 4 + std::min(l, 3)) * 3 + nbr) * 2) + par;
+  }
+
+  std::int32_t coef(const Band& band, std::uint32_t index, int c) const {
+    return (*coefs_)[band.patch][c][index];
+  }
+
+  /// Tests node (l, x, y) of `band` at plain plane p (known significant when `inferred`); splits it if
+  /// significant.
+  void process(Band& band, int l, int x, int y, int p, bool inferred) {
+    const std::size_t idx = band.node(l, x, y);
+    int bit = 1;
+    if (!inferred) {
+      if constexpr (!kDecode) bit = band.msb[idx] >= p;
+      bit = sym(bit, node_ctx_[node_context(band, l, x, y)]);
+      if (!bit) {
+        band.lis_next.push_back(pack(l, x, y));
+        return;
+      }
+      if constexpr (kDecode) {
+        if (p > kMaxCoefficientPlane) throw Corrupt{};
+      }
+    }
+    band.state[idx] |= kSig;
+    if (l == 0) {
+      new_sample(band, x, y, p);
+      return;
+    }
+    // Children at level l − 1; the last active one is significant for sure when no sibling was.
+    const int cl = l - 1;
+    int children[4][2];
+    int count = 0;
+    for (int cy = 2 * y; cy <= 2 * y + 1 && cy < band.lh[cl]; ++cy) {
+      for (int cx = 2 * x; cx <= 2 * x + 1 && cx < band.lw[cl]; ++cx) {
+        if (band.state[band.node(cl, cx, cy)] & kActive) {
+          children[count][0] = cx;
+          children[count][1] = cy;
+          ++count;
+        }
+      }
+    }
+    bool any = false;
+    for (int i = 0; i < count; ++i) {
+      const int cx = children[i][0], cy = children[i][1];
+      const bool infer = (i == count - 1) && !any;
+      process(band, cl, cx, cy, p, infer);
+      any = any || (band.state[band.node(cl, cx, cy)] & kSig);
+    }
+  }
+
+  void new_sample(Band& band, int x, int y, int p) {
+    const std::uint32_t index = band.grid_index(x, y, size_);
+    band.lsp.push_back(Sample{index, {0, 0, 0}, {0, 0, 0}, 0});
+    const std::size_t at = band.lsp.size() - 1;  // band.lsp is not resized below: a reference is safe
+    Sample& s = band.lsp[at];
+    bool any = false;
+    for (int c = 0; c < 3; ++c) {
+      int bit = 1, negative = 0;
+      if constexpr (!kDecode) {
+        const std::int32_t v = coef(band, index, c);
+        const std::uint32_t m = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v);
+        bit = (m >> p) & 1;
+        negative = v < 0;
+      }
+      if (c < 2 || any) bit = sym(bit, chan_ctx_[(band.cls * 3 + c) * 2 + any]);
+      if (bit) {
+        negative = raw(negative);
+        s.mag[c] = 1u << p;
+        s.q[c] = static_cast<std::uint8_t>(p);
+        s.flags |= static_cast<std::uint8_t>((1 << c) | (negative << (3 + c)));
+        any = true;
+      }
+    }
+  }
+
+  void refine(Band& band, int p) {
+    for (std::size_t n = 0; n < band.refine_count; ++n) {
+      Sample& s = band.lsp[n];
+      for (int c = 0; c < 3; ++c) {
+        int bit = 0, negative = 0;
+        if constexpr (!kDecode) {
+          const std::int32_t v = coef(band, s.index, c);
+          const std::uint32_t m = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v);
+          bit = (m >> p) & 1;
+          negative = v < 0;
+        }
+        if (s.flags & (1 << c)) {
+          const std::uint32_t known = s.mag[c] >> (p + 1);
+          int ctx;
+          if constexpr (kDecode) {
+            ctx = known == 1 ? 0 : (known >> 1) == 1 ? 1 : 2;
+          } else {
+            const std::int32_t v = coef(band, s.index, c);
+            const std::uint32_t m = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v);
+            const std::uint32_t k2 = m >> (p + 1);
+            ctx = k2 == 1 ? 0 : (k2 >> 1) == 1 ? 1 : 2;
+          }
+          bit = sym(bit, ref_ctx_[band.cls * 3 + ctx]);
+          if constexpr (kDecode) {
+            s.mag[c] |= static_cast<std::uint32_t>(bit) << p;
+            s.q[c] = static_cast<std::uint8_t>(p);
+          }
+        } else {
+          bit = sym(bit, late_ctx_[band.cls * 3 + c]);
+          if (bit) {
+            negative = raw(negative);
+            s.mag[c] = 1u << p;
+            s.q[c] = static_cast<std::uint8_t>(p);
+            s.flags |= static_cast<std::uint8_t>((1 << c) | (negative << (3 + c)));
+          }
+        }
+      }
+    }
+  }
+
+  int size_;
+  std::vector<Band>& bands_;
+  const std::vector<PatchCoefficients>* coefs_;
+  ArithmeticEncoder* enc_ = nullptr;
+  ArithmeticDecoder* dec_ = nullptr;
+  bool check_ = false;
+  Context node_ctx_[kNodeContexts];
+  Context chan_ctx_[3 * 3 * 2];
+  Context late_ctx_[3 * 3];
+  Context ref_ctx_[3 * 3];
+};
+
+}  // namespace
+
+BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout, const std::vector<PatchCoefficients>& coefficients,
+                                  const std::vector<std::vector<std::uint8_t>>& coded) {
+  if (!layout_ok(layout)) throw std::invalid_argument("encode_bitplanes: layout out of range");
+  const std::size_t size = (std::size_t{1} << layout.level) + 1, samples = size * size;
+  if (coefficients.size() != static_cast<std::size_t>(layout.num_patches) ||
+      coded.size() != static_cast<std::size_t>(layout.num_patches)) {
+    throw std::invalid_argument("encode_bitplanes: " + std::to_string(coefficients.size()) + " patches / " +
+                                std::to_string(coded.size()) + " masks for " +
+                                std::to_string(layout.num_patches) + " patches");
+  }
+  for (std::size_t p = 0; p < coefficients.size(); ++p) {
+    if (coded[p].size() != samples) throw std::invalid_argument("encode_bitplanes: mask size");
+    for (const auto& ch : coefficients[p]) {
+      if (ch.size() != samples) throw std::invalid_argument("encode_bitplanes: coefficient grid size");
+    }
+  }
+  std::vector<Band> bands = make_bands(layout, coded);
+  int top = 0;
+  for (auto& b : bands) {
+    b.msb.assign(b.state.size(), -1);
+    const auto& cf = coefficients[b.patch];
+    for (int y = 0; y < b.h; ++y) {
+      for (int x = 0; x < b.w; ++x) {
+        if (!(b.state[b.node(0, x, y)] & kActive)) continue;
+        const std::uint32_t index = b.grid_index(x, y, static_cast<int>(size));
+        std::int64_t m = 0;
+        for (int c = 0; c < 3; ++c) m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
+        if (m >= (std::int64_t{1} << (kMaxCoefficientPlane + 1))) {
+          throw std::invalid_argument("encode_bitplanes: coefficient magnitude " + std::to_string(m) + " too large");
+        }
+        b.msb[b.node(0, x, y)] = static_cast<std::int8_t>(std::bit_width(static_cast<std::uint64_t>(m)) - 1);
+      }
+    }
+    for (int l = 1; l < b.levels; ++l) {
+      for (int y = 0; y < b.lh[l - 1]; ++y) {
+        for (int x = 0; x < b.lw[l - 1]; ++x) {
+          auto& parent = b.msb[b.node(l, x >> 1, y >> 1)];
+          parent = std::max(parent, b.msb[b.node(l - 1, x, y)]);
+        }
+      }
+    }
+    top = std::max(top, b.msb[b.node(b.levels - 1, 0, 0)] + b.offset);
+  }
+  BitplaneEncoding result;
+  result.top_bitplane = top;
+  PlaneCoder<false> coder(layout, bands, &coefficients);
+  for (int b = top; b >= 0; --b) {
+    ArithmeticEncoder enc;
+    coder.set_encoder(&enc);
+    coder.code_plane(b);
+    result.segments.push_back(enc.finish());
+  }
+  return result;
+}
+
+Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
+                        const std::vector<std::vector<std::uint8_t>>& coded,
+                        std::span<const std::span<const std::uint8_t>> segments,
+                        std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
+                        BitplaneDecodeResult& result) {
+  result = {};
+  if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) || top_bitplane < 0 ||
+      top_bitplane > 64) {
+    return Status::kInvalidArgument;
+  }
+  const std::size_t size = (std::size_t{1} << layout.level) + 1, samples = size * size;
+  for (const auto& m : coded) {
+    if (m.size() != samples) return Status::kInvalidArgument;
+  }
+  out.assign(static_cast<std::size_t>(layout.num_patches), PatchCoefficients{});
+  for (auto& patch : out) {
+    for (auto& ch : patch) ch.assign(samples, 0);
+  }
+  const std::size_t planes = static_cast<std::size_t>(top_bitplane) + 1;
+  Status status = Status::kOk;
+  if (segments.size() > planes || (segments.size() == planes && !partial_tail.empty())) {
+    status = Status::kCorrupt;  // decode what fits, then report
+  }
+  std::vector<Band> bands = make_bands(layout, coded);
+  PlaneCoder<true> coder(layout, bands, nullptr);
+  try {
+    for (std::size_t t = 0; t < planes; ++t) {
+      const int b = top_bitplane - static_cast<int>(t);
+      if (t < segments.size()) {
+        ArithmeticDecoder dec(segments[t]);
+        coder.set_decoder(&dec, false);
+        coder.code_plane(b);
+        ++result.segments_complete;
+      } else {
+        if (!partial_tail.empty()) {
+          ArithmeticDecoder dec(partial_tail);
+          coder.set_decoder(&dec, true);
+          result.partial = true;
+          try {
+            coder.code_plane(b);
+          } catch (const Stop&) {
+          }
+        }
+        break;
+      }
+    }
+  } catch (const Corrupt&) {
+    status = Status::kCorrupt;
+  }
+  for (const auto& band : bands) {
+    auto& patch = out[band.patch];
+    for (const Sample& s : band.lsp) {
+      for (int c = 0; c < 3; ++c) {
+        if (!(s.flags & (1 << c))) continue;
+        const std::int64_t v = static_cast<std::int64_t>(s.mag[c]) + (s.q[c] > 0 ? (std::int64_t{1} << (s.q[c] - 1)) : 0);
+        patch[c][s.index] = static_cast<std::int32_t>((s.flags >> (3 + c)) & 1 ? -v : v);
+      }
+    }
+  }
+  return status;
+}
+
+}  // namespace geomip::codec

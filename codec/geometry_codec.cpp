@@ -1,0 +1,357 @@
+#include "codec/geometry_codec.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include "codec/bitplane_coder.h"
+
+namespace geomip::codec {
+namespace {
+
+constexpr std::uint8_t kHeaderVersion = 1;
+constexpr int kMaxLevel = 12;
+constexpr int kMaxTopBitplane = 48;
+constexpr std::uint64_t kMaxTotalSamples = std::uint64_t{1} << 26;  // patches · (2^level+1)²
+
+int grid_size(int level) { return (1 << level) + 1; }
+
+/// Grid index of parameter k of side s (see PatchSeam).
+int side_index(int level, int side, int k) {
+  const int m = 1 << level, size = m + 1;
+  int i, j;
+  switch (side) {
+    case 0: i = k, j = 0; break;
+    case 1: i = m, j = k; break;
+    case 2: i = m - k, j = m; break;
+    default: i = 0, j = m - k; break;
+  }
+  return j * size + i;
+}
+
+/// Which samples are coded (the owner of each seam class: its lowest patch·size² + index sample), and the
+/// (copy, owner) pairs of global indices (patch·size² + grid index) the decoder must fill.
+struct Ownership {
+  std::vector<std::vector<std::uint8_t>> coded;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> copies;
+};
+
+Ownership seam_ownership(int level, int num_patches, const std::vector<PatchSeam>& seams) {
+  const int m = 1 << level;
+  const std::size_t per_patch = static_cast<std::size_t>(grid_size(level)) * grid_size(level);
+  Ownership own;
+  own.coded.assign(static_cast<std::size_t>(num_patches), std::vector<std::uint8_t>(per_patch, 1));
+  if (seams.empty()) return own;
+  // Union-find over boundary samples only: id = (patch·4 + side)·m + k, k < m (each boundary sample once).
+  const std::size_t ids = static_cast<std::size_t>(num_patches) * 4 * m;
+  std::vector<std::uint32_t> parent(ids);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](std::uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  auto id = [&](int p, int s, int k) {
+    if (k == m) s = (s + 1) % 4, k = 0;
+    return static_cast<std::uint32_t>((static_cast<std::size_t>(p) * 4 + s) * m + k);
+  };
+  for (const PatchSeam& seam : seams) {
+    for (int k = 0; k <= m; ++k) {
+      const std::uint32_t a = find(id(seam.patch, seam.side, k));
+      const std::uint32_t b = find(id(seam.other_patch, seam.other_side, seam.reversed ? m - k : k));
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  auto global = [&](std::uint32_t a) {
+    const std::size_t p = a / (4 * static_cast<std::size_t>(m));
+    const int s = static_cast<int>(a / m % 4), k = static_cast<int>(a % m);
+    return p * per_patch + static_cast<std::size_t>(side_index(level, s, k));
+  };
+  std::vector<std::uint64_t> owner(ids, std::numeric_limits<std::uint64_t>::max());
+  for (std::uint32_t a = 0; a < ids; ++a) {
+    const std::uint32_t r = find(a);
+    owner[r] = std::min<std::uint64_t>(owner[r], global(a));
+  }
+  for (std::uint32_t a = 0; a < ids; ++a) {
+    const std::uint64_t g = global(a), o = owner[find(a)];
+    if (g != o) {
+      own.coded[g / per_patch][g % per_patch] = 0;
+      own.copies.emplace_back(g, o);
+    }
+  }
+  return own;
+}
+
+bool seam_ok(const PatchSeam& s, int num_patches) {
+  return s.patch >= 0 && s.patch < num_patches && s.other_patch >= 0 && s.other_patch < num_patches &&
+         s.side >= 0 && s.side < 4 && s.other_side >= 0 && s.other_side < 4;
+}
+
+/// The checks parse() applies, shared with decode_geometry() for headers built by hand.
+bool header_ok(const GeometryCodecHeader& h) {
+  if (h.level < 0 || h.level > kMaxLevel || h.num_patches < 1 || h.steps < 0 || h.steps > h.level) return false;
+  const std::uint64_t size = static_cast<std::uint64_t>(grid_size(h.level));
+  if (static_cast<std::uint64_t>(h.num_patches) * size * size > kMaxTotalSamples) return false;
+  if (h.filter != WaveletFilter::kLinear && h.filter != WaveletFilter::kCubic) return false;
+  for (double o : h.origin) {
+    if (!std::isfinite(o)) return false;
+  }
+  if (!std::isfinite(h.step) || !(h.step > 0)) return false;
+  if (h.top_bitplane < 0 || h.top_bitplane > kMaxTopBitplane) return false;
+  if (h.seams.size() > 4 * static_cast<std::size_t>(h.num_patches)) return false;
+  for (const auto& s : h.seams) {
+    if (!seam_ok(s, h.num_patches)) return false;
+  }
+  return true;
+}
+
+void put_varint(std::vector<std::uint8_t>& out, std::uint64_t v) {
+  while (v >= 0x80) {
+    out.push_back(static_cast<std::uint8_t>(v | 0x80));
+    v >>= 7;
+  }
+  out.push_back(static_cast<std::uint8_t>(v));
+}
+
+void put_double(std::vector<std::uint8_t>& out, double d) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &d, sizeof bits);
+  for (int i = 0; i < 8; ++i) out.push_back(static_cast<std::uint8_t>(bits >> (8 * i)));
+}
+
+/// Bounds-checked reader: every get fails (returns false) instead of reading past the end.
+class Reader {
+ public:
+  explicit Reader(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
+  bool byte(std::uint8_t& b) {
+    if (pos_ >= bytes_.size()) return false;
+    b = bytes_[pos_++];
+    return true;
+  }
+  /// Varint of at most 5 bytes (values < 2^35), canonical (no trailing zero byte).
+  bool varint(std::uint64_t& v) {
+    v = 0;
+    for (int i = 0; i < 5; ++i) {
+      std::uint8_t b;
+      if (!byte(b)) return false;
+      v |= static_cast<std::uint64_t>(b & 0x7F) << (7 * i);
+      if (!(b & 0x80)) return !(i > 0 && b == 0);
+    }
+    return false;
+  }
+  bool small_int(int& out, std::uint64_t max) {
+    std::uint64_t v;
+    if (!varint(v) || v > max) return false;
+    out = static_cast<int>(v);
+    return true;
+  }
+  bool f64(double& d) {
+    std::uint64_t bits = 0;
+    for (int i = 0; i < 8; ++i) {
+      std::uint8_t b;
+      if (!byte(b)) return false;
+      bits |= static_cast<std::uint64_t>(b) << (8 * i);
+    }
+    std::memcpy(&d, &bits, sizeof d);
+    return true;
+  }
+  bool at_end() const { return pos_ == bytes_.size(); }
+
+ private:
+  std::span<const std::uint8_t> bytes_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> GeometryCodecHeader::serialize() const {
+  std::vector<std::uint8_t> out;
+  out.push_back(kHeaderVersion);
+  put_varint(out, static_cast<std::uint64_t>(level));
+  put_varint(out, static_cast<std::uint64_t>(num_patches));
+  put_varint(out, static_cast<std::uint64_t>(steps));
+  out.push_back(static_cast<std::uint8_t>(filter));
+  for (double o : origin) put_double(out, o);
+  put_double(out, step);
+  put_varint(out, static_cast<std::uint64_t>(top_bitplane));
+  put_varint(out, seams.size());
+  for (const auto& s : seams) {
+    put_varint(out, static_cast<std::uint64_t>(s.patch));
+    put_varint(out, static_cast<std::uint64_t>(s.other_patch));
+    out.push_back(static_cast<std::uint8_t>((s.side & 3) | (s.other_side & 3) << 2 | (s.reversed ? 16 : 0)));
+  }
+  return out;
+}
+
+Status GeometryCodecHeader::parse(std::span<const std::uint8_t> bytes, GeometryCodecHeader& out) {
+  Reader r(bytes);
+  GeometryCodecHeader h;
+  std::uint8_t version, filter;
+  if (!r.byte(version) || version != kHeaderVersion) return Status::kCorrupt;
+  if (!r.small_int(h.level, kMaxLevel) || !r.small_int(h.num_patches, 1 << 20) ||
+      !r.small_int(h.steps, kMaxLevel) || !r.byte(filter) || filter > 1) {
+    return Status::kCorrupt;
+  }
+  h.filter = static_cast<WaveletFilter>(filter);
+  for (double& o : h.origin) {
+    if (!r.f64(o)) return Status::kCorrupt;
+  }
+  int num_seams = 0;
+  if (!r.f64(h.step) || !r.small_int(h.top_bitplane, kMaxTopBitplane) || !r.small_int(num_seams, 1 << 22)) {
+    return Status::kCorrupt;
+  }
+  if (num_seams > 4 * h.num_patches) return Status::kCorrupt;
+  h.seams.resize(static_cast<std::size_t>(num_seams));
+  for (auto& s : h.seams) {
+    std::uint8_t packed;
+    if (!r.small_int(s.patch, 1 << 20) || !r.small_int(s.other_patch, 1 << 20) || !r.byte(packed) ||
+        (packed & ~0x1F) != 0) {
+      return Status::kCorrupt;
+    }
+    s.side = packed & 3;
+    s.other_side = (packed >> 2) & 3;
+    s.reversed = (packed & 16) != 0;
+  }
+  if (!r.at_end() || !header_ok(h)) return Status::kCorrupt;
+  out = std::move(h);
+  return Status::kOk;
+}
+
+EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::vector<PatchSeam>& seams,
+                                const GeometryCodecOptions& options) {
+  if (patches.empty()) throw std::invalid_argument("encode_geometry: no patches");
+  const int level = patches[0].level;
+  if (level < 0 || level > kMaxLevel) {
+    throw std::invalid_argument("encode_geometry: level " + std::to_string(level) + " outside [0, 12]");
+  }
+  const std::size_t size = static_cast<std::size_t>(grid_size(level)), samples = size * size;
+  for (std::size_t p = 0; p < patches.size(); ++p) {
+    if (patches[p].level != level || patches[p].values.size() != 3 * samples) {
+      throw std::invalid_argument("encode_geometry: patch " + std::to_string(p) + " has another level or size");
+    }
+  }
+  if (options.quantization_bits < 1 || options.quantization_bits > 24) {
+    throw std::invalid_argument("encode_geometry: quantization_bits must be in [1, 24]");
+  }
+  if (options.steps < -1 || options.steps > level) {
+    throw std::invalid_argument("encode_geometry: steps must be -1 or in [0, level]");
+  }
+  const int np = static_cast<int>(patches.size());
+  if (seams.size() > 4 * patches.size()) throw std::invalid_argument("encode_geometry: more than 4 seams per patch");
+  for (const auto& s : seams) {
+    if (!seam_ok(s, np)) throw std::invalid_argument("encode_geometry: seam references a bad patch or side");
+  }
+  if (static_cast<std::uint64_t>(np) * samples > kMaxTotalSamples) {
+    throw std::invalid_argument("encode_geometry: too many samples");
+  }
+
+  double lo[3], hi[3];
+  for (int c = 0; c < 3; ++c) lo[c] = INFINITY, hi[c] = -INFINITY;
+  for (const auto& g : patches) {
+    for (std::size_t i = 0; i < samples; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        const double v = g.values[3 * i + c];
+        if (!std::isfinite(v)) throw std::invalid_argument("encode_geometry: NaN or infinite sample");
+        lo[c] = std::min(lo[c], v);
+        hi[c] = std::max(hi[c], v);
+      }
+    }
+  }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  EncodedGeometry result;
+  GeometryCodecHeader& h = result.header;
+  h.level = level;
+  h.num_patches = np;
+  h.steps = options.steps < 0 ? level : options.steps;
+  h.filter = options.filter;
+  for (int c = 0; c < 3; ++c) h.origin[c] = lo[c];
+  h.step = extent > 0 ? extent / std::ldexp(1.0, options.quantization_bits) : 1.0;
+  h.seams = seams;
+
+  const Ownership own = seam_ownership(level, np, seams);
+  std::vector<PatchCoefficients> coefs(static_cast<std::size_t>(np));
+  for (int p = 0; p < np; ++p) {
+    for (int c = 0; c < 3; ++c) {
+      auto& ch = coefs[p][c];
+      ch.resize(samples);
+      for (std::size_t i = 0; i < samples; ++i) {
+        ch[i] = static_cast<std::int32_t>(std::lround((patches[p].values[3 * i + c] - h.origin[c]) / h.step));
+      }
+    }
+  }
+  // Seam copies take their owner's integers (equal anyway for bit-identical seams), so the per-patch transforms
+  // give every copy its owner's coefficient.
+  for (const auto& [copy, owner] : own.copies) {
+    for (int c = 0; c < 3; ++c) coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
+  }
+  for (auto& pc : coefs) {
+    for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter);
+  }
+  BitplaneEncoding enc = encode_bitplanes({level, h.steps, np}, coefs, own.coded);
+  h.top_bitplane = enc.top_bitplane;
+  result.segments = std::move(enc.segments);
+  return result;
+}
+
+Status decode_geometry(const GeometryCodecHeader& header, std::span<const std::span<const std::uint8_t>> segments,
+                       std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,
+                       const GeometryDecodeOptions& options) {
+  out = DecodedGeometry{};
+  if (!header_ok(header) || options.drop_finest_steps < 0) return Status::kInvalidArgument;
+  const int level = header.level, np = header.num_patches, steps = header.steps;
+  const std::size_t size = static_cast<std::size_t>(grid_size(level)), samples = size * size;
+  const Ownership own = seam_ownership(level, np, header.seams);
+  std::vector<PatchCoefficients> coefs;
+  BitplaneDecodeResult r;
+  const Status status =
+      decode_bitplanes({level, steps, np}, header.top_bitplane, own.coded, segments, partial_tail, coefs, r);
+  out.segments_complete = r.segments_complete;
+  out.partial = r.partial;
+  if (coefs.size() != static_cast<std::size_t>(np)) return status == Status::kOk ? Status::kCorrupt : status;
+  for (const auto& [copy, owner] : own.copies) {
+    for (int c = 0; c < 3; ++c) coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
+  }
+  // Drop the finest details, then find the finest step with a non-zero detail.
+  const int drop = std::min(options.drop_finest_steps, steps);
+  int finest_step = steps + 1;  // none
+  for (auto& pc : coefs) {
+    for (auto& ch : pc) {
+      for (std::size_t j = 0; j < size; ++j) {
+        for (std::size_t i = 0; i < size; ++i) {
+          std::int32_t& v = ch[j * size + i];
+          if (v == 0) continue;
+          // The step that introduced (i, j): 1 + trailing zeros of i | j; beyond `steps`: the coarse band.
+          const unsigned both = static_cast<unsigned>(i | j);
+          const int k = both == 0 ? steps + 1 : std::min(std::countr_zero(both) + 1, steps + 1);
+          if (k > steps) continue;
+          if (k <= drop) {
+            v = 0;
+          } else {
+            finest_step = std::min(finest_step, k);
+          }
+        }
+      }
+    }
+  }
+  out.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
+  out.patches.resize(static_cast<std::size_t>(np));
+  for (int p = 0; p < np; ++p) {
+    Grid3& g = out.patches[p];
+    g.level = level;
+    g.values.resize(3 * samples);
+    for (int c = 0; c < 3; ++c) {
+      auto& ch = coefs[p][c];
+      wavelet_inverse(ch, level, steps, header.filter);
+      for (std::size_t i = 0; i < samples; ++i) {
+        g.values[3 * i + c] = static_cast<float>(header.origin[c] + header.step * static_cast<double>(ch[i]));
+      }
+    }
+  }
+  return status;
+}
+
+}  // namespace geomip::codec

@@ -1,0 +1,286 @@
+#include "codec/geometry_codec.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "tests/codec/codec_fixtures.h"
+
+namespace geomip::codec {
+namespace {
+
+using testing::side_sample;
+using testing::two_patch_surface;
+
+std::vector<std::span<const std::uint8_t>> first_segments(const EncodedGeometry& enc, std::size_t k) {
+  std::vector<std::span<const std::uint8_t>> out;
+  for (std::size_t i = 0; i < k; ++i) out.emplace_back(enc.segments[i]);
+  return out;
+}
+
+double max_error(const std::vector<Grid3>& a, const std::vector<Grid3>& b) {
+  double e = 0;
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    for (std::size_t i = 0; i < a[p].values.size(); ++i) {
+      e = std::max(e, std::abs(static_cast<double>(a[p].values[i]) - b[p].values[i]));
+    }
+  }
+  return e;
+}
+
+double rms_error(const std::vector<Grid3>& a, const std::vector<Grid3>& b) {
+  double e = 0;
+  std::size_t n = 0;
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    for (std::size_t i = 0; i < a[p].values.size(); ++i, ++n) {
+      const double d = static_cast<double>(a[p].values[i]) - b[p].values[i];
+      e += d * d;
+    }
+  }
+  return std::sqrt(e / static_cast<double>(n));
+}
+
+/// Every glued pair of samples is bit-identical.
+void expect_watertight(const std::vector<Grid3>& patches, const std::vector<PatchSeam>& seams) {
+  const int level = patches[0].level, m = 1 << level;
+  for (const auto& s : seams) {
+    for (int k = 0; k <= m; ++k) {
+      const float* a = patches[s.patch].values.data() + 3 * side_sample(level, s.side, k);
+      const float* b = patches[s.other_patch].values.data() + 3 * side_sample(level, s.other_side, s.reversed ? m - k : k);
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(std::memcmp(a + c, b + c, sizeof(float)), 0)
+            << "seam " << s.patch << "." << s.side << " k = " << k << " channel " << c;
+      }
+    }
+  }
+}
+
+TEST(GeometryCodec, FixtureIsWatertight) {
+  std::vector<PatchSeam> seams;
+  const auto patches = two_patch_surface(5, seams);
+  expect_watertight(patches, seams);
+}
+
+TEST(GeometryCodec, AllSegmentsReconstructWithinHalfAStep) {
+  for (auto filter : {WaveletFilter::kLinear, WaveletFilter::kCubic}) {
+    for (int level : {0, 1, 3, 6}) {
+      for (int steps : {-1, level / 2}) {
+        std::vector<PatchSeam> seams;
+        const auto patches = two_patch_surface(level, seams);
+        GeometryCodecOptions options;
+        options.filter = filter;
+        options.steps = steps;
+        const auto enc = encode_geometry(patches, seams, options);
+        DecodedGeometry dec;
+        const auto segs = first_segments(enc, enc.segments.size());
+        ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec), Status::kOk);
+        ASSERT_EQ(dec.patches.size(), 2u);
+        EXPECT_EQ(dec.segments_complete, enc.segments.size());
+        EXPECT_FALSE(dec.partial);
+        EXPECT_LE(max_error(dec.patches, patches), enc.header.step * 0.5 + 1e-6) << "level " << level;
+        expect_watertight(dec.patches, seams);
+        if (level > 0) {
+          EXPECT_EQ(dec.detail_level, level);
+        }
+      }
+    }
+  }
+}
+
+TEST(GeometryCodec, ErrorNeverIncreasesWithMoreSegments) {
+  std::vector<PatchSeam> seams;
+  const auto patches = two_patch_surface(6, seams);
+  const auto enc = encode_geometry(patches, seams);
+  double previous = std::numeric_limits<double>::infinity();
+  int previous_level = 0;
+  for (std::size_t k = 0; k <= enc.segments.size(); ++k) {
+    DecodedGeometry dec;
+    const auto segs = first_segments(enc, k);
+    ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec), Status::kOk);
+    const double e = rms_error(dec.patches, patches);
+    EXPECT_LE(e, previous * (1 + 1e-9)) << k << " segments";
+    EXPECT_GE(dec.detail_level, previous_level);
+    previous = e;
+    previous_level = dec.detail_level;
+    expect_watertight(dec.patches, seams);
+  }
+}
+
+TEST(GeometryCodec, EveryBytePrefixDecodesWatertight) {
+  std::vector<PatchSeam> seams;
+  const auto patches = two_patch_surface(4, seams);
+  const auto enc = encode_geometry(patches, seams, {12, WaveletFilter::kCubic, -1});
+  std::size_t total = 0;
+  for (const auto& s : enc.segments) total += s.size();
+  std::size_t tested = 0;
+  for (std::size_t k = 0; k < enc.segments.size(); ++k) {
+    const auto segs = first_segments(enc, k);
+    for (std::size_t len = 0; len <= enc.segments[k].size(); ++len) {
+      DecodedGeometry dec;
+      const std::span<const std::uint8_t> tail(enc.segments[k].data(), len);
+      ASSERT_EQ(decode_geometry(enc.header, segs, tail, dec), Status::kOk);
+      ASSERT_EQ(dec.patches.size(), 2u);
+      expect_watertight(dec.patches, seams);
+      ++tested;
+    }
+  }
+  EXPECT_GE(tested, total);
+}
+
+TEST(GeometryCodec, DroppingFinestStepsStaysWatertightAndLowersDetailLevel) {
+  std::vector<PatchSeam> seams;
+  const auto patches = two_patch_surface(5, seams);
+  const auto enc = encode_geometry(patches, seams);
+  const auto segs = first_segments(enc, enc.segments.size());
+  for (int drop = 0; drop <= 6; ++drop) {
+    DecodedGeometry dec;
+    ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec, {drop}), Status::kOk);
+    EXPECT_EQ(dec.detail_level, std::max(5 - drop, 0));
+    expect_watertight(dec.patches, seams);
+    // The kept coarse grid is still exact (interpolating wavelet): samples at multiples of 2^drop.
+    const int n = 33, s = 1 << std::min(drop, 5);
+    for (int j = 0; j < n; j += s) {
+      for (int i = 0; i < n; i += s) {
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_NEAR(dec.patches[0].values[3 * (j * n + i) + c], patches[0].values[3 * (j * n + i) + c],
+                      enc.header.step * 0.5 + 1e-6);
+        }
+      }
+    }
+  }
+}
+
+TEST(GeometryCodec, HeaderRoundTripsAndIsCompact) {
+  std::vector<PatchSeam> seams;
+  const auto enc = encode_geometry(two_patch_surface(3, seams), seams);
+  const auto bytes = enc.header.serialize();
+  EXPECT_LE(bytes.size(), 80u);
+  GeometryCodecHeader h;
+  ASSERT_EQ(GeometryCodecHeader::parse(bytes, h), Status::kOk);
+  EXPECT_EQ(h.serialize(), bytes);
+  EXPECT_EQ(h.level, enc.header.level);
+  EXPECT_EQ(h.top_bitplane, enc.header.top_bitplane);
+  EXPECT_EQ(h.step, enc.header.step);
+  EXPECT_EQ(h.seams.size(), seams.size());
+  // Truncations and trailing bytes are corrupt.
+  for (std::size_t len = 0; len < bytes.size(); ++len) {
+    EXPECT_EQ(GeometryCodecHeader::parse(std::span(bytes.data(), len), h), Status::kCorrupt) << len;
+  }
+  auto longer = bytes;
+  longer.push_back(0);
+  EXPECT_EQ(GeometryCodecHeader::parse(longer, h), Status::kCorrupt);
+}
+
+TEST(GeometryCodec, HeaderParseRejectsInconsistentValues) {
+  std::vector<PatchSeam> seams;
+  const auto enc = encode_geometry(two_patch_surface(3, seams), seams);
+  auto bad = [&](auto mutate) {
+    GeometryCodecHeader h = enc.header;
+    mutate(h);
+    GeometryCodecHeader out;
+    return GeometryCodecHeader::parse(h.serialize(), out) == Status::kCorrupt;
+  };
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.level = 13; }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.steps = h.level + 1; }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.num_patches = 0; }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.seams[0].other_patch = 2; }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.step = 0; }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.step = std::numeric_limits<double>::quiet_NaN(); }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.origin[1] = std::numeric_limits<double>::infinity(); }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.top_bitplane = 200; }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.seams.resize(9, h.seams[0]); }));
+  EXPECT_FALSE(bad([](GeometryCodecHeader&) {}));
+}
+
+TEST(GeometryCodec, GarbageHeadersAndSegmentsNeverCrash) {
+  std::mt19937 rng(2024);
+  std::vector<PatchSeam> seams;
+  const auto enc = encode_geometry(two_patch_surface(4, seams), seams);
+  const auto header_bytes = enc.header.serialize();
+  for (int trial = 0; trial < 300; ++trial) {
+    // Headers: random bytes, and the real header with a few bytes flipped.
+    std::vector<std::uint8_t> hb = header_bytes;
+    if (trial % 2) {
+      hb.resize(rng() % 80);
+      for (auto& b : hb) b = static_cast<std::uint8_t>(rng());
+    } else {
+      for (int f = 0; f < 3; ++f) hb[rng() % hb.size()] ^= static_cast<std::uint8_t>(1 + rng() % 255);
+    }
+    GeometryCodecHeader h;
+    if (GeometryCodecHeader::parse(hb, h) != Status::kOk) h = enc.header;
+    if (h.level > 6 || static_cast<long>(h.num_patches) << (2 * h.level) > (1 << 16)) h = enc.header;
+    // Segments: garbage, or real ones with flipped bytes.
+    std::vector<std::vector<std::uint8_t>> segs = enc.segments;
+    if (trial % 3 == 0) {
+      segs.resize(rng() % 30);
+      for (auto& s : segs) {
+        s.resize(rng() % 100);
+        for (auto& b : s) b = static_cast<std::uint8_t>(rng());
+      }
+    } else {
+      for (auto& s : segs) {
+        if (!s.empty() && rng() % 2) s[rng() % s.size()] ^= static_cast<std::uint8_t>(1 + rng() % 255);
+      }
+    }
+    std::vector<std::span<const std::uint8_t>> spans;
+    for (const auto& s : segs) spans.emplace_back(s);
+    std::vector<std::uint8_t> tail(rng() % 20, 0xAB);
+    DecodedGeometry dec;
+    const Status st = decode_geometry(h, spans, tail, dec);
+    EXPECT_TRUE(st == Status::kOk || st == Status::kCorrupt);
+    EXPECT_EQ(dec.patches.size(), static_cast<std::size_t>(h.num_patches));
+    // Whatever the bytes, the result is watertight under the header's own seams.
+    expect_watertight(dec.patches, h.seams);
+  }
+}
+
+TEST(GeometryCodec, EncoderRejectsBadInput) {
+  std::vector<PatchSeam> seams;
+  auto patches = two_patch_surface(3, seams);
+  auto nan = patches;
+  nan[1].values[7] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(encode_geometry(nan, seams), std::invalid_argument);
+  auto inf = patches;
+  inf[0].values[0] = std::numeric_limits<float>::infinity();
+  EXPECT_THROW(encode_geometry(inf, seams), std::invalid_argument);
+  auto sizes = patches;
+  sizes[1].values.pop_back();
+  EXPECT_THROW(encode_geometry(sizes, seams), std::invalid_argument);
+  auto bad_seams = seams;
+  bad_seams[0].other_patch = 5;
+  EXPECT_THROW(encode_geometry(patches, bad_seams), std::invalid_argument);
+  EXPECT_THROW(encode_geometry({}, {}), std::invalid_argument);
+  GeometryCodecOptions o;
+  o.steps = 4;
+  EXPECT_THROW(encode_geometry(patches, seams, o), std::invalid_argument);
+}
+
+TEST(GeometryCodec, CubicBeatsLinearOnASmoothSurface) {
+  // Same byte budget, smaller grid RMS error with the cubic filter (the reason it is the default).
+  std::vector<PatchSeam> seams;
+  const auto patches = two_patch_surface(7, seams);
+  double rms[2];
+  for (int f = 0; f < 2; ++f) {
+    GeometryCodecOptions o;
+    o.filter = static_cast<WaveletFilter>(f);
+    const auto enc = encode_geometry(patches, seams, o);
+    // Concatenate and cut at 4 KB.
+    std::size_t budget = 4096, k = 0;
+    while (k < enc.segments.size() && enc.segments[k].size() <= budget) budget -= enc.segments[k++].size();
+    DecodedGeometry dec;
+    const auto segs = first_segments(enc, k);
+    const std::span<const std::uint8_t> tail =
+        k < enc.segments.size() ? std::span<const std::uint8_t>(enc.segments[k].data(), budget) : std::span<const std::uint8_t>();
+    ASSERT_EQ(decode_geometry(enc.header, segs, tail, dec), Status::kOk);
+    rms[f] = rms_error(dec.patches, patches);
+  }
+  EXPECT_LT(rms[1], rms[0]);
+}
+
+}  // namespace
+}  // namespace geomip::codec

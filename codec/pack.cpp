@@ -177,8 +177,13 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     if (mask_patches != 0 && mask_patches != static_cast<std::uint64_t>(model.geometry.num_patches))
       return Status::kCorrupt;
     model.hole_mask.resize(static_cast<std::size_t>(mask_patches));
+    if (mask_patches > 0) {
+      std::uint8_t mask_level;
+      if (!r.u8(mask_level) || mask_level > model.geometry.level) return Status::kCorrupt;
+      model.hole_mask_level = mask_level;
+    }
     for (auto& mask : model.hole_mask)
-      if (!read_mask(r, 1 << model.geometry.level, mask)) return Status::kCorrupt;
+      if (!read_mask(r, 1 << model.hole_mask_level, mask)) return Status::kCorrupt;
     geometry_passes.push_back(passes_of(model.geometry));
     normal_passes.push_back(model.has_normals ? passes_of(model.normals) : 0);
   }
@@ -251,7 +256,7 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
   if (options.normals_delay < 0 || options.normals_delay > static_cast<int>(kMaxPasses))
     throw std::invalid_argument("write_pack: normals_delay outside [0, 64]");
   std::vector<EncodedGeometry> geometry(models.size()), normals(models.size());
-  std::vector<int> geometry_passes, normal_passes;
+  std::vector<int> geometry_passes, normal_passes, mask_level;
   for (std::size_t m = 0; m < models.size(); ++m) {
     const PackModelInput& model = models[m];
     if (model.name.size() > kMaxNameSize) throw std::invalid_argument("write_pack: model name too long");
@@ -267,8 +272,12 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
       normals[m] = encode_geometry(model.normals, model.seams, options.normal_codec);
     }
     normal_passes.push_back(with_normals ? static_cast<int>(normals[m].segments.size()) : 0);
+    const int level = model.geometry.front().level;
+    mask_level.push_back(model.hole_mask_level < 0 ? level : model.hole_mask_level);
+    if (mask_level.back() > level)
+      throw std::invalid_argument("write_pack: model '" + model.name + "': hole mask level above the grid's");
     if (!model.hole_mask.empty()) {
-      const std::size_t quads = std::size_t{1} << (2 * model.geometry.front().level);
+      const std::size_t quads = std::size_t{1} << (2 * mask_level.back());
       if (model.hole_mask.size() != model.geometry.size() ||
           std::any_of(model.hole_mask.begin(), model.hole_mask.end(),
                       [&](const auto& mask) { return mask.size() != quads; }))
@@ -286,7 +295,8 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
     manifest.u8(normal_passes[m] > 0 ? 1 : 0);
     if (normal_passes[m] > 0) manifest.bytes(normals[m].header.serialize());
     manifest.varint(models[m].hole_mask.size());
-    for (const auto& mask : models[m].hole_mask) write_mask(manifest, mask, 1 << models[m].geometry.front().level);
+    if (!models[m].hole_mask.empty()) manifest.u8(static_cast<std::uint8_t>(mask_level[m]));
+    for (const auto& mask : models[m].hole_mask) write_mask(manifest, mask, 1 << mask_level[m]);
   }
   const std::vector<ChunkKey> order = chunk_order(geometry_passes, normal_passes, options.normals_delay);
   manifest.varint(order.size());
@@ -356,6 +366,7 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
     model.normalization = model_info.normalization;
     model.seams = model_info.geometry.seams;
     model.hole_mask = model_info.hole_mask;
+    model.hole_mask_level = model_info.hole_mask_level;
     model.geometry_passes = s.geometry.size();
     try {
       DecodedGeometry decoded;

@@ -23,5 +23,6 @@ CommandRunner add_param_command(CLI::App& app);
 CommandRunner add_gimage_command(CLI::App& app);
 CommandRunner add_remesh_command(CLI::App& app);
 CommandRunner add_eval_command(CLI::App& app);
+CommandRunner add_rd_command(CLI::App& app);
 
 }  // namespace geomip::tools

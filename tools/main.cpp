@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   add(add_gimage_command(app));
   add(add_remesh_command(app));
   add(add_eval_command(app));
+  add(add_rd_command(app));
 
   try {
     app.parse(argc, argv);

@@ -2,6 +2,10 @@
 
 #include "param/errors.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
+#include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 #include <meshoptimizer.h>
 
 #include <algorithm>
@@ -39,6 +43,49 @@ TriMesh compact(const TriMesh& mesh, const std::vector<unsigned int>& indices) {
   return out;
 }
 
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+
+// CGAL edge_collapse with the Lindstrom–Turk defaults on the triangles `indices` of `mesh`.
+TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& indices, std::size_t target_faces) {
+  SurfaceMesh sm;
+  std::vector<SurfaceMesh::Vertex_index> vertex(mesh.positions.size());
+  std::vector<bool> used(mesh.positions.size(), false);
+  for (unsigned i : indices) used[i] = true;
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+    if (used[v]) {
+      const Eigen::Vector3d& p = mesh.positions[v];
+      vertex[v] = sm.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z()));
+    }
+  for (std::size_t i = 0; i + 2 < indices.size(); i += 3)
+    if (sm.add_face(vertex[indices[i]], vertex[indices[i + 1]], vertex[indices[i + 2]]) == SurfaceMesh::null_face())
+      throw InvalidInput("decimate_mesh: Lindstrom-Turk decimation needs an oriented 2-manifold; triangle " +
+                         std::to_string(i / 3) + " makes it non-manifold or flips the orientation");
+  std::size_t boundary_edges = 0;
+  for (auto h : sm.halfedges())
+    if (sm.is_border(h)) ++boundary_edges;
+  const std::size_t target_edges = (3 * target_faces + boundary_edges) / 2;
+  CGAL::Surface_mesh_simplification::Count_stop_predicate<SurfaceMesh> stop(target_edges);
+  CGAL::Surface_mesh_simplification::edge_collapse(sm, stop);
+  sm.collect_garbage();
+
+  TriMesh out;
+  std::vector<int> index(sm.number_of_vertices(), -1);
+  for (auto v : sm.vertices()) {
+    if (sm.is_isolated(v)) continue;
+    index[v.idx()] = static_cast<int>(out.positions.size());
+    const auto& p = sm.point(v);
+    out.positions.emplace_back(p.x(), p.y(), p.z());
+  }
+  for (auto f : sm.faces()) {
+    std::array<int, 3> t{};
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) t[k++] = index[v.idx()];
+    out.triangles.push_back(t);
+  }
+  return out;
+}
+
 }  // namespace
 
 DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces, const DecimationOptions& options) {
@@ -64,6 +111,11 @@ DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces, co
   const std::size_t faces = indices.size() / 3;
   if (target_faces >= faces) {
     result.mesh = compact(mesh, indices);
+    return result;
+  }
+
+  if (options.method == DecimationMethod::kLindstromTurk) {
+    result.mesh = lindstrom_turk(mesh, indices, target_faces);
     return result;
   }
 

@@ -1,7 +1,8 @@
-// geomip rd MESH -o DIR [--json] [--quick]: rate–distortion baselines of MESH — Draco on the full mesh over
-// quantization bits, Draco on QEM-decimated copies (faces × bits) and their upper envelope, meshoptimizer's
-// codec — each decoded mesh measured against MESH with the Metro-style surface distance. Writes DIR/rd.csv
-// (every point) and DIR/rd.svg (the plot).
+// geomip rd MESH -o DIR [--json] [--quick] [--lindstrom-turk]: rate–distortion baselines of MESH — Draco on
+// the full mesh over quantization bits, Draco on QEM-decimated copies (faces × bits; meshoptimizer's
+// simplifier, and with --lindstrom-turk also CGAL's) and their upper envelopes, meshoptimizer's codec — each
+// decoded mesh measured against MESH with the Metro-style surface distance. Writes DIR/rd.csv (every point)
+// and DIR/rd.svg (the plot).
 //
 // The command is a list of series: each series is a method name and a list of jobs, a job codes one mesh and
 // returns its bytes, decoded mesh and decode time; evaluation, the envelope, the files and the table are the
@@ -44,6 +45,7 @@ struct RdArgs {
   std::string output;
   bool json = false;
   bool quick = false;
+  bool lindstrom_turk = false;  // also the draco_lt series (CGAL Lindstrom-Turk decimation) and its envelope
   std::size_t samples = 0;  // face samples per surface for the evaluation; 0 = surface_distance's default
   unsigned threads = 0;     // 0 = hardware_concurrency
 };
@@ -143,40 +145,64 @@ Job meshopt_job(std::shared_ptr<const TriMesh> mesh, int bits) {
 }
 
 /// Every series of the report. Decimation happens here (in parallel), coding later, in the jobs.
-std::vector<Series> plan_series(const std::shared_ptr<const TriMesh>& original, const Sweep& sweep,
-                                unsigned threads, ProgressBar& progress) {
-  std::vector<Series> plan;
-
-  Series draco{"draco", {}};
-  for (int q : sweep.draco_bits) draco.jobs.push_back(draco_job("draco", original, q));
-  plan.push_back(std::move(draco));
-
+/// The decimated copies of `original` at `sweep.faces` (those below its face count), in parallel.
+std::vector<std::shared_ptr<const TriMesh>> decimate_all(const std::shared_ptr<const TriMesh>& original,
+                                                         const Sweep& sweep, DecimationMethod method,
+                                                         unsigned threads, ProgressBar& progress) {
   std::vector<std::size_t> faces;
   for (std::size_t f : sweep.faces)
     if (f < original->num_triangles()) faces.push_back(f);
   std::vector<std::shared_ptr<const TriMesh>> decimated(faces.size());
   std::atomic<std::size_t> done{0};
   std::mutex progress_mutex;
+  DecimationOptions options;
+  options.method = method;
   parallel_for(faces.size(), threads, [&](std::size_t i) {
-    decimated[i] = std::make_shared<const TriMesh>(decimate_mesh(*original, faces[i]).mesh);
+    decimated[i] = std::make_shared<const TriMesh>(decimate_mesh(*original, faces[i], options).mesh);
     std::lock_guard<std::mutex> lock(progress_mutex);
     progress.update("decimating", static_cast<double>(++done) / static_cast<double>(faces.size()));
   });
+  return decimated;
+}
+
+std::vector<Series> plan_series(const std::shared_ptr<const TriMesh>& original, const Sweep& sweep,
+                                bool lindstrom_turk, unsigned threads, ProgressBar& progress) {
+  std::vector<Series> plan;
+
+  Series draco{"draco", {}};
+  for (int q : sweep.draco_bits) draco.jobs.push_back(draco_job("draco", original, q));
+  plan.push_back(std::move(draco));
+
   Series qem{"draco_qem", {}};
-  for (const auto& mesh : decimated)
+  for (const auto& mesh : decimate_all(original, sweep, DecimationMethod::kMeshopt, threads, progress))
     for (int q : sweep.draco_qem_bits) qem.jobs.push_back(draco_job("draco_qem", mesh, q));
   plan.push_back(std::move(qem));
+
+  if (lindstrom_turk) {
+    Series lt{"draco_lt", {}};
+    for (const auto& mesh : decimate_all(original, sweep, DecimationMethod::kLindstromTurk, threads, progress))
+      for (int q : sweep.draco_qem_bits) lt.jobs.push_back(draco_job("draco_lt", mesh, q));
+    plan.push_back(std::move(lt));
+  }
 
   Series meshopt{"meshopt", {}};
   for (int q : sweep.meshopt_bits) meshopt.jobs.push_back(meshopt_job(original, q));
   plan.push_back(std::move(meshopt));
 
-  // A further codec appends its Series here (and, if it should join the Draco envelope, nothing else:
-  // the envelope is taken over kEnvelopeMethods below).
+  // A further codec appends its Series here; an envelope over it is one more entry of kEnvelopes.
   return plan;
 }
 
-const std::set<std::string> kEnvelopeMethods = {"draco", "draco_qem"};
+/// Envelopes written as series of their own: name and the methods whose points they are taken over. An
+/// envelope is written when one of its methods has points that no earlier envelope covers.
+struct Envelope {
+  std::string name;
+  std::set<std::string> methods;
+};
+const std::vector<Envelope> kEnvelopes = {
+    {"draco_envelope", {"draco", "draco_qem"}},                   // issue 5's Draco baseline
+    {"draco_lt_envelope", {"draco", "draco_qem", "draco_lt"}},  // with the stronger decimation (--lindstrom-turk)
+};
 
 template <typename... T>
 std::string format(const char* fmt, T... values) {
@@ -212,7 +238,7 @@ int run_rd(const RdArgs& args) {
   const Sweep sweep = make_sweep(args.quick);
 
   ProgressBar progress("rd", !args.json);
-  const std::vector<Series> plan = plan_series(original, sweep, threads, progress);
+  const std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -246,21 +272,30 @@ int run_rd(const RdArgs& args) {
   });
   progress.finish();
 
-  std::vector<RdPoint> envelope_input;
-  for (const RdPoint& p : measured)
-    if (kEnvelopeMethods.count(p.method) != 0) envelope_input.push_back(p);
-  std::vector<RdPoint> envelope = upper_envelope(envelope_input);
-  for (RdPoint& p : envelope) {
-    p.source = p.method;
-    p.method = "draco_envelope";
-  }
   std::vector<RdPoint> all = measured;
-  all.insert(all.end(), envelope.begin(), envelope.end());
+  std::set<std::string> covered;
+  for (const Envelope& e : kEnvelopes) {
+    std::vector<RdPoint> input;
+    bool adds = false;
+    for (const RdPoint& p : measured)
+      if (e.methods.count(p.method) != 0) {
+        input.push_back(p);
+        adds = adds || covered.count(p.method) == 0;
+      }
+    if (!adds) continue;
+    covered.insert(e.methods.begin(), e.methods.end());
+    for (RdPoint p : upper_envelope(input)) {
+      p.source = p.method;
+      p.method = e.name;
+      all.push_back(std::move(p));
+    }
+  }
 
   // Render both files first, then write them atomically: a failure leaves neither half-written.
   std::ostringstream csv, svg;
   write_rd_csv(csv, all);
   RdPlotOptions plot;
+  plot.scatter_methods = {"draco_qem", "draco_lt"};
   plot.title = "Rate-distortion: " + std::filesystem::path(args.mesh).filename().string() + " (" +
                std::to_string(original->num_triangles()) + " faces)";
   write_rd_svg(svg, all, plot);
@@ -287,15 +322,15 @@ int run_rd(const RdArgs& args) {
             << " vertices\n"
             << format("%-15s %7s %3s %9s %9s %8s %9s %9s\n", "method", "faces", "Q", "bytes", "KB", "PSNR dB",
                       "Haus. %", "decode ms");
-  std::size_t qem_points = 0;
+  std::size_t candidates = 0;
   for (const RdPoint& p : all) {
-    if (p.method == "draco_qem") {
-      ++qem_points;
+    if (p.method == "draco_qem" || p.method == "draco_lt") {
+      ++candidates;
       continue;
     }
     std::cout << point_row(p);
   }
-  std::cout << "(" << qem_points << " draco_qem points, the envelope's candidates, are in rd.csv)\n"
+  std::cout << "(" << candidates << " decimate-then-Draco points, the envelopes' candidates, are in rd.csv)\n"
             << "wrote " << (dir / "rd.csv").string() << " and " << (dir / "rd.svg").string()
             << format(" in %.1f s\n", seconds);
   return kExitOk;
@@ -315,6 +350,9 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
   cmd->add_flag("--json", args->json, "Print every point as JSON instead of the table");
   cmd->add_flag("--quick", args->quick, "A few points only, coarser evaluation (for tests)");
+  cmd->add_flag("--lindstrom-turk", args->lindstrom_turk,
+                "Also decimate with CGAL's Lindstrom-Turk edge collapse (series draco_lt, same faces x Q) and "
+                "write draco_lt_envelope over draco, draco_qem and draco_lt (needs a manifold MESH)");
   cmd->add_option("--samples", args->samples,
                   "Face samples per surface for the evaluation (default: as `geomip eval`; --quick: 20000)");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)");

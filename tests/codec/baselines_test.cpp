@@ -129,6 +129,30 @@ TEST(MeshDecimation, HitsTheTargetWithoutDegenerateFaces) {
   }
 }
 
+TEST(MeshDecimation, LindstromTurkHitsTheTargetAndStaysManifold) {
+  DecimationOptions options;
+  options.method = DecimationMethod::kLindstromTurk;
+  for (const TriMesh& mesh : {test::sphere(4), test::open_cylinder(48, 32)}) {
+    const TopologyReport before = analyze_topology(mesh);
+    for (std::size_t target : {std::size_t{300}, std::size_t{1000}}) {
+      const DecimationResult r = decimate_mesh(mesh, target, options);
+      const double faces = static_cast<double>(r.mesh.num_triangles());
+      EXPECT_LE(faces, 1.05 * static_cast<double>(target)) << target;
+      EXPECT_GE(faces, 0.9 * static_cast<double>(target)) << target;
+      const TopologyReport topo = analyze_topology(r.mesh);
+      EXPECT_EQ(topo.degenerate_faces, 0u) << target;
+      EXPECT_TRUE(topo.manifold) << target;
+      EXPECT_EQ(topo.unreferenced_vertices, 0u) << target;
+      EXPECT_EQ(topo.boundary_loops, before.boundary_loops) << target;
+      EXPECT_EQ(topo.genus, before.genus) << target;
+    }
+  }
+  // Non-manifold input (a duplicated face: three faces on its edges) is refused, not mangled.
+  TriMesh bad = test::tetrahedron();
+  bad.triangles.push_back(bad.triangles[0]);
+  EXPECT_THROW(decimate_mesh(bad, 2, options), InvalidInput);
+}
+
 TEST(MeshDecimation, TargetAboveTheFaceCountKeepsTheMesh) {
   const TriMesh mesh = test::sphere(2);
   const DecimationResult r = decimate_mesh(mesh, 10 * mesh.num_triangles());

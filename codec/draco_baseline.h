@@ -25,7 +25,7 @@ struct DracoOptions {
   /// Compression level 0..10 (draco_encoder -cl); speed = 10 − level for both encoder and decoder.
   int compression_level = 10;
   /// Decode runs timed; the reported decode time is the fastest (best of `decode_runs`, at least 1).
-  int decode_runs = 3;
+  int decode_runs = 5;
 };
 
 struct DracoResult {

@@ -61,12 +61,16 @@ TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& ind
     if (sm.add_face(vertex[indices[i]], vertex[indices[i + 1]], vertex[indices[i + 2]]) == SurfaceMesh::null_face())
       throw InvalidInput("decimate_mesh: Lindstrom-Turk decimation needs an oriented 2-manifold; triangle " +
                          std::to_string(i / 3) + " makes it non-manifold or flips the orientation");
-  std::size_t boundary_edges = 0;
-  for (auto h : sm.halfedges())
-    if (sm.is_border(h)) ++boundary_edges;
-  const std::size_t target_edges = (3 * target_faces + boundary_edges) / 2;
-  CGAL::Surface_mesh_simplification::Count_stop_predicate<SurfaceMesh> stop(target_edges);
-  CGAL::Surface_mesh_simplification::edge_collapse(sm, stop);
+  // Count_stop_predicate stops on the edge count: E = (3F + B)/2 with B the boundary edges, which shrink as
+  // the boundary is simplified too; so stop on the current B, then continue while the faces overshoot.
+  for (int pass = 0; pass < 4; ++pass) {
+    std::size_t boundary_edges = 0;
+    for (auto h : sm.halfedges())
+      if (!sm.is_removed(h) && sm.is_border(h)) ++boundary_edges;
+    if (static_cast<double>(sm.number_of_faces()) <= 1.01 * static_cast<double>(target_faces)) break;
+    CGAL::Surface_mesh_simplification::Count_stop_predicate<SurfaceMesh> stop((3 * target_faces + boundary_edges) / 2);
+    if (CGAL::Surface_mesh_simplification::edge_collapse(sm, stop) == 0) break;  // no collapse left
+  }
   sm.collect_garbage();
 
   TriMesh out;

@@ -47,7 +47,8 @@ struct DecimationResult {
 /// Decimates `mesh` to about `target_faces` triangles. A `target_faces` at or above the input's face count
 /// returns the input's referenced part unchanged. Faces with a repeated corner are never produced (such input
 /// faces are removed first). kLindstromTurk stops at the edge count that corresponds to `target_faces`
-/// (E = (3F + boundary edges)/2), so its face count lands within a few percent of the target.
+/// (E = (3F + boundary edges)/2, repeated while the boundary shrinks), so its face count lands within about
+/// 1 % above the target (or below it by the few faces one collapse removes).
 ///
 /// \param mesh #V×3 positions, #F triangles.
 /// \param target_faces the wanted face count (≥ 1).

@@ -26,5 +26,6 @@ CommandRunner add_eval_command(CLI::App& app);
 CommandRunner add_convert_command(CLI::App& app);
 CommandRunner add_encode_command(CLI::App& app);
 CommandRunner add_decode_command(CLI::App& app);
+CommandRunner add_rd_command(CLI::App& app);
 
 }  // namespace geomip::tools

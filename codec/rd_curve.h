@@ -28,7 +28,8 @@ struct RdPoint {
 
 /// The Pareto front of `points` for (fewer bytes, higher PSNR): a point is kept iff no other point has
 /// bytes ≤ and psnr ≥ its own with at least one strict; of exactly equal points the first is kept. The
-/// result is sorted by bytes (ascending), hence also by PSNR (strictly ascending). O(n log n).
+/// result is sorted by bytes (ascending), hence also by PSNR (strictly ascending). Points with a NaN PSNR are
+/// ignored. O(n log n).
 std::vector<RdPoint> upper_envelope(const std::vector<RdPoint>& points);
 
 /// The staircase of a front: the best PSNR among `front`'s points with at most `bytes` bytes, or −infinity

@@ -71,10 +71,10 @@ struct Series {
 
 /// The sweep parameters (the full sweep, or the --quick one for tests).
 struct Sweep {
-  std::vector<int> draco_bits;       // Draco on the full mesh
-  std::vector<std::size_t> faces;    // decimation targets (those below the mesh's face count are used)
-  std::vector<int> draco_qem_bits;   // Draco on each decimated mesh
-  std::vector<int> meshopt_bits;     // meshoptimizer's codec on the full mesh
+  std::vector<int> draco_bits;      // Draco on the full mesh
+  std::vector<std::size_t> faces;   // decimation targets (those below the mesh's face count are used)
+  std::vector<int> draco_qem_bits;  // Draco on each decimated mesh
+  std::vector<int> meshopt_bits;    // meshoptimizer's codec on the full mesh
 };
 
 Sweep make_sweep(bool quick) {
@@ -186,7 +186,8 @@ std::vector<Series> plan_series(const std::shared_ptr<const TriMesh>& original, 
 
   if (lindstrom_turk) {
     Series lt{"draco_lt", {}};
-    for (const auto& mesh : decimate_all(original, sweep, DecimationMethod::kLindstromTurk, threads, progress))
+    for (const auto& mesh :
+         decimate_all(original, sweep, DecimationMethod::kLindstromTurk, threads, progress))
       for (int q : sweep.draco_qem_bits) lt.jobs.push_back(draco_job("draco_lt", mesh, q));
     plan.push_back(std::move(lt));
   }
@@ -265,8 +266,9 @@ struct Envelope {
   std::set<std::string> methods;
 };
 const std::vector<Envelope> kEnvelopes = {
-    {"draco_envelope", {"draco", "draco_qem"}},                   // issue 5's Draco baseline
-    {"draco_lt_envelope", {"draco", "draco_qem", "draco_lt"}},  // with the stronger decimation (--lindstrom-turk)
+    {"draco_envelope", {"draco", "draco_qem"}},  // issue 5's Draco baseline
+    {"draco_lt_envelope",
+     {"draco", "draco_qem", "draco_lt"}},  // with the stronger decimation (--lindstrom-turk)
 };
 
 template <typename... T>
@@ -292,14 +294,16 @@ nlohmann::json point_to_json(const RdPoint& p) {
 }
 
 std::string point_row(const RdPoint& p) {
-  return format("%-15s %7zu %3d %9zu %9.2f %8.2f %9.4f %9.3f\n", p.method.c_str(), p.faces, p.quantization_bits,
-                p.bytes, static_cast<double>(p.bytes) / 1000.0, p.psnr_db, p.hausdorff_pct, p.decode_ms);
+  return format("%-15s %7zu %3d %9zu %9.2f %8.2f %9.4f %9.3f\n", p.method.c_str(), p.faces,
+                p.quantization_bits, p.bytes, static_cast<double>(p.bytes) / 1000.0, p.psnr_db,
+                p.hausdorff_pct, p.decode_ms);
 }
 
 int run_rd(const RdArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
-  const unsigned threads = args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads =
+      args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
   const Sweep sweep = make_sweep(args.quick);
 
   ProgressBar progress("rd", !args.json);
@@ -328,7 +332,8 @@ int run_rd(const RdArgs& args) {
       d = measure_surface_distance(*original, c.decoded, distance_options);
     } catch (const InvalidInput& e) {  // the decoded mesh is ours, not the user's
       throw SolverFailure(c.point.method + " Q" + std::to_string(c.point.quantization_bits) + " " +
-                          std::to_string(c.point.faces) + " faces: cannot measure the decoded mesh: " + e.what());
+                          std::to_string(c.point.faces) +
+                          " faces: cannot measure the decoded mesh: " + e.what());
     }
     c.point.psnr_db = d.psnr_db;
     c.point.hausdorff_pct = d.hausdorff_pct;
@@ -444,9 +449,10 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
   cmd->add_flag("--json", args->json, "Print every point as JSON instead of the table");
   cmd->add_flag("--quick", args->quick, "A few points only, coarser evaluation (for tests)");
-  cmd->add_flag("--lindstrom-turk", args->lindstrom_turk,
-                "Also decimate with CGAL's Lindstrom-Turk edge collapse (series draco_lt, same faces x Q) and "
-                "write draco_lt_envelope over draco, draco_qem and draco_lt (needs a manifold MESH)");
+  cmd->add_flag(
+      "--lindstrom-turk", args->lindstrom_turk,
+      "Also decimate with CGAL's Lindstrom-Turk edge collapse (series draco_lt, same faces x Q) and "
+      "write draco_lt_envelope over draco, draco_qem and draco_lt (needs a manifold MESH)");
   cmd->add_option("--samples", args->samples,
                   "Face samples per surface for the evaluation (default: as `geomip eval`; --quick: 20000)");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)");

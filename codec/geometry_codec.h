@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "codec/status.h"
-#include "codec/wavelet.h"  // WaveletFilter
+#include "codec/wavelet.h"  // WaveletFilter (defined there, with the transform it selects)
 
 namespace geomip::codec {
 
@@ -44,8 +44,14 @@ struct Grid3 {
 };
 
 struct GeometryCodecOptions {
-  /// Quantization: the step is (largest bounding-box extent of all patches) / 2^quantization_bits.
+  /// Quantization: the step is (largest bounding-box extent of all patches) / 2^quantization_bits, the origin
+  /// the bounding-box minimum; in [1, 24]. Full decoding is lossless up to this quantization (error ≤ step/2
+  /// per coordinate). Cost of the bottom planes, measured on the Stanford bunny (2 patches of 257², cubic):
+  /// 10 bits 72 KB, 12 bits 100 KB, 14 bits 165 KB, 16 bits 254 KB in all; prefixes of a given size give
+  /// nearly the same quality whatever this is (the top planes hardly change).
   int quantization_bits = 16;
+  /// kCubic by default: on the bunny it gives 1.5–3 dB more grid PSNR than kLinear at the same byte count
+  /// (tests/bench/codec_bench.cpp --rd).
   WaveletFilter filter = WaveletFilter::kCubic;
   /// Wavelet steps; -1 = all the way down to the 2×2 grid of corners (level 0).
   int steps = -1;

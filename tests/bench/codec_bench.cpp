@@ -1,7 +1,8 @@
 // Codec benchmarks (Google Benchmark): encode and full decode of a synthetic two-patch level-8 model.
 //
 // Rate–distortion report instead of benchmarks:
-//   codec_bench --rd FILE.geometry.exr|synthetic [--filter linear|cubic|both] [--steps N] [--bits B] [--mesh M | --surface on]
+//   codec_bench --rd FILE.geometry.exr|synthetic [--filter linear|cubic|both] [--steps N] [--bits B] [--mesh
+//   M | --surface on]
 // reads a geometry image written by `geomip gimage`, encodes it and prints, for byte budgets (prefixes of the
 // concatenated segments), the grid RMS error (per-sample Euclidean distance) and the grid PSNR
 // 20·log10(bbox diagonal / RMS), plus the full decode time; with --mesh, also the surface PSNR (Metro-style
@@ -149,16 +150,25 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
     if (const char* dump = std::getenv("CODEC_DUMP")) {
       FILE* f = std::fopen(dump, "wb");
       const auto hb = enc.header.serialize();
-      const std::uint32_t hn = static_cast<std::uint32_t>(hb.size()), ns = static_cast<std::uint32_t>(enc.segments.size());
-      std::fwrite(&hn, 4, 1, f); std::fwrite(hb.data(), 1, hn, f); std::fwrite(&ns, 4, 1, f);
-      for (const auto& s : enc.segments) { const std::uint32_t n = static_cast<std::uint32_t>(s.size()); std::fwrite(&n, 4, 1, f); std::fwrite(s.data(), 1, n, f); }
+      const std::uint32_t hn = static_cast<std::uint32_t>(hb.size()),
+                          ns = static_cast<std::uint32_t>(enc.segments.size());
+      std::fwrite(&hn, 4, 1, f);
+      std::fwrite(hb.data(), 1, hn, f);
+      std::fwrite(&ns, 4, 1, f);
+      for (const auto& s : enc.segments) {
+        const std::uint32_t n = static_cast<std::uint32_t>(s.size());
+        std::fwrite(&n, 4, 1, f);
+        std::fwrite(s.data(), 1, n, f);
+      }
       std::fclose(f);
     }
-    std::printf("filter %s: level %d, %zu patches, %zu segments, %zu bytes total, header %zu bytes, encode %.1f ms\n",
-                filter == WaveletFilter::kCubic ? "cubic" : "linear", enc.header.level, m.patches.size(),
-                enc.segments.size(), total, enc.header.serialize().size(),
-                std::chrono::duration<double, std::milli>(t1 - t0).count());
-    std::vector<std::size_t> budgets = {256, 512, 1024, 2048, 4096, 8192, 16384, 32768, 65536, 131072, 262144, total};
+    std::printf(
+        "filter %s: level %d, %zu patches, %zu segments, %zu bytes total, header %zu bytes, encode %.1f ms\n",
+        filter == WaveletFilter::kCubic ? "cubic" : "linear", enc.header.level, m.patches.size(),
+        enc.segments.size(), total, enc.header.serialize().size(),
+        std::chrono::duration<double, std::milli>(t1 - t0).count());
+    std::vector<std::size_t> budgets = {256,   512,   1024,  2048,   4096,   8192,
+                                        16384, 32768, 65536, 131072, 262144, total};
     for (std::size_t budget : budgets) {
       if (budget > total) continue;
       std::size_t left = budget, k = 0;
@@ -171,8 +181,9 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
       decode_geometry(enc.header, segs, tail, dec);
       const auto d1 = std::chrono::steady_clock::now();
       const Quality q = measure(m, dec.patches);
-      std::printf("  %7zu bytes: rms %.3e  grid psnr %6.2f dB  detail level %d  decode %.2f ms", budget, q.rms,
-                  q.psnr, dec.detail_level, std::chrono::duration<double, std::milli>(d1 - d0).count());
+      std::printf("  %7zu bytes: rms %.3e  grid psnr %6.2f dB  detail level %d  decode %.2f ms", budget,
+                  q.rms, q.psnr, dec.detail_level,
+                  std::chrono::duration<double, std::milli>(d1 - d0).count());
       if (g_reference) std::printf("  surface psnr %6.2f dB", surface_psnr(dec.patches));
       std::printf("\n");
     }
@@ -183,7 +194,8 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
       DecodedGeometry dec;
       const auto d0 = std::chrono::steady_clock::now();
       decode_geometry(enc.header, all, {}, dec);
-      best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - d0).count());
+      best = std::min(
+          best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - d0).count());
     }
     std::printf("  full decode: %.2f ms (best of 10)\n", best);
   }
@@ -205,7 +217,8 @@ int main(int argc, char** argv) {
         reference = geomip::read_mesh(argv[i + 1]);
         g_reference = &reference;
       }
-      if (std::strcmp(argv[i], "--surface") == 0 && std::strcmp(argv[i + 1], "on") == 0) g_reference = &reference;
+      if (std::strcmp(argv[i], "--surface") == 0 && std::strcmp(argv[i + 1], "on") == 0)
+        g_reference = &reference;
     }
     const Model m = std::string(argv[2]) == "synthetic" ? synthetic_model() : load_exr(argv[2]);
     if (g_reference && reference.positions.empty()) reference = grid_mesh(m.patches);

@@ -96,6 +96,15 @@ Ownership seam_ownership(int level, int num_patches, const std::vector<PatchSeam
   return own;
 }
 
+/// double → float without undefined behaviour for values beyond float's range (a header from bytes may hold
+/// any finite origin and step): those become ±infinity.
+float to_float(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (v > kMax) return std::numeric_limits<float>::infinity();
+  if (v < -kMax) return -std::numeric_limits<float>::infinity();
+  return static_cast<float>(v);
+}
+
 bool seam_ok(const PatchSeam& s, int num_patches) {
   return s.patch >= 0 && s.patch < num_patches && s.other_patch >= 0 && s.other_patch < num_patches &&
          s.side >= 0 && s.side < 4 && s.other_side >= 0 && s.other_side < 4;
@@ -363,7 +372,7 @@ Status decode_geometry(const GeometryCodecHeader& header,
       auto& ch = coefs[p][c];
       wavelet_inverse(ch, level, steps, header.filter);
       for (std::size_t i = 0; i < samples; ++i) {
-        g.values[3 * i + c] = static_cast<float>(header.origin[c] + header.step * static_cast<double>(ch[i]));
+        g.values[3 * i + c] = to_float(header.origin[c] + header.step * static_cast<double>(ch[i]));
       }
     }
   }

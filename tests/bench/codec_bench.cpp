@@ -8,6 +8,8 @@
 // 20·log10(bbox diagonal / RMS), plus the full decode time; with --mesh, also the surface PSNR (Metro-style
 // symmetric RMS distance to mesh M, gimage/surface_distance.h) of the decoded grids; with --surface on, the
 // same against the uncompressed grids (the codec's own error, tangential displacement not counted).
+// CODEC_DUMP=PATH in the environment also writes the encoded stream (u32 header size, header, u32 segment
+// count, then u32 size + bytes per segment; little-endian) for decoder experiments outside this program.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

@@ -14,13 +14,14 @@
 // bands skip the weighted planes below their offset.
 //
 // Joint channels. One quadtree per band over sample positions, with magnitude max(|x|, |y|, |z|). A node is
-// significant at plane p when its magnitude is ≥ 2^p. Each plane: (1) sorting pass, for every band: each
+// significant at plane p when its magnitude is ≥ 2^p. Each plane: (1) refinement pass, for every band: each
+// sample significant before this plane (the band's significant-sample list, LSP) codes bit p of its
+// significant channels and the significance (and sign) of the others; (2) sorting pass, for every band: each
 // insignificant node of the band's list (LIS) is tested; a significant node is split into its (up to four)
 // children, recursively (the last child of a significant node is inferred significant when its siblings were
 // not); a significant leaf (sample) codes the significance of each channel (the last inferred when needed)
-// and the signs, and joins the band's significant-sample list (LSP); (2) refinement pass, for every band:
-// each sample significant before this plane codes bit p of its significant channels and the significance of
-// the others. Contexts: node significance by band class (coarse / row-or-column / diagonal), step (1, 2, ≥
+// and the signs, and joins the LSP. Refinement before sorting measured better on the bunny for prefixes that
+// end inside a plane (+0.1 to +0.7 dB grid PSNR at 0.5–128 KB, −0.15 dB at 2 KB). Contexts: node significance by band class (coarse / row-or-column / diagonal), step (1, 2, ≥
 // 3), quadtree depth (0, 1, 2, ≥ 3), number of significant 4-neighbours at the same depth (0, 1, ≥ 2) and the
 // significance of the parent (the same place one step coarser, same orientation); channel significance by
 // class, channel and whether another channel is significant; the first refinement bit of a coefficient by

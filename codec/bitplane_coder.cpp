@@ -171,7 +171,6 @@ class PlaneCoder {
     }
   }
 
-
  private:
   int sym(int bit, Context& ctx) {
     if constexpr (kDecode) {

@@ -349,3 +349,34 @@ TEST(GeometryCodec, GoldenStreamIsStable) {
 
 }  // namespace
 }  // namespace geomip::codec
+
+namespace geomip::codec {
+namespace {
+
+TEST(GeometryCodec, ReportsPartialTailsAndRejectsSegmentsBeyondTheLastPlane) {
+  std::vector<PatchSeam> seams;
+  const auto enc = encode_geometry(testing::two_patch_surface(4, seams), seams);
+  std::vector<std::span<const std::uint8_t>> segs(enc.segments.begin(), enc.segments.end());
+  DecodedGeometry dec;
+  // A partial tail of the third segment.
+  const std::span<const std::span<const std::uint8_t>> two(segs.data(), 2);
+  const auto& third = enc.segments[2];
+  ASSERT_EQ(decode_geometry(enc.header, two, std::span(third.data(), third.size() / 2), dec), Status::kOk);
+  EXPECT_EQ(dec.segments_complete, 2u);
+  EXPECT_TRUE(dec.partial);
+  // One segment more than there are planes, or a tail after the last plane: corrupt, but still decoded.
+  auto extra = segs;
+  extra.push_back(segs.back());
+  EXPECT_EQ(decode_geometry(enc.header, extra, {}, dec), Status::kCorrupt);
+  EXPECT_EQ(dec.patches.size(), 2u);
+  const std::vector<std::uint8_t> tail = {1, 2, 3};
+  EXPECT_EQ(decode_geometry(enc.header, segs, tail, dec), Status::kCorrupt);
+  // A hand-made header that parse() would refuse is an invalid argument.
+  GeometryCodecHeader bad = enc.header;
+  bad.steps = bad.level + 1;
+  EXPECT_EQ(decode_geometry(bad, segs, {}, dec), Status::kInvalidArgument);
+  EXPECT_EQ(decode_geometry(enc.header, segs, {}, dec, {-1}), Status::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace geomip::codec

@@ -35,6 +35,7 @@ struct Band {
   int parent = -1;
   std::vector<std::uint32_t> lis, lis_next;
   std::vector<Sample> lsp;
+  std::size_t refine_count = 0;
 
   std::size_t node(int l, int x, int y) const { return lbase[l] + static_cast<std::size_t>(y) * lw[l] + x; }
   std::uint32_t grid_index(int x, int y, int size) const {
@@ -149,15 +150,11 @@ class PlaneCoder {
     check_ = check;
   }
 
-  /// One weighted bit-plane: refinement pass over every band (the samples significant before this plane),
-  /// then sorting pass over every band. Refinement first measured better on the bunny for prefixes that end
-  /// inside a plane (+0.1 to +0.7 dB grid PSNR at 0.5–128 KB, −0.15 dB at 2 KB) than the SPIHT order.
+  /// One weighted bit-plane: sorting pass over every band, then refinement pass over every band.
   void code_plane(int b) {
-    for (auto& band : bands_) {
-      const int p = b - band.offset;
-      if (p >= 0) refine(band, p);
-    }
-    for (auto& band : bands_) {
+    for (auto& band : bands_) band.refine_count = band.lsp.size();
+    for (std::size_t bi = 0; bi < bands_.size(); ++bi) {
+      Band& band = bands_[bi];
       const int p = b - band.offset;
       if (p < 0 || band.lis.empty()) continue;
       band.lis_next.clear();
@@ -168,6 +165,11 @@ class PlaneCoder {
                 static_cast<int>(packed & 0x3FFF), p, false);
       }
       std::swap(band.lis, band.lis_next);
+    }
+    for (auto& band : bands_) {
+      const int p = b - band.offset;
+      if (p < 0) continue;
+      refine(band, p);
     }
   }
 
@@ -283,7 +285,7 @@ class PlaneCoder {
   }
 
   void refine(Band& band, int p) {
-    for (std::size_t n = 0; n < band.lsp.size(); ++n) {
+    for (std::size_t n = 0; n < band.refine_count; ++n) {
       Sample& s = band.lsp[n];
       for (int c = 0; c < 3; ++c) {
         int bit = 0, negative = 0;

@@ -14,20 +14,21 @@
 // bands skip the weighted planes below their offset.
 //
 // Joint channels. One quadtree per band over sample positions, with magnitude max(|x|, |y|, |z|). A node is
-// significant at plane p when its magnitude is ≥ 2^p. Each plane: (1) refinement pass, for every band: each
-// sample significant before this plane (the band's significant-sample list, LSP) codes bit p of its
-// significant channels and the significance (and sign) of the others; (2) sorting pass, for every band: each
+// significant at plane p when its magnitude is ≥ 2^p. Each plane: (1) sorting pass, for every band: each
 // insignificant node of the band's list (LIS) is tested; a significant node is split into its (up to four)
 // children, recursively (the last child of a significant node is inferred significant when its siblings were
 // not); a significant leaf (sample) codes the significance of each channel (the last inferred when needed)
-// and the signs, and joins the LSP. Refinement before sorting measured better on the bunny for prefixes that
-// end inside a plane (+0.1 to +0.7 dB grid PSNR at 0.5–128 KB, −0.15 dB at 2 KB). Contexts: node significance
-// by band class (coarse / row-or-column / diagonal), step (1, 2, ≥ 3), quadtree depth (0, 1, 2, ≥ 3), number
-// of significant 4-neighbours at the same depth (0, 1, ≥ 2) and the significance of the parent (the same
-// place one step coarser, same orientation); channel significance by class, channel and whether another
-// channel is significant; the first refinement bit of a coefficient by class; later refinement bits and signs
-// are coded as raw (bypass) bits (measured on the bunny: context-coding the second and third refinement bits
-// saves only 0.15% of the bytes, and raw bits decode several times faster).
+// and the signs, and joins the band's significant-sample list (LSP); (2) refinement pass, for every band:
+// each sample significant before this plane codes bit p of its significant channels and the significance of
+// the others. (Refinement before sorting gives 0.1–0.7 dB more grid PSNR for prefixes ending inside a plane,
+// but 0.6–1.7 dB less surface PSNR — the product's measure — on the bunny at 2–128 KB: sorting stays first.)
+// Contexts: node significance by band class (coarse / row-or-column / diagonal), step (1, 2, ≥
+// 3), quadtree depth (0, 1, 2, ≥ 3), number of significant 4-neighbours at the same depth (0, 1, ≥ 2) and the
+// significance of the parent (the same place one step coarser, same orientation); channel significance by
+// class, channel and whether another channel is significant; the first refinement bit of a coefficient by
+// class; later refinement bits and signs are coded as raw (bypass) bits (measured on the bunny:
+// context-coding the second and third refinement bits saves only 0.15% of the bytes, and raw bits decode
+// several times faster).
 //
 // Segments. One segment per weighted bit-plane, from top_bitplane down to 0; the arithmetic coder is flushed
 // at each segment end and the contexts carry over. Samples whose `coded` mask entry is 0 (seam copies owned

@@ -448,8 +448,9 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
     for (const Sample& s : band.lsp) {
       for (int c = 0; c < 3; ++c) {
         if (!(s.flags & (1 << c))) continue;
-        // ⌊3·2^q / 8⌋ into the interval [mag, mag + 2^q) (see the header).
-        const std::int64_t v = static_cast<std::int64_t>(s.mag[c]) + ((std::int64_t{3} << s.q[c]) >> 3);
+        // The middle of the interval [mag, mag + 2^q) (see the header).
+        const std::int64_t v =
+            static_cast<std::int64_t>(s.mag[c]) + (s.q[c] > 0 ? (std::int64_t{1} << (s.q[c] - 1)) : 0);
         patch[c][s.index] = static_cast<std::int32_t>((s.flags >> (3 + c)) & 1 ? -v : v);
       }
     }

@@ -125,10 +125,6 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
     }
     const int top = b.levels - 1;
     if (b.state[b.node(top, 0, 0)] & kActive) b.lis.push_back(pack(top, 0, 0));
-    // Every coded sample may end up in the LSP: reserve once rather than grow (and copy) plane after plane.
-    std::size_t coded_samples = 0;
-    for (int i = 0; i < b.w * b.h; ++i) coded_samples += b.state[i] & kActive;
-    b.lsp.reserve(coded_samples);
   }
   return bands;
 }

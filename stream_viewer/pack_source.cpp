@@ -4,33 +4,6 @@
 
 namespace geomip::viewer {
 
-std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
-                                     codec::Status& status, std::size_t& bytes_used) {
-  codec::PackDecodeOptions options;
-  options.partial_chunks = false;  // only complete, CRC-checked chunks: the last complete level stays
-  codec::PackDecodeResult full = codec::decode_pack(bytes, options);
-  status = full.status;
-  bytes_used = full.bytes_used;
-  if (full.models.empty() || full.models[0].geometry_passes == 0 || full.models[0].geometry.empty()) return {};
-  std::vector<SceneModel> out;
-  const int bands = std::max(1, std::min(settings.bands, full.models[0].geometry[0].level + 1));
-  if (bands == 1) {
-    for (const auto& m : full.models) out.push_back(make_scene_model(m));
-    return out;
-  }
-  std::vector<std::vector<codec::DecodedModel>> by_model(full.models.size());
-  for (std::size_t m = 0; m < full.models.size(); ++m) by_model[m].push_back(std::move(full.models[m]));
-  for (int d = 1; d < bands; ++d) {
-    options.drop_finest_steps = d;
-    options.normals = false;
-    codec::PackDecodeResult r = codec::decode_pack(bytes, options);
-    for (std::size_t m = 0; m < by_model.size() && m < r.models.size(); ++m)
-      by_model[m].push_back(std::move(r.models[m]));
-  }
-  for (const auto& decodes : by_model) out.push_back(make_banded_scene_model(decodes));
-  return out;
-}
-
 PackSource::PackSource(const std::string& source, FetchOptions fetch, DecodeSettings decode) : decode_(decode) {
   fetcher_ = std::make_unique<Fetcher>(source, fetch, [this] { wake_.notify_all(); });
   decoder_ = std::thread([this] { decode_loop(); });

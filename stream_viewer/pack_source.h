@@ -19,17 +19,6 @@
 
 namespace geomip::viewer {
 
-struct DecodeSettings {
-  /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 decodes B times with
-  /// drop_finest_steps = 0 … B−1).
-  int bands = 1;
-};
-
-/// Decodes a byte prefix of a pack into scene models. Returns an empty vector (status in `status`) when the
-/// prefix holds no geometry pass of model 0 yet.
-std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
-                                     codec::Status& status, std::size_t& bytes_used);
-
 struct SourceUpdate {
   std::vector<SceneModel> models;
   std::uint64_t bytes_used = 0;  ///< bytes of the pack those models come from (complete chunks)

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -57,5 +58,16 @@ std::vector<std::vector<float>> evaluate_morph(const SceneModel& source, const S
 
 /// True when the models can be morphed (same level, patch count and bands).
 bool same_layout(const SceneModel& a, const SceneModel& b);
+
+struct DecodeSettings {
+  /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 decodes B times with
+  /// drop_finest_steps = 0 … B−1).
+  int bands = 1;
+};
+
+/// Decodes a byte prefix of a pack into scene models. Returns an empty vector (status in `status`) when the
+/// prefix holds no geometry pass of model 0 yet.
+std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
+                                     codec::Status& status, std::size_t& bytes_used);
 
 }  // namespace geomip::viewer

@@ -134,6 +134,8 @@ class ViewPackTest : public ::testing::Test {
   static void TearDownTestSuite() {
     delete context_;
     context_ = nullptr;
+    std::error_code ignored;
+    if (!std::getenv("GEOMIP_VIEW_TEST_KEEP")) fs::remove_all(work_dir(), ignored);  // keep: for debugging
   }
   void SetUp() override {
     if (!context_->ok()) GTEST_SKIP() << "no OpenGL 3.3 display (run under xvfb-run)";

@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
   add(add_convert_command(app));
   add(add_encode_command(app));
   add(add_decode_command(app));
+#ifdef GEOMIP_WITH_MORPH
+  add(add_morph_command(app));
+#endif
 
   try {
     app.parse(argc, argv);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "codec/arithmetic_coder.h"
 #include "codec/byte_io.h"
 
 namespace geomip::codec {
@@ -76,37 +77,46 @@ bool read_normalization(ByteReader& r, std::array<double, 16>& m) {
   return std::all_of(m.begin(), m.end(), [](double v) { return std::isfinite(v); });
 }
 
-// Hole mask of one patch: run lengths of alternating 0/1 quads, starting with a (possibly empty) 0 run.
-void write_mask(ByteWriter& w, const std::vector<std::uint8_t>& mask) {
-  std::vector<std::uint64_t> runs;
-  std::uint8_t current = 0;
-  std::uint64_t run = 0;
-  for (std::uint8_t v : mask) {
-    const std::uint8_t bit = v ? 1 : 0;
-    if (bit != current) {
-      runs.push_back(run);
-      run = 0;
-      current = bit;
-    }
-    ++run;
-  }
-  runs.push_back(run);
-  w.varint(runs.size());
-  for (std::uint64_t r : runs) w.varint(r);
+// Hole mask of one patch, `side` × `side` quads: a flag byte (0 = no masked quad), then the bits in raster
+// order through the arithmetic coder, each in a context of its already coded neighbours (left, up, up-left,
+// up-right): a hole costs about its perimeter, an empty patch one byte.
+int mask_context(const std::vector<std::uint8_t>& mask, int side, int i, int j) {
+  auto at = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < side ? mask[static_cast<std::size_t>(y) * side + x] : std::uint8_t{0};
+  };
+  return at(i - 1, j) | at(i, j - 1) << 1 | at(i - 1, j - 1) << 2 | at(i + 1, j - 1) << 3;
 }
 
-bool read_mask(ByteReader& r, std::uint64_t quads, std::vector<std::uint8_t>& mask) {
-  std::uint64_t count;
-  if (!r.bounded(count, std::min<std::uint64_t>(quads + 1, r.remaining()))) return false;
-  mask.assign(static_cast<std::size_t>(quads), 0);
-  std::uint64_t at = 0;
-  for (std::uint64_t k = 0; k < count; ++k) {
-    std::uint64_t run;
-    if (!r.bounded(run, quads - at)) return false;
-    if (k % 2 == 1) std::fill_n(mask.begin() + static_cast<std::ptrdiff_t>(at), run, std::uint8_t{1});
-    at += run;
+void write_mask(ByteWriter& w, const std::vector<std::uint8_t>& mask, int side) {
+  std::vector<std::uint8_t> bits(mask.size());
+  for (std::size_t k = 0; k < mask.size(); ++k) bits[k] = mask[k] ? 1 : 0;
+  if (std::none_of(bits.begin(), bits.end(), [](std::uint8_t b) { return b; })) {
+    w.u8(0);
+    return;
   }
-  return at == quads;
+  w.u8(1);
+  ArithmeticEncoder encoder;
+  Context contexts[16];
+  for (int j = 0; j < side; ++j)
+    for (int i = 0; i < side; ++i)
+      encoder.encode(bits[static_cast<std::size_t>(j) * side + i], contexts[mask_context(bits, side, i, j)]);
+  w.bytes(encoder.finish());
+}
+
+bool read_mask(ByteReader& r, int side, std::vector<std::uint8_t>& mask) {
+  std::uint8_t coded;
+  if (!r.u8(coded) || coded > 1) return false;
+  mask.assign(static_cast<std::size_t>(side) * side, 0);
+  if (coded == 0) return true;
+  std::vector<std::uint8_t> bytes;
+  if (!r.bytes(bytes, r.remaining())) return false;
+  ArithmeticDecoder decoder(bytes);
+  Context contexts[16];
+  for (int j = 0; j < side; ++j)
+    for (int i = 0; i < side; ++i)
+      mask[static_cast<std::size_t>(j) * side + i] =
+          static_cast<std::uint8_t>(decoder.decode(contexts[mask_context(mask, side, i, j)]));
+  return true;
 }
 
 // The canonical chunk order: by stage (geometry pass p → p, normal pass p → p + delay), then geometry before
@@ -167,9 +177,13 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     if (mask_patches != 0 && mask_patches != static_cast<std::uint64_t>(model.geometry.num_patches))
       return Status::kCorrupt;
     model.hole_mask.resize(static_cast<std::size_t>(mask_patches));
-    const std::uint64_t quads = std::uint64_t{1} << (2 * model.geometry.level);
+    if (mask_patches > 0) {
+      std::uint8_t mask_level;
+      if (!r.u8(mask_level) || mask_level > model.geometry.level) return Status::kCorrupt;
+      model.hole_mask_level = mask_level;
+    }
     for (auto& mask : model.hole_mask)
-      if (!read_mask(r, quads, mask)) return Status::kCorrupt;
+      if (!read_mask(r, 1 << model.hole_mask_level, mask)) return Status::kCorrupt;
     geometry_passes.push_back(passes_of(model.geometry));
     normal_passes.push_back(model.has_normals ? passes_of(model.normals) : 0);
   }
@@ -242,7 +256,7 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
   if (options.normals_delay < 0 || options.normals_delay > static_cast<int>(kMaxPasses))
     throw std::invalid_argument("write_pack: normals_delay outside [0, 64]");
   std::vector<EncodedGeometry> geometry(models.size()), normals(models.size());
-  std::vector<int> geometry_passes, normal_passes;
+  std::vector<int> geometry_passes, normal_passes, mask_level;
   for (std::size_t m = 0; m < models.size(); ++m) {
     const PackModelInput& model = models[m];
     if (model.name.size() > kMaxNameSize) throw std::invalid_argument("write_pack: model name too long");
@@ -258,8 +272,12 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
       normals[m] = encode_geometry(model.normals, model.seams, options.normal_codec);
     }
     normal_passes.push_back(with_normals ? static_cast<int>(normals[m].segments.size()) : 0);
+    const int level = model.geometry.front().level;
+    mask_level.push_back(model.hole_mask_level < 0 ? level : model.hole_mask_level);
+    if (mask_level.back() > level)
+      throw std::invalid_argument("write_pack: model '" + model.name + "': hole mask level above the grid's");
     if (!model.hole_mask.empty()) {
-      const std::size_t quads = std::size_t{1} << (2 * model.geometry.front().level);
+      const std::size_t quads = std::size_t{1} << (2 * mask_level.back());
       if (model.hole_mask.size() != model.geometry.size() ||
           std::any_of(model.hole_mask.begin(), model.hole_mask.end(),
                       [&](const auto& mask) { return mask.size() != quads; }))
@@ -277,7 +295,8 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
     manifest.u8(normal_passes[m] > 0 ? 1 : 0);
     if (normal_passes[m] > 0) manifest.bytes(normals[m].header.serialize());
     manifest.varint(models[m].hole_mask.size());
-    for (const auto& mask : models[m].hole_mask) write_mask(manifest, mask);
+    if (!models[m].hole_mask.empty()) manifest.u8(static_cast<std::uint8_t>(mask_level[m]));
+    for (const auto& mask : models[m].hole_mask) write_mask(manifest, mask, 1 << mask_level[m]);
   }
   const std::vector<ChunkKey> order = chunk_order(geometry_passes, normal_passes, options.normals_delay);
   manifest.varint(order.size());
@@ -347,6 +366,7 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
     model.normalization = model_info.normalization;
     model.seams = model_info.geometry.seams;
     model.hole_mask = model_info.hole_mask;
+    model.hole_mask_level = model_info.hole_mask_level;
     model.geometry_passes = s.geometry.size();
     try {
       DecodedGeometry decoded;

@@ -51,9 +51,10 @@ struct PackModelInfo {
   GeometryCodecHeader geometry;
   bool has_normals = false;
   GeometryCodecHeader normals;  ///< valid when has_normals
-  /// Per patch, per quad of the geometry grid (2^level × 2^level, row-major), 1 = the quad covers a filled hole
-  /// of the source mesh (geomip repair) and is left out of decoded meshes. Empty = no holes.
+  /// Per patch, per quad of the level-hole_mask_level grid (2^L × 2^L, row-major), 1 = the quad covers a
+  /// filled hole of the source mesh (geomip repair) and is left out of decoded meshes. Empty = no holes.
   std::vector<std::vector<std::uint8_t>> hole_mask;
+  int hole_mask_level = 0;  ///< L ≤ geometry.level
 };
 
 struct PackInfo {
@@ -82,6 +83,7 @@ struct PackModelInput {
   std::vector<Grid3> normals;   ///< per patch, or empty (geometry-only pack)
   std::vector<PatchSeam> seams;
   std::vector<std::vector<std::uint8_t>> hole_mask;  ///< as PackModelInfo::hole_mask; may be empty
+  int hole_mask_level = -1;  ///< level of hole_mask's grid; -1 = the geometry's level
 };
 
 struct PackWriteOptions {
@@ -113,6 +115,7 @@ struct DecodedModel {
   std::vector<Grid3> normals;                         ///< per patch (empty when not decoded / not in pack)
   std::vector<PatchSeam> seams;
   std::vector<std::vector<std::uint8_t>> hole_mask;   ///< as PackModelInfo::hole_mask
+  int hole_mask_level = 0;
   int detail_level = 0;                               ///< finest level that received detail
   std::size_t geometry_passes = 0;                    ///< complete geometry passes decoded
 };

@@ -42,7 +42,8 @@ HoleMaskResult hole_mask(const ModelParameterization& model, const TriMesh& orig
     std::vector<std::uint8_t> quads(static_cast<std::size_t>(intervals) * intervals, 0);
     for (int j = 0; j < intervals; ++j) {
       for (int i = 0; i < intervals; ++i) {
-        const bool masked = filled(i, j) && filled(i + 1, j) && filled(i, j + 1) && filled(i + 1, j + 1);
+        const int corners = filled(i, j) + filled(i + 1, j) + filled(i, j + 1) + filled(i + 1, j + 1);
+        const bool masked = corners >= options.min_fill_corners;
         quads[static_cast<std::size_t>(j) * intervals + i] = masked;
         result.masked_quads += masked;
       }

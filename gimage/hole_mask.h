@@ -18,11 +18,15 @@ struct HoleMaskOptions {
   /// relative_tolerance · (its longest edge) from the ORIGINAL surface; triangles of the original (and the
   /// pieces of those the partition split) lie on it up to rounding.
   double relative_tolerance = 1e-6;
+  /// A quad is masked when at least this many of its 4 corner samples lie in fill triangles. 3 (a majority)
+  /// balances the two directions of the surface distance on the hole borders: on the repaired bunny at level
+  /// 8, against the open bunny.obj, 1/2/3/4 give 79.37/80.85/80.92/78.92 dB symmetric PSNR (README).
+  int min_fill_corners = 3;
 };
 
 struct HoleMaskResult {
-  /// Per patch, per quad (i, j) of the level-`level` grid at index j·2^level + i: 1 = all four corner samples
-  /// lie in fill triangles. Empty when no triangle is a fill triangle.
+  /// Per patch, per quad (i, j) of the level-`level` grid at index j·2^level + i: 1 = at least
+  /// min_fill_corners of its corner samples lie in fill triangles. Empty when no triangle is a fill triangle.
   std::vector<std::vector<std::uint8_t>> quads;
   std::size_t fill_triangles = 0;  ///< parameterized triangles found off the original surface
   std::size_t masked_quads = 0;

@@ -24,6 +24,7 @@ struct ConvertArgs {
   int level = 8;
   int normal_level = -1;
   int quantization_bits = 16;
+  int hole_mask_level = -1;
   bool no_normals = false;
 };
 
@@ -50,6 +51,7 @@ int run_convert(const ConvertArgs& args) {
   options.normal_level = args.normal_level;
   options.normals = !args.no_normals;
   options.quantization_bits = args.quantization_bits;
+  options.hole_mask_level = args.hole_mask_level;
   options.progress = bar.callback();
   const ConvertResult converted = convert_models(models, options);
   const std::vector<std::uint8_t>& pack = converted.pack;
@@ -103,6 +105,8 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
   cmd->add_option("--bits", args->quantization_bits,
                   "Position quantization bits over the largest bounding-box extent (default 16)");
+  cmd->add_option("--hole-mask-level", args->hole_mask_level,
+                  "Grid level of the mask of filled holes (default: N; coarser costs fewer bytes)");
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack (for rate–distortion comparisons)");
   return [args] { return run_convert(*args); };
 }

@@ -5,6 +5,7 @@
 #include "param/consistent_parameterization.h"
 #include "tools/pack_models.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace geomip::tools {
@@ -30,6 +31,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
 
   t0 = std::chrono::steady_clock::now();
   std::vector<codec::PackModelInput> inputs;
+  const int mask_level = options.hole_mask_level < 0 ? options.level : std::min(options.hole_mask_level, options.level);
   for (std::size_t m = 0; m < params.size(); ++m) {
     progress("resample", 0.8 + 0.1 * static_cast<double>(m) / static_cast<double>(params.size()));
     ResampleOptions resample;
@@ -38,9 +40,10 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
     const GeometryImages images = resample_geometry(params[m], options.level, resample);
     HoleMaskResult mask;
     if (m < models.originals.size() && !models.originals[m].triangles.empty())
-      mask = hole_mask(params[m], models.originals[m], options.level);
+      mask = hole_mask(params[m], models.originals[m], mask_level);
     result.masked_quads.push_back(mask.masked_quads);
     inputs.push_back(pack_model_input(models.inputs[m].name, images, &mask, options.normals));
+    inputs.back().hole_mask_level = mask_level;
   }
   result.resample_seconds = seconds_since(t0);
 

@@ -46,8 +46,13 @@ TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
   if (model.hole_mask.empty()) return std::move(remesh.mesh);
 
   // Quad q of patch p at this level → triangles 2q, 2q+1 (uniform_remesh_connectivity's order).
+  // A quad of this level is left out when every mask quad it overlaps is masked (a finer mask), or when the
+  // mask quad containing it is (a coarser mask).
   const int intervals = 1 << level;
-  const int grid_intervals = 1 << grid_level;
+  const int mask_level = model.hole_mask_level;
+  const int mask_intervals = 1 << mask_level;
+  const int span = mask_level >= level ? 1 << (mask_level - level) : 1;
+  const int shrink = mask_level >= level ? 0 : level - mask_level;
   TriMesh out;
   std::vector<int> new_id(remesh.mesh.positions.size(), -1);
   for (std::size_t p = 0; p < model.geometry.size(); ++p) {
@@ -55,9 +60,10 @@ TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
     for (int j = 0; j < intervals; ++j) {
       for (int i = 0; i < intervals; ++i) {
         bool masked = true;
-        for (int jj = j * stride; jj < (j + 1) * stride && masked; ++jj)
-          for (int ii = i * stride; ii < (i + 1) * stride && masked; ++ii)
-            masked = mask[static_cast<std::size_t>(jj) * grid_intervals + ii] != 0;
+        const int i0 = (i >> shrink) * span, j0 = (j >> shrink) * span;
+        for (int jj = j0; jj < j0 + span && masked; ++jj)
+          for (int ii = i0; ii < i0 + span && masked; ++ii)
+            masked = mask[static_cast<std::size_t>(jj) * mask_intervals + ii] != 0;
         if (masked) continue;
         const std::size_t q = (p * intervals + j) * static_cast<std::size_t>(intervals) + i;
         for (std::size_t t = 2 * q; t < 2 * q + 2; ++t) {

@@ -37,6 +37,12 @@ PackModelInput pillow_model(int level, const std::string& name, double scale = 1
   return m;
 }
 
+PackWriteOptions geometry_only() {
+  PackWriteOptions o;
+  o.normals = false;
+  return o;
+}
+
 /// Largest |decoded − original| over all samples of all patches.
 double max_error(const std::vector<Grid3>& decoded, const std::vector<Grid3>& original) {
   double e = 0;
@@ -57,7 +63,7 @@ double rms_error(const std::vector<Grid3>& decoded, const std::vector<Grid3>& or
 
 TEST(Pack, RoundTripWithinQuantization) {
   const std::vector<PackModelInput> models = {pillow_model(6, "a"), pillow_model(6, "b", 2.0)};
-  const std::vector<std::uint8_t> pack = write_pack(models, {.normals = false});
+  const std::vector<std::uint8_t> pack = write_pack(models, geometry_only());
   const PackDecodeResult r = decode_pack(pack);
   ASSERT_EQ(r.status, Status::kOk);
   ASSERT_EQ(r.models.size(), 2u);
@@ -92,7 +98,7 @@ TEST(Pack, ChunksAreOrderedCoarseToFineAcrossModels) {
 
 TEST(Pack, EveryPrefixDecodesToACoarserModelOrTruncated) {
   const std::vector<PackModelInput> models = {pillow_model(4, "a"), pillow_model(4, "b", 1.5)};
-  const std::vector<std::uint8_t> pack = write_pack(models, {.normals = false});
+  const std::vector<std::uint8_t> pack = write_pack(models, geometry_only());
   PackInfo info;
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   double previous_error = INFINITY;
@@ -143,7 +149,7 @@ TEST(Pack, FlippedBytesAreCorruptNeverACrash) {
 
 TEST(Pack, CorruptChunkStopsAtLastGoodPass) {
   const std::vector<PackModelInput> models = {pillow_model(5, "a")};
-  const std::vector<std::uint8_t> pack = write_pack(models, {.normals = false});
+  const std::vector<std::uint8_t> pack = write_pack(models, geometry_only());
   PackInfo info;
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   // Damage the first non-empty chunk after the third.

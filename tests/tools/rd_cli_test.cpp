@@ -1,0 +1,81 @@
+// End to end: `geomip rd --quick` writes rd.csv and rd.svg, and fails cleanly (exit 2, one line, no output
+// files) on a missing mesh.
+#include "param/mesh_io.h"
+#include "tests/param/test_meshes.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace geomip {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+class RdCli : public ::testing::Test {
+ protected:
+  std::string dir_ = test::temp_dir("rd_cli");
+  void TearDown() override { fs::remove_all(dir_); }
+
+  int geomip(const std::string& args, std::string& err) {
+    const std::string cmd = std::string("timeout 300 '") + GEOMIP_BINARY + "' " + args + " > '" + dir_ +
+                            "/stdout' 2> '" + dir_ + "/stderr' < /dev/null";
+    const int status = std::system(cmd.c_str());
+    err = slurp(fs::path(dir_) / "stderr");
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+};
+
+TEST_F(RdCli, QuickRunWritesCsvAndSvg) {
+  // A closed sphere of 3072 faces, written as OBJ.
+  const std::string mesh = dir_ + "/sphere.obj";
+  {
+    std::ofstream out(mesh);
+    write_mesh(test::sphere(4), out, MeshFormat::kObj);
+  }
+  const std::string out_dir = dir_ + "/rd";
+  std::string err;
+  ASSERT_EQ(geomip("rd --quick '" + mesh + "' -o '" + out_dir + "'", err), 0) << err;
+  const std::string csv = slurp(fs::path(out_dir) / "rd.csv");
+  const std::string svg = slurp(fs::path(out_dir) / "rd.svg");
+  EXPECT_EQ(csv.rfind("method,bytes,psnr_db,hausdorff_pct,decode_ms", 0), 0u);
+  std::set<std::string> methods;
+  std::istringstream lines(csv);
+  std::string line;
+  std::getline(lines, line);
+  while (std::getline(lines, line)) methods.insert(line.substr(0, line.find(',')));
+  EXPECT_EQ(methods, (std::set<std::string>{"draco", "draco_qem", "draco_envelope", "meshopt"}));
+  for (const char* method : {"draco", "draco_qem", "draco_envelope", "meshopt"})
+    EXPECT_NE(svg.find(std::string("data-method=\"") + method + "\""), std::string::npos) << method;
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  // No temporary files left beside the outputs.
+  std::size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(out_dir)) {
+    (void)entry;
+    ++files;
+  }
+  EXPECT_EQ(files, 2u);
+}
+
+TEST_F(RdCli, MissingMeshFailsCleanly) {
+  const std::string out_dir = dir_ + "/rd";
+  std::string err;
+  EXPECT_EQ(geomip("rd '" + dir_ + "/no-such-mesh.obj' -o '" + out_dir + "'", err), 2);
+  EXPECT_NE(err.find("no-such-mesh.obj"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(fs::exists(out_dir));
+  EXPECT_EQ(geomip("rd --quick", err), 2);  // missing arguments
+}
+
+}  // namespace
+}  // namespace geomip

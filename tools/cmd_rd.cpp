@@ -1,0 +1,362 @@
+// geomip rd MESH -o DIR [--json] [--quick] [--lindstrom-turk]: rate–distortion baselines of MESH — Draco on
+// the full mesh over quantization bits, Draco on QEM-decimated copies (faces × bits; meshoptimizer's
+// simplifier, and with --lindstrom-turk also CGAL's) and their upper envelopes, meshoptimizer's codec — each
+// decoded mesh measured against MESH with the Metro-style surface distance. Writes DIR/rd.csv (every point)
+// and DIR/rd.svg (the plot).
+//
+// The command is a list of series: each series is a method name and a list of jobs, a job codes one mesh and
+// returns its bytes, decoded mesh and decode time; evaluation, the envelope, the files and the table are the
+// same for every series. A further codec adds one `Series` to `plan_series()`.
+#include "codec/draco_baseline.h"
+#include "codec/mesh_decimation.h"
+#include "codec/meshopt_baseline.h"
+#include "codec/rd_curve.h"
+#include "gimage/surface_distance.h"
+#include "param/errors.h"
+#include "param/mesh_io.h"
+#include "tools/atomic_file.h"
+#include "tools/commands.h"
+#include "tools/progress.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace geomip::tools {
+namespace {
+
+struct RdArgs {
+  std::string mesh;
+  std::string output;
+  bool json = false;
+  bool quick = false;
+  bool lindstrom_turk = false;  // also the draco_lt series (CGAL Lindstrom-Turk decimation) and its envelope
+  std::size_t samples = 0;  // face samples per surface for the evaluation; 0 = surface_distance's default
+  unsigned threads = 0;     // 0 = hardware_concurrency
+};
+
+/// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
+/// decoded mesh to measure.
+struct Coded {
+  RdPoint point;
+  TriMesh decoded;
+};
+using Job = std::function<Coded()>;
+
+struct Series {
+  std::string method;
+  std::vector<Job> jobs;
+};
+
+/// The sweep parameters (the full sweep, or the --quick one for tests).
+struct Sweep {
+  std::vector<int> draco_bits;       // Draco on the full mesh
+  std::vector<std::size_t> faces;    // decimation targets (those below the mesh's face count are used)
+  std::vector<int> draco_qem_bits;   // Draco on each decimated mesh
+  std::vector<int> meshopt_bits;     // meshoptimizer's codec on the full mesh
+};
+
+Sweep make_sweep(bool quick) {
+  if (quick) return {{8, 11, 14}, {500, 2000}, {8, 11}, {16}};
+  return {{6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16},
+          {500, 750, 1000, 1500, 2000, 3000, 4000, 6000, 8000, 12000, 16000, 24000, 32000, 40000},
+          {7, 8, 9, 10, 11, 12, 13},
+          {12, 14, 16}};
+}
+
+constexpr int kDracoLevel = 10;  // draco_encoder -cl 10: speed 0, the smallest streams
+
+/// Runs f(0..n-1) on `threads` threads (the caller's included); the first exception stops the others'
+/// further work and is rethrown.
+void parallel_for(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& f) {
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next++;
+      if (i >= n) return;
+      try {
+        f(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = n;
+        return;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  const unsigned extra = static_cast<unsigned>(std::min<std::size_t>(threads, n)) - (n > 0 ? 1 : 0);
+  for (unsigned t = 0; t < extra; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+Job draco_job(std::string method, std::shared_ptr<const TriMesh> mesh, int bits) {
+  return [method = std::move(method), mesh = std::move(mesh), bits] {
+    DracoOptions options;
+    options.quantization_bits = bits;
+    options.compression_level = kDracoLevel;
+    DracoResult r = draco_encode(*mesh, options);
+    Coded c;
+    c.point.method = method;
+    c.point.bytes = r.bytes.size();
+    c.point.decode_ms = r.decode_ms;
+    c.point.faces = mesh->num_triangles();
+    c.point.vertices = r.decoded.num_vertices();
+    c.point.quantization_bits = bits;
+    c.decoded = std::move(r.decoded);
+    return c;
+  };
+}
+
+Job meshopt_job(std::shared_ptr<const TriMesh> mesh, int bits) {
+  return [mesh = std::move(mesh), bits] {
+    MeshoptCodecOptions options;
+    options.quantization_bits = bits;
+    MeshoptCodecResult r = meshopt_encode(*mesh, options);
+    Coded c;
+    c.point.method = "meshopt";
+    c.point.bytes = r.bytes;
+    c.point.decode_ms = r.decode_ms;
+    c.point.faces = mesh->num_triangles();
+    c.point.vertices = r.decoded.num_vertices();
+    c.point.quantization_bits = bits;
+    c.decoded = std::move(r.decoded);
+    return c;
+  };
+}
+
+/// Every series of the report. Decimation happens here (in parallel), coding later, in the jobs.
+/// The decimated copies of `original` at `sweep.faces` (those below its face count), in parallel.
+std::vector<std::shared_ptr<const TriMesh>> decimate_all(const std::shared_ptr<const TriMesh>& original,
+                                                         const Sweep& sweep, DecimationMethod method,
+                                                         unsigned threads, ProgressBar& progress) {
+  std::vector<std::size_t> faces;
+  for (std::size_t f : sweep.faces)
+    if (f < original->num_triangles()) faces.push_back(f);
+  std::vector<std::shared_ptr<const TriMesh>> decimated(faces.size());
+  std::atomic<std::size_t> done{0};
+  std::mutex progress_mutex;
+  DecimationOptions options;
+  options.method = method;
+  parallel_for(faces.size(), threads, [&](std::size_t i) {
+    decimated[i] = std::make_shared<const TriMesh>(decimate_mesh(*original, faces[i], options).mesh);
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    progress.update("decimating", static_cast<double>(++done) / static_cast<double>(faces.size()));
+  });
+  return decimated;
+}
+
+std::vector<Series> plan_series(const std::shared_ptr<const TriMesh>& original, const Sweep& sweep,
+                                bool lindstrom_turk, unsigned threads, ProgressBar& progress) {
+  std::vector<Series> plan;
+
+  Series draco{"draco", {}};
+  for (int q : sweep.draco_bits) draco.jobs.push_back(draco_job("draco", original, q));
+  plan.push_back(std::move(draco));
+
+  Series qem{"draco_qem", {}};
+  for (const auto& mesh : decimate_all(original, sweep, DecimationMethod::kMeshopt, threads, progress))
+    for (int q : sweep.draco_qem_bits) qem.jobs.push_back(draco_job("draco_qem", mesh, q));
+  plan.push_back(std::move(qem));
+
+  if (lindstrom_turk) {
+    Series lt{"draco_lt", {}};
+    for (const auto& mesh : decimate_all(original, sweep, DecimationMethod::kLindstromTurk, threads, progress))
+      for (int q : sweep.draco_qem_bits) lt.jobs.push_back(draco_job("draco_lt", mesh, q));
+    plan.push_back(std::move(lt));
+  }
+
+  Series meshopt{"meshopt", {}};
+  for (int q : sweep.meshopt_bits) meshopt.jobs.push_back(meshopt_job(original, q));
+  plan.push_back(std::move(meshopt));
+
+  // A further codec appends its Series here; an envelope over it is one more entry of kEnvelopes.
+  return plan;
+}
+
+/// Envelopes written as series of their own: name and the methods whose points they are taken over. An
+/// envelope is written when one of its methods has points that no earlier envelope covers.
+struct Envelope {
+  std::string name;
+  std::set<std::string> methods;
+};
+const std::vector<Envelope> kEnvelopes = {
+    {"draco_envelope", {"draco", "draco_qem"}},                   // issue 5's Draco baseline
+    {"draco_lt_envelope", {"draco", "draco_qem", "draco_lt"}},  // with the stronger decimation (--lindstrom-turk)
+};
+
+template <typename... T>
+std::string format(const char* fmt, T... values) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, fmt, values...);
+  return buffer;
+}
+
+nlohmann::json point_to_json(const RdPoint& p) {
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json j{{"method", p.method},
+                   {"bytes", p.bytes},
+                   {"psnr_db", num(p.psnr_db)},
+                   {"hausdorff_pct", num(p.hausdorff_pct)},
+                   {"rms_pct", num(p.rms_pct)},
+                   {"decode_ms", num(p.decode_ms)},
+                   {"faces", p.faces},
+                   {"vertices", p.vertices},
+                   {"quantization_bits", p.quantization_bits}};
+  if (!p.source.empty()) j["source"] = p.source;
+  return j;
+}
+
+std::string point_row(const RdPoint& p) {
+  return format("%-15s %7zu %3d %9zu %9.2f %8.2f %9.4f %9.3f\n", p.method.c_str(), p.faces, p.quantization_bits,
+                p.bytes, static_cast<double>(p.bytes) / 1000.0, p.psnr_db, p.hausdorff_pct, p.decode_ms);
+}
+
+int run_rd(const RdArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
+  const unsigned threads = args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
+  const Sweep sweep = make_sweep(args.quick);
+
+  ProgressBar progress("rd", !args.json);
+  const std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
+
+  // Code and measure every job: one job per worker, each distance query single-threaded.
+  struct Slot {
+    std::size_t series;
+    std::size_t job;
+  };
+  std::vector<Slot> slots;
+  for (std::size_t s = 0; s < plan.size(); ++s)
+    for (std::size_t j = 0; j < plan[s].jobs.size(); ++j) slots.push_back({s, j});
+  std::vector<RdPoint> measured(slots.size());
+  SurfaceDistanceOptions distance_options;
+  distance_options.threads = 1;
+  distance_options.face_samples = args.samples > 0 ? args.samples : (args.quick ? 20000 : 0);
+  std::atomic<std::size_t> done{0};
+  std::mutex progress_mutex;
+  parallel_for(slots.size(), threads, [&](std::size_t i) {
+    Coded c = plan[slots[i].series].jobs[slots[i].job]();
+    SurfaceDistance d;
+    try {
+      d = measure_surface_distance(*original, c.decoded, distance_options);
+    } catch (const InvalidInput& e) {  // the decoded mesh is ours, not the user's
+      throw SolverFailure(c.point.method + " Q" + std::to_string(c.point.quantization_bits) + " " +
+                          std::to_string(c.point.faces) + " faces: cannot measure the decoded mesh: " + e.what());
+    }
+    c.point.psnr_db = d.psnr_db;
+    c.point.hausdorff_pct = d.hausdorff_pct;
+    c.point.rms_pct = d.rms_pct;
+    measured[i] = std::move(c.point);
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    progress.update("coding and measuring", static_cast<double>(++done) / static_cast<double>(slots.size()));
+  });
+  progress.finish();
+
+  std::vector<RdPoint> all = measured;
+  std::set<std::string> covered;
+  for (const Envelope& e : kEnvelopes) {
+    std::vector<RdPoint> input;
+    bool adds = false;
+    for (const RdPoint& p : measured)
+      if (e.methods.count(p.method) != 0) {
+        input.push_back(p);
+        adds = adds || covered.count(p.method) == 0;
+      }
+    if (!adds) continue;
+    covered.insert(e.methods.begin(), e.methods.end());
+    for (RdPoint p : upper_envelope(input)) {
+      p.source = p.method;
+      p.method = e.name;
+      all.push_back(std::move(p));
+    }
+  }
+
+  // Render both files first, then write them atomically: a failure leaves neither half-written.
+  std::ostringstream csv, svg;
+  write_rd_csv(csv, all);
+  RdPlotOptions plot;
+  plot.scatter_methods = {"draco_qem", "draco_lt"};
+  plot.title = "Rate-distortion: " + std::filesystem::path(args.mesh).filename().string() + " (" +
+               std::to_string(original->num_triangles()) + " faces)";
+  write_rd_svg(svg, all, plot);
+  std::filesystem::create_directories(args.output);
+  const std::filesystem::path dir(args.output);
+  write_file_atomically((dir / "rd.csv").string(), [&](std::ostream& out) { out << csv.str(); });
+  write_file_atomically((dir / "rd.svg").string(), [&](std::ostream& out) { out << svg.str(); });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  if (args.json) {
+    nlohmann::json j;
+    j["mesh"] = args.mesh;
+    j["faces"] = original->num_triangles();
+    j["vertices"] = original->num_vertices();
+    j["csv"] = (dir / "rd.csv").string();
+    j["svg"] = (dir / "rd.svg").string();
+    j["seconds"] = seconds;
+    j["points"] = nlohmann::json::array();
+    for (const RdPoint& p : all) j["points"].push_back(point_to_json(p));
+    std::cout << j.dump(2) << "\n";
+    return kExitOk;
+  }
+  std::cout << args.mesh << ": " << original->num_triangles() << " faces, " << original->num_vertices()
+            << " vertices\n"
+            << format("%-15s %7s %3s %9s %9s %8s %9s %9s\n", "method", "faces", "Q", "bytes", "KB", "PSNR dB",
+                      "Haus. %", "decode ms");
+  std::size_t candidates = 0;
+  for (const RdPoint& p : all) {
+    if (p.method == "draco_qem" || p.method == "draco_lt") {
+      ++candidates;
+      continue;
+    }
+    std::cout << point_row(p);
+  }
+  std::cout << "(" << candidates << " decimate-then-Draco points, the envelopes' candidates, are in rd.csv)\n"
+            << "wrote " << (dir / "rd.csv").string() << " and " << (dir / "rd.svg").string()
+            << format(" in %.1f s\n", seconds);
+  return kExitOk;
+}
+
+}  // namespace
+
+CommandRunner add_rd_command(CLI::App& app) {
+  auto args = std::make_shared<RdArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "rd",
+      "Rate-distortion baselines of MESH: Draco (cl 10) at Q = 6..16 on the full mesh, Draco Q = 7..13 on "
+      "QEM-decimated copies (500..40k faces) and their upper envelope, meshoptimizer's codec; PSNR and "
+      "Hausdorff of each decoded mesh vs MESH (as `geomip eval`). Writes DIR/rd.csv and DIR/rd.svg");
+  cmd->add_option("mesh", args->mesh, "Original mesh (.obj .ply .off .stl), used as it is (not repaired)")
+      ->required();
+  cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
+  cmd->add_flag("--json", args->json, "Print every point as JSON instead of the table");
+  cmd->add_flag("--quick", args->quick, "A few points only, coarser evaluation (for tests)");
+  cmd->add_flag("--lindstrom-turk", args->lindstrom_turk,
+                "Also decimate with CGAL's Lindstrom-Turk edge collapse (series draco_lt, same faces x Q) and "
+                "write draco_lt_envelope over draco, draco_qem and draco_lt (needs a manifold MESH)");
+  cmd->add_option("--samples", args->samples,
+                  "Face samples per surface for the evaluation (default: as `geomip eval`; --quick: 20000)");
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)");
+  return [args] { return run_rd(*args); };
+}
+
+}  // namespace geomip::tools

@@ -47,7 +47,7 @@ uniform usampler2DArray holes;
 uniform int has_normals;
 uniform int normal_size;   // samples per side of the normal map
 uniform int has_holes;
-uniform int hole_res;      // 2^n quads per side
+uniform int hole_res;      // 2^L quads per side of the hole mask
 uniform int patch_index;
 uniform float nw_a;        // normal-map weights (linear: 1-t, t; wavelet: the finest band's weights,
 uniform float nw_b;        // the rest is the geometric normal of the blended surface)
@@ -114,7 +114,7 @@ unsigned compile(GLenum type, const char* src) {
 }
 
 struct ModelGpu {
-  int level = 0, num_patches = 0, bands = 1, normal_size = 0;
+  int level = 0, num_patches = 0, bands = 1, normal_size = 0, hole_level = 0;
   bool has_normals = false, has_holes = false;
   GLuint geometry = 0, normals = 0, holes = 0;
 };
@@ -222,7 +222,8 @@ void Renderer::set_models(const std::vector<SceneModel>& models) {
     }
     if (!m.holes.empty()) {
       g.has_holes = true;
-      g.holes = make_array(GL_R8UI, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1 << m.level, m.num_patches, m.holes.data(),
+      g.hole_level = m.hole_level;
+      g.holes = make_array(GL_R8UI, GL_RED_INTEGER, GL_UNSIGNED_BYTE, 1 << m.hole_level, m.num_patches, m.holes.data(),
                            GL_NEAREST);
     }
     impl_->models.push_back(g);
@@ -281,7 +282,7 @@ void Renderer::draw(const RenderSettings& s) {
   glUniform1i(im.uniform("has_normals"), normals ? 1 : 0);
   glUniform1i(im.uniform("normal_size"), a.normal_size);
   glUniform1i(im.uniform("has_holes"), a.has_holes ? 1 : 0);  // the source's filled holes
-  glUniform1i(im.uniform("hole_res"), 1 << a.level);
+  glUniform1i(im.uniform("hole_res"), 1 << a.hole_level);
   glUniform1f(im.uniform("nw_a"), morph ? w.source[a.bands - 1] : 1.0f);
   glUniform1f(im.uniform("nw_b"), morph ? w.target[a.bands - 1] : 0.0f);
   glUniform1i(im.uniform("checker"), s.checker ? 1 : 0);

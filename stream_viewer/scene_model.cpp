@@ -72,7 +72,8 @@ void fill_common(const codec::DecodedModel& m, SceneModel& s) {
     }
   }
   s.holes.clear();
-  const std::size_t quads = std::size_t{1} << (2 * s.level);
+  s.hole_level = std::clamp(m.hole_mask_level, 0, s.level);
+  const std::size_t quads = std::size_t{1} << (2 * s.hole_level);
   if (m.hole_mask.size() == m.geometry.size()) {
     bool ok = true;
     for (const auto& h : m.hole_mask) ok = ok && h.size() == quads;

@@ -26,7 +26,8 @@ struct SceneModel {
   std::vector<float> positions;  ///< [(patch·bands + band) · size² + j·size + i] · 3 + c
   int normal_level = -1;         ///< −1: no normal map (the renderer shades with screen-space derivatives)
   std::vector<float> normals;    ///< [patch · nsize² + j·nsize + i] · 3 + c, unit length, normalized frame
-  std::vector<std::uint8_t> holes;  ///< [patch · 4^level + j·2^level + i]: 1 = quad not drawn; empty = none
+  std::vector<std::uint8_t> holes;  ///< [patch · 4^L + j·2^L + i], L = hole_level: 1 = quad not drawn; empty = none
+  int hole_level = 0;               ///< level L ≤ level of the hole mask's grid
   int detail_level = 0;          ///< finest level that received detail (codec::DecodedModel::detail_level)
   int size() const { return (1 << level) + 1; }
 };

@@ -161,10 +161,11 @@ inline std::vector<std::uint8_t> cpu_coverage(const SceneModel& model, int level
         for (int r = 0; r < 4; ++r) clip[r] = vp[r] * x + vp[4 + r] * y + vp[8 + r] * z + vp[12 + r];
         screen[j * s + i] = {(clip[0] / clip[3] * 0.5f + 0.5f) * width, (0.5f - clip[1] / clip[3] * 0.5f) * height};
       }
-    auto hole = [&](int i, int j) {  // a level-`level` quad whose first fine quad is a hole
+    auto hole = [&](int i, int j) {  // a drawn quad whose centre lies in a masked hole-mask quad
       if (model.holes.empty()) return false;
-      const int q = 1 << model.level;
-      return model.holes[static_cast<std::size_t>(p) * q * q + static_cast<std::size_t>(j * stride) * q + i * stride] != 0;
+      const int q = 1 << model.hole_level;
+      const int hi = std::min(int((i + 0.5) / (s - 1) * q), q - 1), hj = std::min(int((j + 0.5) / (s - 1) * q), q - 1);
+      return model.holes[static_cast<std::size_t>(p) * q * q + static_cast<std::size_t>(hj) * q + hi] != 0;
     };
     auto raster = [&](const std::array<float, 2>& a, const std::array<float, 2>& b, const std::array<float, 2>& c) {
       const float area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);

@@ -10,7 +10,7 @@ namespace geomip::viewer {
 struct Camera {
   float yaw = 0.6f;          ///< radians, about +y
   float pitch = 0.35f;       ///< radians, elevation above the xz plane
-  float distance = 2.6f;     ///< from the origin, normalized units
+  float distance = 3.2f;     ///< from the origin, normalized units
   float fov_y_deg = 35.0f;   ///< vertical field of view
 };
 

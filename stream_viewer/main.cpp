@@ -40,7 +40,7 @@ struct Options {
   bool bench = false, checker = false, wireframe = false;
   std::uint64_t limit_rate = 0;
   double timeout = 120;
-  float yaw = 0.6f, pitch = 0.35f, distance = 2.6f;
+  float yaw = 0.6f, pitch = 0.35f, distance = 3.2f;
 };
 
 struct Ui {

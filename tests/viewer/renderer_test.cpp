@@ -84,6 +84,7 @@ TEST_F(RendererTest, FrameCoversTheProjectedModelAtEveryLevel) {
     const auto reference = cpu_coverage(model, level, s.camera, kW, kH);
     ASSERT_GT(count(reference), std::size_t(kW * kH / 20)) << "the model should fill a good part of the frame";
     EXPECT_GT(iou(image, reference), 0.97) << "level " << level;
+    EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "no cracks at level " << level;
   }
 }
 

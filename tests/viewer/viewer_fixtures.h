@@ -212,6 +212,21 @@ inline double iou(const std::vector<std::uint8_t>& a, const std::vector<std::uin
   return uni ? double(inter) / double(uni) : 1.0;
 }
 
+/// Pixels well inside the reference coverage (the pixel and its 8 neighbours covered) that the image leaves
+/// at the background: cracks between patches or missing triangles. A closed model should have none.
+inline std::size_t interior_misses(const std::vector<std::uint8_t>& image, const std::vector<std::uint8_t>& reference,
+                                   int width, int height) {
+  std::size_t misses = 0;
+  for (int y = 1; y + 1 < height; ++y)
+    for (int x = 1; x + 1 < width; ++x) {
+      bool inside = true;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) inside = inside && reference[(std::size_t(y) + dy) * width + x + dx];
+      misses += inside && !image[std::size_t(y) * width + x];
+    }
+  return misses;
+}
+
 inline std::size_t count(const std::vector<std::uint8_t>& m) {
   std::size_t c = 0;
   for (auto v : m) c += v != 0;

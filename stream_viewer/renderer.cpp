@@ -11,6 +11,7 @@ namespace geomip::viewer {
 namespace {
 
 constexpr int kMaxBands = 8;
+constexpr std::uint32_t kRestart = 0xFFFFFFFFu;
 
 const char* kVertexShader = R"(#version 330 core
 uniform sampler2DArray geom_a;
@@ -158,14 +159,14 @@ struct Renderer::Impl {
   std::pair<GLuint, GLsizei> grid(int level) {
     auto it = grids.find(level);
     if (it != grids.end()) return it->second;
+    // One triangle strip per row of quads, rows separated by the primitive-restart index.
     const std::uint32_t s = (1u << level) + 1;
     std::vector<std::uint32_t> idx;
-    idx.reserve(6u * (s - 1) * (s - 1));
-    for (std::uint32_t j = 0; j + 1 < s; ++j)
-      for (std::uint32_t i = 0; i + 1 < s; ++i) {
-        const std::uint32_t a = j * s + i, b = a + 1, c = a + s, d = c + 1;
-        idx.insert(idx.end(), {a, b, d, a, d, c});
-      }
+    idx.reserve(static_cast<std::size_t>(2 * s + 1) * (s - 1));
+    for (std::uint32_t j = 0; j + 1 < s; ++j) {
+      for (std::uint32_t i = 0; i < s; ++i) idx.insert(idx.end(), {j * s + i, (j + 1) * s + i});
+      idx.push_back(kRestart);
+    }
     GLuint buf = 0;
     glGenBuffers(1, &buf);
     glBindVertexArray(vao);
@@ -246,6 +247,8 @@ void Renderer::draw(const RenderSettings& s) {
 
   glEnable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
+  glEnable(GL_PRIMITIVE_RESTART);
+  glPrimitiveRestartIndex(kRestart);
   glPolygonMode(GL_FRONT_AND_BACK, s.wireframe ? GL_LINE : GL_FILL);
   glUseProgram(im.program);
   glBindVertexArray(im.vao);
@@ -291,7 +294,7 @@ void Renderer::draw(const RenderSettings& s) {
     glUniform1i(im.uniform("patch_index"), p);
     glUniform1i(im.uniform("layer_a"), p * a.bands);
     glUniform1i(im.uniform("layer_b"), p * b.bands);
-    glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr);
+    glDrawElements(GL_TRIANGLE_STRIP, index_count, GL_UNSIGNED_INT, nullptr);
   }
   glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   glBindVertexArray(0);

@@ -1,5 +1,5 @@
 // OpenGL 3.3 core renderer of geomip-view (needs a current context; libepoxy resolves the entry points).
-// Each patch is drawn as a regular (2^k+1)² grid with no vertex attributes: the vertex shader fetches the
+// Each patch is drawn as a regular (2^k+1)² grid (one triangle strip per row) with no vertex attributes: the vertex shader fetches the
 // positions from the model's geometry-image texture array (vertex texture fetch, level k = every 2^(n−k)-th
 // sample of the nested grid, so patches that share bit-identical seam samples meet without cracks at every
 // level); the fragment shader shades with the normal map (Blinn–Phong) so coarse levels keep their detail

@@ -188,8 +188,8 @@ inline std::vector<std::uint8_t> cpu_coverage(const SceneModel& model, int level
         if (hole(i, j)) continue;
         const auto &a = screen[j * s + i], &b = screen[j * s + i + 1], &c = screen[(j + 1) * s + i],
                    &d = screen[(j + 1) * s + i + 1];
-        raster(a, b, d);
-        raster(a, d, c);
+        raster(a, c, b);  // the renderer's strips split quads along b–c
+        raster(c, d, b);
       }
   }
   return mask;

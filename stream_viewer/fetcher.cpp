@@ -35,6 +35,11 @@ struct FetchAccess {
     r->at += take;
     return n;  // bytes beyond the range (a server that ignores Range) are dropped, the status check catches it
   }
+
+  // Called by libcurl often, also while no byte arrives: lets the destructor cancel a stalled transfer.
+  static int progress(void* user, curl_off_t, curl_off_t, curl_off_t, curl_off_t) {
+    return static_cast<Fetcher*>(user)->cancel_.load() ? 1 : 0;
+  }
 };
 
 namespace {
@@ -153,6 +158,9 @@ void Fetcher::fetch_http() {
   curl_easy_setopt(curl, CURLOPT_WRITEFUNCTION, &FetchAccess::write);
   curl_easy_setopt(curl, CURLOPT_ERRORBUFFER, curl_error);
   curl_easy_setopt(curl, CURLOPT_NOSIGNAL, 1L);
+  curl_easy_setopt(curl, CURLOPT_NOPROGRESS, 0L);
+  curl_easy_setopt(curl, CURLOPT_XFERINFOFUNCTION, &FetchAccess::progress);
+  curl_easy_setopt(curl, CURLOPT_XFERINFODATA, this);
   curl_easy_setopt(curl, CURLOPT_CONNECTTIMEOUT, 10L);
   curl_easy_setopt(curl, CURLOPT_LOW_SPEED_LIMIT, 1L);   // a stalled connection is an error after 20 s
   curl_easy_setopt(curl, CURLOPT_LOW_SPEED_TIME, 20L);

@@ -260,6 +260,18 @@ TEST_F(ViewPackTest, ServerKilledMidStreamKeepsTheLastCompleteLevel) {
       << "the last complete level is still shown";
 }
 
+TEST_F(ViewPackTest, StalledServerTimesOutAndExitsPromptly) {
+  const fs::path pack = pack_file(6);
+  Server server({"--rate", "20"});  // 20 bytes/s: not even the manifest arrives in time
+  ASSERT_GT(server.port(), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  const ViewRun r = view(server.url(pack.filename().string()) + " " + size_args() + " --timeout 2");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("timed out"), std::string::npos) << r.err;
+  EXPECT_LT(seconds, 10.0) << "cancelling the transfer must not wait for the stalled connection";
+}
+
 TEST_F(ViewPackTest, MissingOrNonPackSourcesGiveAClearMessage) {
   Server server({});
   ASSERT_GT(server.port(), 0);

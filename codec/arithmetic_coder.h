@@ -37,17 +37,15 @@ struct Context {
     static constexpr std::uint8_t kFastShift[8] = {1, 2, 3, 4, 5, 5, 5, 5};
     static constexpr std::uint8_t kSlowShift[8] = {1, 2, 3, 4, 5, 6, 7, 8};
     const int fs = kFastShift[count], ss = kSlowShift[count];
-    if (count < 7) ++count;
-    if (bit) {
-      fast -= fast >> fs;
-      slow -= slow >> ss;
-    } else {
-      fast += (65535u - fast) >> fs;
-      slow += (65535u - slow) >> ss;
-    }
-    // fast, slow stay in [1, 65535] once there: x - (x >> s) >= 1 for x >= 1, and x + ((65535 - x) >> s) <= 65535.
-    if (fast == 0) fast = 1;
-    if (slow == 0) slow = 1;
+    count = static_cast<std::uint8_t>(count + (count < 7));
+    // Written as selects rather than branches: refinement bits are close to random, and a mispredicted branch
+    // per symbol would dominate the decoder's time. The results stay in [1, 65535]: x − (x >> s) ≥ 1 for
+    // x ≥ 1 (s ≥ 1), and x + ((65535 − x) >> s) ≤ 65535.
+    const int f = fast, s = slow;
+    const int f1 = f - (f >> fs), f0 = f + ((65535 - f) >> fs);
+    const int s1 = s - (s >> ss), s0 = s + ((65535 - s) >> ss);
+    fast = static_cast<std::uint16_t>(bit ? f1 : f0);
+    slow = static_cast<std::uint16_t>(bit ? s1 : s0);
   }
 };
 
@@ -105,33 +103,19 @@ class ArithmeticDecoder {
   }
   int decode(Context& context) {
     const std::uint32_t bound = (range_ >> 16) * context.p0();
-    int bit;
-    if (code_ < bound) {
-      range_ = bound;
-      bit = 0;
-    } else {
-      code_ -= bound;
-      range_ -= bound;
-      bit = 1;
-    }
+    const int bit = code_ >= bound;
+    const std::uint32_t mask = 0u - static_cast<std::uint32_t>(bit);
+    code_ -= bound & mask;
+    range_ = bit ? range_ - bound : bound;
     context.update(bit);
-    while (range_ < kTop) {
-      range_ <<= 8;
-      code_ = (code_ << 8) | next_byte();
-    }
+    if (range_ < kTop) normalize();
     return bit;
   }
   int decode_bypass() {
     range_ >>= 1;
-    int bit = 0;
-    if (code_ >= range_) {
-      code_ -= range_;
-      bit = 1;
-    }
-    while (range_ < kTop) {
-      range_ <<= 8;
-      code_ = (code_ << 8) | next_byte();
-    }
+    const int bit = code_ >= range_;
+    code_ -= range_ & (0u - static_cast<std::uint32_t>(bit));
+    if (range_ < kTop) normalize();
     return bit;
   }
   /// True once the decoder has needed a byte beyond the end of its span. Symbols decoded while this was
@@ -140,6 +124,12 @@ class ArithmeticDecoder {
 
  private:
   static constexpr std::uint32_t kTop = 1u << 24;
+  void normalize() {
+    do {
+      range_ <<= 8;
+      code_ = (code_ << 8) | next_byte();
+    } while (range_ < kTop);
+  }
   std::uint32_t next_byte() {
     if (pos_ < bytes_.size()) return bytes_[pos_++];
     exhausted_ = true;

@@ -17,9 +17,9 @@ constexpr int kMaxQuadLevels = 16;
 
 /// A sample of the significant-sample list. flags: bit c = channel c significant, bit 3 + c = its sign.
 struct Sample {
-  std::uint32_t index;     ///< grid index j·size + i
-  std::uint32_t mag[3];    ///< decoder: known magnitude bits; encoder: unused
-  std::uint8_t q[3];       ///< lowest plain plane known (decoder)
+  std::uint32_t index;   ///< grid index j·size + i
+  std::uint32_t mag[3];  ///< decoder: known magnitude bits; encoder: unused
+  std::uint8_t q[3];     ///< lowest plain plane known (decoder)
   std::uint8_t flags;
 };
 
@@ -44,7 +44,8 @@ struct Band {
 };
 
 inline std::uint32_t pack(int l, int x, int y) {
-  return static_cast<std::uint32_t>(l) << 28 | static_cast<std::uint32_t>(x) << 14 | static_cast<std::uint32_t>(y);
+  return static_cast<std::uint32_t>(l) << 28 | static_cast<std::uint32_t>(x) << 14 |
+         static_cast<std::uint32_t>(y);
 }
 
 struct Stop {};     // the partial tail is exhausted
@@ -55,7 +56,8 @@ bool layout_ok(const BitplaneLayout& layout) {
          layout.num_patches >= 1;
 }
 
-std::vector<Band> make_bands(const BitplaneLayout& layout, const std::vector<std::vector<std::uint8_t>>& coded) {
+std::vector<Band> make_bands(const BitplaneLayout& layout,
+                             const std::vector<std::vector<std::uint8_t>>& coded) {
   const int size = (1 << layout.level) + 1;
   const int np = layout.num_patches, steps = layout.steps;
   std::vector<Band> bands;
@@ -117,7 +119,8 @@ std::vector<Band> make_bands(const BitplaneLayout& layout, const std::vector<std
     }
     for (int l = 1; l < b.levels; ++l) {
       for (int y = 0; y < b.lh[l - 1]; ++y) {
-        for (int x = 0; x < b.lw[l - 1]; ++x) b.state[b.node(l, x >> 1, y >> 1)] |= b.state[b.node(l - 1, x, y)];
+        for (int x = 0; x < b.lw[l - 1]; ++x)
+          b.state[b.node(l, x >> 1, y >> 1)] |= b.state[b.node(l - 1, x, y)];
       }
     }
     const int top = b.levels - 1;
@@ -128,11 +131,13 @@ std::vector<Band> make_bands(const BitplaneLayout& layout, const std::vector<std
 
 constexpr int kNodeContexts = 3 * 3 * 4 * 3 * 2;
 
-/// The shared traversal of encoder and decoder: every decision goes through sym(), so both walk the same path.
+/// The shared traversal of encoder and decoder: every decision goes through sym(), so both walk the same
+/// path.
 template <bool kDecode>
 class PlaneCoder {
  public:
-  PlaneCoder(const BitplaneLayout& layout, std::vector<Band>& bands, const std::vector<PatchCoefficients>* coefs)
+  PlaneCoder(const BitplaneLayout& layout, std::vector<Band>& bands,
+             const std::vector<PatchCoefficients>* coefs)
       : size_((1 << layout.level) + 1), bands_(bands), coefs_(coefs) {}
 
   void set_encoder(ArithmeticEncoder* enc) { enc_ = enc; }
@@ -287,17 +292,15 @@ class PlaneCoder {
           negative = v < 0;
         }
         if (s.flags & (1 << c)) {
-          const std::uint32_t known = s.mag[c] >> (p + 1);
-          int ctx;
+          // Only the first refinement bit (just the leading one known) is context coded; see the header.
+          std::uint32_t known;
           if constexpr (kDecode) {
-            ctx = known == 1 ? 0 : (known >> 1) == 1 ? 1 : 2;
+            known = s.mag[c] >> (p + 1);
           } else {
             const std::int32_t v = coef(band, s.index, c);
-            const std::uint32_t m = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v);
-            const std::uint32_t k2 = m >> (p + 1);
-            ctx = k2 == 1 ? 0 : (k2 >> 1) == 1 ? 1 : 2;
+            known = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v) >> (p + 1);
           }
-          bit = sym(bit, ref_ctx_[band.cls * 3 + ctx]);
+          bit = known == 1 ? sym(bit, ref_ctx_[band.cls]) : raw(bit);
           if constexpr (kDecode) {
             s.mag[c] |= static_cast<std::uint32_t>(bit) << p;
             s.q[c] = static_cast<std::uint8_t>(p);
@@ -324,12 +327,13 @@ class PlaneCoder {
   Context node_ctx_[kNodeContexts];
   Context chan_ctx_[3 * 3 * 2];
   Context late_ctx_[3 * 3];
-  Context ref_ctx_[3 * 3];
+  Context ref_ctx_[3];
 };
 
 }  // namespace
 
-BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout, const std::vector<PatchCoefficients>& coefficients,
+BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
+                                  const std::vector<PatchCoefficients>& coefficients,
                                   const std::vector<std::vector<std::uint8_t>>& coded) {
   if (!layout_ok(layout)) throw std::invalid_argument("encode_bitplanes: layout out of range");
   const std::size_t size = (std::size_t{1} << layout.level) + 1, samples = size * size;
@@ -355,9 +359,11 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout, const std::vecto
         if (!(b.state[b.node(0, x, y)] & kActive)) continue;
         const std::uint32_t index = b.grid_index(x, y, static_cast<int>(size));
         std::int64_t m = 0;
-        for (int c = 0; c < 3; ++c) m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
+        for (int c = 0; c < 3; ++c)
+          m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
         if (m >= (std::int64_t{1} << (kMaxCoefficientPlane + 1))) {
-          throw std::invalid_argument("encode_bitplanes: coefficient magnitude " + std::to_string(m) + " too large");
+          throw std::invalid_argument("encode_bitplanes: coefficient magnitude " + std::to_string(m) +
+                                      " too large");
         }
         b.msb[b.node(0, x, y)] = static_cast<std::int8_t>(std::bit_width(static_cast<std::uint64_t>(m)) - 1);
       }
@@ -390,8 +396,8 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
                         BitplaneDecodeResult& result) {
   result = {};
-  if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) || top_bitplane < 0 ||
-      top_bitplane > 64) {
+  if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) ||
+      top_bitplane < 0 || top_bitplane > 64) {
     return Status::kInvalidArgument;
   }
   const std::size_t size = (std::size_t{1} << layout.level) + 1, samples = size * size;
@@ -438,7 +444,9 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
     for (const Sample& s : band.lsp) {
       for (int c = 0; c < 3; ++c) {
         if (!(s.flags & (1 << c))) continue;
-        const std::int64_t v = static_cast<std::int64_t>(s.mag[c]) + (s.q[c] > 0 ? (std::int64_t{1} << (s.q[c] - 1)) : 0);
+        // The middle of the interval [mag, mag + 2^q) (see the header).
+        const std::int64_t v =
+            static_cast<std::int64_t>(s.mag[c]) + (s.q[c] > 0 ? (std::int64_t{1} << (s.q[c] - 1)) : 0);
         patch[c][s.index] = static_cast<std::int32_t>((s.flags >> (3 + c)) & 1 ? -v : v);
       }
     }

@@ -54,7 +54,8 @@ std::unique_ptr<draco::Mesh> to_draco(const TriMesh& mesh) {
   draco::PointAttribute* att = out->attribute(att_id);
   for (draco::PointIndex::ValueType i = 0; i < nv; ++i) {
     const Eigen::Vector3d& p = mesh.positions[i];
-    const std::array<float, 3> v{static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+    const std::array<float, 3> v{static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                 static_cast<float>(p.z())};
     att->SetAttributeValue(draco::AttributeValueIndex(i), v.data());
   }
   for (const auto& t : mesh.triangles) {

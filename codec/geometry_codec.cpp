@@ -19,17 +19,27 @@ constexpr int kMaxLevel = 12;
 constexpr int kMaxTopBitplane = 48;
 constexpr std::uint64_t kMaxTotalSamples = std::uint64_t{1} << 26;  // patches · (2^level+1)²
 
-int grid_size(int level) { return (1 << level) + 1; }
+int grid_size(int level) {
+  return (1 << level) + 1;
+}
 
 /// Grid index of parameter k of side s (see PatchSeam).
 int side_index(int level, int side, int k) {
   const int m = 1 << level, size = m + 1;
   int i, j;
   switch (side) {
-    case 0: i = k, j = 0; break;
-    case 1: i = m, j = k; break;
-    case 2: i = m - k, j = m; break;
-    default: i = 0, j = m - k; break;
+    case 0:
+      i = k, j = 0;
+      break;
+    case 1:
+      i = m, j = k;
+      break;
+    case 2:
+      i = m - k, j = m;
+      break;
+    default:
+      i = 0, j = m - k;
+      break;
   }
   return j * size + i;
 }
@@ -86,6 +96,15 @@ Ownership seam_ownership(int level, int num_patches, const std::vector<PatchSeam
   return own;
 }
 
+/// double → float without undefined behaviour for values beyond float's range (a header from bytes may hold
+/// any finite origin and step): those become ±infinity.
+float to_float(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (v > kMax) return std::numeric_limits<float>::infinity();
+  if (v < -kMax) return -std::numeric_limits<float>::infinity();
+  return static_cast<float>(v);
+}
+
 bool seam_ok(const PatchSeam& s, int num_patches) {
   return s.patch >= 0 && s.patch < num_patches && s.other_patch >= 0 && s.other_patch < num_patches &&
          s.side >= 0 && s.side < 4 && s.other_side >= 0 && s.other_side < 4;
@@ -93,7 +112,8 @@ bool seam_ok(const PatchSeam& s, int num_patches) {
 
 /// The checks parse() applies, shared with decode_geometry() for headers built by hand.
 bool header_ok(const GeometryCodecHeader& h) {
-  if (h.level < 0 || h.level > kMaxLevel || h.num_patches < 1 || h.steps < 0 || h.steps > h.level) return false;
+  if (h.level < 0 || h.level > kMaxLevel || h.num_patches < 1 || h.steps < 0 || h.steps > h.level)
+    return false;
   const std::uint64_t size = static_cast<std::uint64_t>(grid_size(h.level));
   if (static_cast<std::uint64_t>(h.num_patches) * size * size > kMaxTotalSamples) return false;
   if (h.filter != WaveletFilter::kLinear && h.filter != WaveletFilter::kCubic) return false;
@@ -231,7 +251,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   const std::size_t size = static_cast<std::size_t>(grid_size(level)), samples = size * size;
   for (std::size_t p = 0; p < patches.size(); ++p) {
     if (patches[p].level != level || patches[p].values.size() != 3 * samples) {
-      throw std::invalid_argument("encode_geometry: patch " + std::to_string(p) + " has another level or size");
+      throw std::invalid_argument("encode_geometry: patch " + std::to_string(p) +
+                                  " has another level or size");
     }
   }
   if (options.quantization_bits < 1 || options.quantization_bits > 24) {
@@ -241,7 +262,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
     throw std::invalid_argument("encode_geometry: steps must be -1 or in [0, level]");
   }
   const int np = static_cast<int>(patches.size());
-  if (seams.size() > 4 * patches.size()) throw std::invalid_argument("encode_geometry: more than 4 seams per patch");
+  if (seams.size() > 4 * patches.size())
+    throw std::invalid_argument("encode_geometry: more than 4 seams per patch");
   for (const auto& s : seams) {
     if (!seam_ok(s, np)) throw std::invalid_argument("encode_geometry: seam references a bad patch or side");
   }
@@ -283,10 +305,11 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
       }
     }
   }
-  // Seam copies take their owner's integers (equal anyway for bit-identical seams), so the per-patch transforms
-  // give every copy its owner's coefficient.
+  // Seam copies take their owner's integers (equal anyway for bit-identical seams), so the per-patch
+  // transforms give every copy its owner's coefficient.
   for (const auto& [copy, owner] : own.copies) {
-    for (int c = 0; c < 3; ++c) coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
+    for (int c = 0; c < 3; ++c)
+      coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
   }
   for (auto& pc : coefs) {
     for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter);
@@ -297,7 +320,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   return result;
 }
 
-Status decode_geometry(const GeometryCodecHeader& header, std::span<const std::span<const std::uint8_t>> segments,
+Status decode_geometry(const GeometryCodecHeader& header,
+                       std::span<const std::span<const std::uint8_t>> segments,
                        std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,
                        const GeometryDecodeOptions& options) {
   out = DecodedGeometry{};
@@ -313,7 +337,8 @@ Status decode_geometry(const GeometryCodecHeader& header, std::span<const std::s
   out.partial = r.partial;
   if (coefs.size() != static_cast<std::size_t>(np)) return status == Status::kOk ? Status::kCorrupt : status;
   for (const auto& [copy, owner] : own.copies) {
-    for (int c = 0; c < 3; ++c) coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
+    for (int c = 0; c < 3; ++c)
+      coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
   }
   // Drop the finest details, then find the finest step with a non-zero detail.
   const int drop = std::min(options.drop_finest_steps, steps);
@@ -347,7 +372,7 @@ Status decode_geometry(const GeometryCodecHeader& header, std::span<const std::s
       auto& ch = coefs[p][c];
       wavelet_inverse(ch, level, steps, header.filter);
       for (std::size_t i = 0; i < samples; ++i) {
-        g.values[3 * i + c] = static_cast<float>(header.origin[c] + header.step * static_cast<double>(ch[i]));
+        g.values[3 * i + c] = to_float(header.origin[c] + header.step * static_cast<double>(ch[i]));
       }
     }
   }

@@ -47,7 +47,8 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 
 // CGAL edge_collapse with the Lindstrom–Turk defaults on the triangles `indices` of `mesh`.
-TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& indices, std::size_t target_faces) {
+TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& indices,
+                       std::size_t target_faces) {
   SurfaceMesh sm;
   std::vector<SurfaceMesh::Vertex_index> vertex(mesh.positions.size());
   std::vector<bool> used(mesh.positions.size(), false);
@@ -58,7 +59,8 @@ TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& ind
       vertex[v] = sm.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z()));
     }
   for (std::size_t i = 0; i + 2 < indices.size(); i += 3)
-    if (sm.add_face(vertex[indices[i]], vertex[indices[i + 1]], vertex[indices[i + 2]]) == SurfaceMesh::null_face())
+    if (sm.add_face(vertex[indices[i]], vertex[indices[i + 1]], vertex[indices[i + 2]]) ==
+        SurfaceMesh::null_face())
       throw InvalidInput("decimate_mesh: Lindstrom-Turk decimation needs an oriented 2-manifold; triangle " +
                          std::to_string(i / 3) + " makes it non-manifold or flips the orientation");
   // Count_stop_predicate stops on the edge count: E = (3F + B)/2 with B the boundary edges, which shrink as
@@ -68,7 +70,8 @@ TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& ind
     for (auto h : sm.halfedges())
       if (!sm.is_removed(h) && sm.is_border(h)) ++boundary_edges;
     if (static_cast<double>(sm.number_of_faces()) <= 1.01 * static_cast<double>(target_faces)) break;
-    CGAL::Surface_mesh_simplification::Count_stop_predicate<SurfaceMesh> stop((3 * target_faces + boundary_edges) / 2);
+    CGAL::Surface_mesh_simplification::Count_stop_predicate<SurfaceMesh> stop(
+        (3 * target_faces + boundary_edges) / 2);
     if (CGAL::Surface_mesh_simplification::edge_collapse(sm, stop) == 0) break;  // no collapse left
   }
   sm.collect_garbage();
@@ -92,7 +95,8 @@ TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& ind
 
 }  // namespace
 
-DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces, const DecimationOptions& options) {
+DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces,
+                               const DecimationOptions& options) {
   const std::string fn = "decimate_mesh: ";
   if (mesh.triangles.empty()) throw InvalidInput(fn + "the mesh has no triangles");
   if (target_faces < 1) throw InvalidInput(fn + "target_faces must be at least 1");
@@ -108,8 +112,8 @@ DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces, co
     for (int i : t)
       if (i < 0 || static_cast<std::size_t>(i) >= nv) throw InvalidInput(fn + "triangle index out of range");
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
-    indices.insert(indices.end(), {static_cast<unsigned>(t[0]), static_cast<unsigned>(t[1]),
-                                   static_cast<unsigned>(t[2])});
+    indices.insert(indices.end(),
+                   {static_cast<unsigned>(t[0]), static_cast<unsigned>(t[1]), static_cast<unsigned>(t[2])});
   }
   DecimationResult result;
   const std::size_t faces = indices.size() / 3;
@@ -136,9 +140,11 @@ DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces, co
     std::vector<unsigned int> sloppy(indices.size());
     float sloppy_error = 0;
     const std::size_t sloppy_count =
-        meshopt_simplifySloppy(sloppy.data(), indices.data(), indices.size(), xyz.data(), nv, 3 * sizeof(float),
-                               3 * target_faces, target_error, &sloppy_error);
-    const auto gap = [&](std::size_t c) { return std::abs(static_cast<double>(c / 3) - double(target_faces)); };
+        meshopt_simplifySloppy(sloppy.data(), indices.data(), indices.size(), xyz.data(), nv,
+                               3 * sizeof(float), 3 * target_faces, target_error, &sloppy_error);
+    const auto gap = [&](std::size_t c) {
+      return std::abs(static_cast<double>(c / 3) - double(target_faces));
+    };
     if (sloppy_count > 0 && gap(sloppy_count) < gap(count)) {
       sloppy.resize(sloppy_count);
       out.swap(sloppy);

@@ -1,8 +1,9 @@
 // Decimation of a triangle mesh to a target face count by edge collapses, for the rate–distortion baseline
 // "decimate, then Draco" (`geomip rd`), which trades faces for quantization bits. Two simplifiers:
 //
-// kMeshopt (default): meshoptimizer's simplifier (Debian libmeshoptimizer-dev 0.18). meshopt_simplify is an edge-collapse simplifier in the manner of Garland & Heckbert, "Surface
-// simplification using quadric error metrics", SIGGRAPH 1997: it collapses the edge whose quadric error is
+// kMeshopt (default): meshoptimizer's simplifier (Debian libmeshoptimizer-dev 0.18). meshopt_simplify is an
+// edge-collapse simplifier in the manner of Garland & Heckbert, "Surface simplification using quadric error
+// metrics", SIGGRAPH 1997: it collapses the edge whose quadric error is
 // smallest, keeping the surviving vertex in place (half-edge collapse: no optimal vertex placement, so every
 // output position is an input position), and respects topology (it does not collapse across borders
 // or seams in ways that would change them). When topology stops it above the target, meshopt_simplifySloppy
@@ -10,9 +11,9 @@
 //
 // kLindstromTurk: CGAL's Surface_mesh_simplification::edge_collapse with its default policies, Lindstrom &
 // Turk, "Fast and memory efficient polygonal simplification", IEEE Visualization 1998 (volume- and
-// boundary-preserving cost, optimal vertex placement). Slower (about 1 s for the 69k-face bunny against 0.03 s)
-// but much closer to the original at equal face count: on the bunny, +3 to +6 dB PSNR after Draco at Q 10..12
-// for 1.5k..24k faces (measured with `geomip eval`'s distance). Needs an oriented 2-manifold input.
+// boundary-preserving cost, optimal vertex placement). Slower (about 1 s for the 69k-face bunny against 0.03
+// s) but much closer to the original at equal face count: on the bunny, +3 to +6 dB PSNR after Draco at
+// Q 10..12 for 1.5k..24k faces (measured with `geomip eval`'s distance). Needs an oriented 2-manifold input.
 #pragma once
 
 #include "param/mesh.h"
@@ -28,8 +29,8 @@ enum class DecimationMethod {
 
 struct DecimationOptions {
   DecimationMethod method = DecimationMethod::kMeshopt;
-  /// kMeshopt: error bound relative to the mesh's extent handed to the simplifier (meshopt's target_error; 1 = 100 % of
-  /// the extent). Large by default so that the face count, not the error, stops the decimation.
+  /// kMeshopt: error bound relative to the mesh's extent handed to the simplifier (meshopt's target_error; 1
+  /// = 100 % of the extent). Large by default so that the face count, not the error, stops the decimation.
   double target_error = 1.0;
   /// kMeshopt: when meshopt_simplify stops with more than `(1 + tolerance)·target_faces` faces, run
   /// meshopt_simplifySloppy on the original instead (if its result is closer to the target).
@@ -39,8 +40,8 @@ struct DecimationOptions {
 };
 
 struct DecimationResult {
-  TriMesh mesh;               ///< the decimated mesh, compacted (only referenced vertices, in first-use order)
-  bool used_sloppy = false;   ///< true when meshopt_simplifySloppy produced `mesh`
+  TriMesh mesh;              ///< the decimated mesh, compacted (only referenced vertices, in first-use order)
+  bool used_sloppy = false;  ///< true when meshopt_simplifySloppy produced `mesh`
   double relative_error = 0;  ///< kMeshopt: meshoptimizer's own error estimate, relative to the mesh extent
 };
 
@@ -55,6 +56,7 @@ struct DecimationResult {
 /// \pre at least one triangle, indices in range, finite coordinates; for kLindstromTurk also an oriented
 ///      2-manifold (possibly with boundary).
 /// \throw InvalidInput naming `decimate_mesh` when a precondition fails.
-DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces, const DecimationOptions& options = {});
+DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces,
+                               const DecimationOptions& options = {});
 
 }  // namespace geomip

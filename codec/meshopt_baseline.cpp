@@ -27,7 +27,8 @@ MeshoptCodecResult meshopt_encode(const TriMesh& mesh, const MeshoptCodecOptions
   const std::string fn = "meshopt_encode: ";
   if (mesh.triangles.empty()) throw InvalidInput(fn + "the mesh has no triangles");
   if (options.quantization_bits < 1 || options.quantization_bits > 16)
-    throw InvalidInput(fn + "quantization_bits must be in 1..16, got " + std::to_string(options.quantization_bits));
+    throw InvalidInput(fn + "quantization_bits must be in 1..16, got " +
+                       std::to_string(options.quantization_bits));
   const auto nv = mesh.positions.size();
 
   // Referenced vertices, compacted in first-use order.
@@ -57,7 +58,8 @@ MeshoptCodecResult meshopt_encode(const TriMesh& mesh, const MeshoptCodecOptions
   const double extent = (hi - lo).maxCoeff();
   const double levels = std::ldexp(1.0, options.quantization_bits) - 1;
   // Store origin and step as float32 (the header's precision), and quantize against exactly those values.
-  const std::array<float, 3> origin{static_cast<float>(lo.x()), static_cast<float>(lo.y()), static_cast<float>(lo.z())};
+  const std::array<float, 3> origin{static_cast<float>(lo.x()), static_cast<float>(lo.y()),
+                                    static_cast<float>(lo.z())};
   const float step = extent > 0 ? static_cast<float>(extent / levels) : 1.0f;
   std::vector<std::array<std::uint16_t, 4>> quantized(vertex_count);
   for (std::size_t v = 0; v < vertex_count; ++v)
@@ -68,14 +70,15 @@ MeshoptCodecResult meshopt_encode(const TriMesh& mesh, const MeshoptCodecOptions
     }
 
   meshopt_optimizeVertexCache(indices.data(), indices.data(), indices.size(), vertex_count);
-  meshopt_optimizeVertexFetch(quantized.data(), indices.data(), indices.size(), quantized.data(), vertex_count,
-                              sizeof(quantized[0]));
+  meshopt_optimizeVertexFetch(quantized.data(), indices.data(), indices.size(), quantized.data(),
+                              vertex_count, sizeof(quantized[0]));
   std::vector<unsigned char> index_stream(meshopt_encodeIndexBufferBound(indices.size(), vertex_count));
   index_stream.resize(
       meshopt_encodeIndexBuffer(index_stream.data(), index_stream.size(), indices.data(), indices.size()));
-  std::vector<unsigned char> vertex_stream(meshopt_encodeVertexBufferBound(vertex_count, sizeof(quantized[0])));
-  vertex_stream.resize(meshopt_encodeVertexBuffer(vertex_stream.data(), vertex_stream.size(), quantized.data(),
-                                                  vertex_count, sizeof(quantized[0])));
+  std::vector<unsigned char> vertex_stream(
+      meshopt_encodeVertexBufferBound(vertex_count, sizeof(quantized[0])));
+  vertex_stream.resize(meshopt_encodeVertexBuffer(vertex_stream.data(), vertex_stream.size(),
+                                                  quantized.data(), vertex_count, sizeof(quantized[0])));
   result.encode_ms = ms_since(encode_start);
   result.index_bytes = index_stream.size();
   result.vertex_bytes = vertex_stream.size();
@@ -87,18 +90,21 @@ MeshoptCodecResult meshopt_encode(const TriMesh& mesh, const MeshoptCodecOptions
   result.decode_ms = INFINITY;
   for (int run = 0; run < std::max(1, options.decode_runs); ++run) {
     const auto start = Clock::now();
-    const int ri = meshopt_decodeIndexBuffer(decoded_indices.data(), decoded_indices.size(), sizeof(unsigned int),
-                                             index_stream.data(), index_stream.size());
-    const int rv = meshopt_decodeVertexBuffer(decoded_vertices.data(), vertex_count, sizeof(decoded_vertices[0]),
-                                              vertex_stream.data(), vertex_stream.size());
+    const int ri = meshopt_decodeIndexBuffer(decoded_indices.data(), decoded_indices.size(),
+                                             sizeof(unsigned int), index_stream.data(), index_stream.size());
+    const int rv =
+        meshopt_decodeVertexBuffer(decoded_vertices.data(), vertex_count, sizeof(decoded_vertices[0]),
+                                   vertex_stream.data(), vertex_stream.size());
     if (ri != 0 || rv != 0) throw SolverFailure("meshopt_encode: meshoptimizer rejected its own stream");
     for (std::size_t v = 0; v < vertex_count; ++v)
-      for (int k = 0; k < 3; ++k) xyz[3 * v + k] = origin[k] + step * static_cast<float>(decoded_vertices[v][k]);
+      for (int k = 0; k < 3; ++k)
+        xyz[3 * v + k] = origin[k] + step * static_cast<float>(decoded_vertices[v][k]);
     result.decode_ms = std::min(result.decode_ms, ms_since(start));
   }
   TriMesh& out = result.decoded;
   out.positions.resize(vertex_count);
-  for (std::size_t v = 0; v < vertex_count; ++v) out.positions[v] = Eigen::Vector3f(&xyz[3 * v]).cast<double>();
+  for (std::size_t v = 0; v < vertex_count; ++v)
+    out.positions[v] = Eigen::Vector3f(&xyz[3 * v]).cast<double>();
   out.triangles.resize(decoded_indices.size() / 3);
   for (std::size_t f = 0; f < out.triangles.size(); ++f)
     for (int k = 0; k < 3; ++k) out.triangles[f][k] = static_cast<int>(decoded_indices[3 * f + k]);

@@ -29,11 +29,11 @@ struct MeshoptCodecOptions {
 };
 
 struct MeshoptCodecResult {
-  std::size_t bytes = 0;          ///< header + encoded index stream + encoded vertex stream
-  std::size_t index_bytes = 0;    ///< meshopt_encodeIndexBuffer output
-  std::size_t vertex_bytes = 0;   ///< meshopt_encodeVertexBuffer output
-  TriMesh decoded;                ///< the decoded, dequantized mesh (vertices in fetch order)
-  double encode_ms = 0;           ///< one encode (quantize, optimize, encode), milliseconds
+  std::size_t bytes = 0;         ///< header + encoded index stream + encoded vertex stream
+  std::size_t index_bytes = 0;   ///< meshopt_encodeIndexBuffer output
+  std::size_t vertex_bytes = 0;  ///< meshopt_encodeVertexBuffer output
+  TriMesh decoded;               ///< the decoded, dequantized mesh (vertices in fetch order)
+  double encode_ms = 0;          ///< one encode (quantize, optimize, encode), milliseconds
   /// Best decode (both streams and dequantization to float xyz; the copy into a TriMesh is not timed), ms.
   double decode_ms = 0;
 };

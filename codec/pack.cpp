@@ -119,17 +119,70 @@ bool read_mask(ByteReader& r, int side, std::vector<std::uint8_t>& mask) {
   return true;
 }
 
-// The canonical chunk order: by stage (geometry pass p → p, normal pass p → p + delay), then geometry before
-// normals, then model.
+// The fine hole masks of one model (all patches, `side` × `side` quads each) in one arithmetic-coded chunk,
+// each bit in a context of its coded neighbours and of the coarse mask bit above it (`shift` levels coarser):
+// far from the coarse mask's border the bits are nearly free.
+int fine_mask_context(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& coarse, int side,
+                      int shift, int i, int j) {
+  const int coarse_side = side >> shift;
+  return mask_context(mask, side, i, j) |
+         coarse[static_cast<std::size_t>(j >> shift) * coarse_side + (i >> shift)] << 4;
+}
+
+std::vector<std::uint8_t> encode_fine_masks(const std::vector<std::vector<std::uint8_t>>& masks,
+                                            const std::vector<std::vector<std::uint8_t>>& coarse, int side,
+                                            int shift) {
+  ArithmeticEncoder encoder;
+  Context contexts[32];
+  for (std::size_t p = 0; p < masks.size(); ++p) {
+    std::vector<std::uint8_t> bits(masks[p].size());
+    for (std::size_t k = 0; k < bits.size(); ++k) bits[k] = masks[p][k] ? 1 : 0;
+    for (int j = 0; j < side; ++j)
+      for (int i = 0; i < side; ++i)
+        encoder.encode(bits[static_cast<std::size_t>(j) * side + i],
+                       contexts[fine_mask_context(bits, coarse[p], side, shift, i, j)]);
+  }
+  return encoder.finish();
+}
+
+void decode_fine_masks(std::span<const std::uint8_t> bytes, const std::vector<std::vector<std::uint8_t>>& coarse,
+                       int side, int shift, std::vector<std::vector<std::uint8_t>>& masks) {
+  ArithmeticDecoder decoder(bytes);
+  Context contexts[32];
+  masks.assign(coarse.size(), std::vector<std::uint8_t>(static_cast<std::size_t>(side) * side, 0));
+  for (std::size_t p = 0; p < coarse.size(); ++p)
+    for (int j = 0; j < side; ++j)
+      for (int i = 0; i < side; ++i)
+        masks[p][static_cast<std::size_t>(j) * side + i] =
+            static_cast<std::uint8_t>(decoder.decode(contexts[fine_mask_context(masks[p], coarse[p], side, shift, i, j)]));
+}
+
+/// The coarse mask `shift` levels above `mask`: a coarse quad is masked when at least half of its quads are.
+std::vector<std::uint8_t> coarsen_mask(const std::vector<std::uint8_t>& mask, int side, int shift) {
+  const int coarse_side = side >> shift, block = 1 << shift;
+  std::vector<std::uint8_t> coarse(static_cast<std::size_t>(coarse_side) * coarse_side, 0);
+  for (int cj = 0; cj < coarse_side; ++cj)
+    for (int ci = 0; ci < coarse_side; ++ci) {
+      int count = 0;
+      for (int j = cj * block; j < (cj + 1) * block; ++j)
+        for (int i = ci * block; i < (ci + 1) * block; ++i) count += mask[static_cast<std::size_t>(j) * side + i] != 0;
+      coarse[static_cast<std::size_t>(cj) * coarse_side + ci] = 2 * count >= block * block;
+    }
+  return coarse;
+}
+
+// The canonical chunk order: by stage (geometry pass p → p, normal pass p → p + delay, a fine hole mask → the
+// manifest's mask stage), then geometry, normals, hole mask, then model.
 struct ChunkKey {
   int stage, kind, model, pass;
 };
 std::vector<ChunkKey> chunk_order(const std::vector<int>& geometry_passes, const std::vector<int>& normal_passes,
-                                  int normals_delay) {
+                                  const std::vector<bool>& fine_mask, int normals_delay, int mask_stage) {
   std::vector<ChunkKey> keys;
   for (std::size_t m = 0; m < geometry_passes.size(); ++m) {
     for (int p = 0; p < geometry_passes[m]; ++p) keys.push_back({p, 0, static_cast<int>(m), p});
     for (int p = 0; p < normal_passes[m]; ++p) keys.push_back({p + normals_delay, 1, static_cast<int>(m), p});
+    if (fine_mask[m]) keys.push_back({mask_stage, 2, static_cast<int>(m), 0});
   }
   std::stable_sort(keys.begin(), keys.end(), [](const ChunkKey& a, const ChunkKey& b) {
     return std::tie(a.stage, a.kind, a.model) < std::tie(b.stage, b.kind, b.model);
@@ -146,11 +199,13 @@ std::uint64_t samples_of(const GeometryCodecHeader& h) {
 
 Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_end, PackInfo& out) {
   ByteReader r(bytes);
-  std::uint64_t model_count, normals_delay;
-  if (!r.bounded(model_count, kMaxModels) || model_count == 0 || !r.bounded(normals_delay, kMaxPasses))
+  std::uint64_t model_count, normals_delay, mask_stage;
+  if (!r.bounded(model_count, kMaxModels) || model_count == 0 || !r.bounded(normals_delay, kMaxPasses) ||
+      !r.bounded(mask_stage, kMaxPasses))
     return Status::kCorrupt;
   out.models.assign(static_cast<std::size_t>(model_count), {});
   std::vector<int> geometry_passes, normal_passes;
+  std::vector<bool> fine_mask;
   std::uint64_t samples = 0;
   for (PackModelInfo& model : out.models) {
     std::vector<std::uint8_t> header;
@@ -178,16 +233,21 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
       return Status::kCorrupt;
     model.hole_mask.resize(static_cast<std::size_t>(mask_patches));
     if (mask_patches > 0) {
-      std::uint8_t mask_level;
-      if (!r.u8(mask_level) || mask_level > model.geometry.level) return Status::kCorrupt;
-      model.hole_mask_level = mask_level;
+      std::uint8_t mask_level, coarse_level;
+      if (!r.u8(mask_level) || mask_level > model.geometry.level || !r.u8(coarse_level) ||
+          coarse_level > mask_level)
+        return Status::kCorrupt;
+      model.hole_mask_level = coarse_level;
+      model.fine_hole_mask_level = mask_level;
     }
     for (auto& mask : model.hole_mask)
       if (!read_mask(r, 1 << model.hole_mask_level, mask)) return Status::kCorrupt;
+    fine_mask.push_back(mask_patches > 0 && model.fine_hole_mask_level > model.hole_mask_level);
     geometry_passes.push_back(passes_of(model.geometry));
     normal_passes.push_back(model.has_normals ? passes_of(model.normals) : 0);
   }
-  const std::vector<ChunkKey> order = chunk_order(geometry_passes, normal_passes, static_cast<int>(normals_delay));
+  const std::vector<ChunkKey> order = chunk_order(geometry_passes, normal_passes, fine_mask,
+                                                  static_cast<int>(normals_delay), static_cast<int>(mask_stage));
   std::uint64_t chunk_count;
   if (!r.varint(chunk_count) || chunk_count != order.size()) return Status::kCorrupt;
   out.chunks.resize(order.size());
@@ -197,7 +257,7 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     std::uint64_t size;
     if (!r.bounded(size, 0x7fffffff) || !r.u32(chunk.crc32)) return Status::kCorrupt;
     chunk.model = order[c].model;
-    chunk.kind = order[c].kind == 0 ? ChunkKind::kGeometry : ChunkKind::kNormals;
+    chunk.kind = static_cast<ChunkKind>(order[c].kind);
     chunk.pass = order[c].pass;
     chunk.offset = offset;
     chunk.size = static_cast<std::uint32_t>(size);
@@ -285,9 +345,37 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
     }
   }
 
+  // Hole masks: the coarse one (2 levels up) in the manifest, the fine one in a chunk after the geometry pass
+  // where the pack passes options.hole_mask_after_bytes.
+  std::vector<std::vector<std::vector<std::uint8_t>>> coarse_masks(models.size());
+  std::vector<int> coarse_level(models.size(), 0);
+  std::vector<bool> fine_mask(models.size(), false);
+  std::vector<std::vector<std::uint8_t>> fine_mask_bytes(models.size());
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    if (models[m].hole_mask.empty()) continue;
+    coarse_level[m] = std::max(0, mask_level[m] - std::max(0, options.coarse_hole_mask_levels));
+    const int shift = mask_level[m] - coarse_level[m];
+    for (const auto& mask : models[m].hole_mask)
+      coarse_masks[m].push_back(coarsen_mask(mask, 1 << mask_level[m], shift));
+    fine_mask[m] = shift > 0;
+    if (fine_mask[m])
+      fine_mask_bytes[m] = encode_fine_masks(models[m].hole_mask, coarse_masks[m], 1 << mask_level[m], shift);
+  }
+  int mask_stage = 0;
+  {
+    std::size_t total = 0;
+    const int max_passes = *std::max_element(geometry_passes.begin(), geometry_passes.end());
+    for (mask_stage = 0; mask_stage + 1 < max_passes; ++mask_stage) {
+      for (std::size_t m = 0; m < models.size(); ++m)
+        if (mask_stage < geometry_passes[m]) total += geometry[m].segments[static_cast<std::size_t>(mask_stage)].size();
+      if (total >= options.hole_mask_after_bytes) break;
+    }
+  }
+
   ByteWriter manifest;
   manifest.varint(models.size());
   manifest.varint(static_cast<std::uint64_t>(options.normals_delay));
+  manifest.varint(static_cast<std::uint64_t>(mask_stage));
   for (std::size_t m = 0; m < models.size(); ++m) {
     manifest.string(models[m].name);
     write_normalization(manifest, models[m].normalization);
@@ -295,12 +383,17 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
     manifest.u8(normal_passes[m] > 0 ? 1 : 0);
     if (normal_passes[m] > 0) manifest.bytes(normals[m].header.serialize());
     manifest.varint(models[m].hole_mask.size());
-    if (!models[m].hole_mask.empty()) manifest.u8(static_cast<std::uint8_t>(mask_level[m]));
-    for (const auto& mask : models[m].hole_mask) write_mask(manifest, mask, 1 << mask_level[m]);
+    if (!models[m].hole_mask.empty()) {
+      manifest.u8(static_cast<std::uint8_t>(mask_level[m]));
+      manifest.u8(static_cast<std::uint8_t>(coarse_level[m]));
+    }
+    for (const auto& mask : coarse_masks[m]) write_mask(manifest, mask, 1 << coarse_level[m]);
   }
-  const std::vector<ChunkKey> order = chunk_order(geometry_passes, normal_passes, options.normals_delay);
+  const std::vector<ChunkKey> order =
+      chunk_order(geometry_passes, normal_passes, fine_mask, options.normals_delay, mask_stage);
   manifest.varint(order.size());
   auto segment = [&](const ChunkKey& key) -> const std::vector<std::uint8_t>& {
+    if (key.kind == 2) return fine_mask_bytes[static_cast<std::size_t>(key.model)];
     const auto& encoded = key.kind == 0 ? geometry[static_cast<std::size_t>(key.model)]
                                         : normals[static_cast<std::size_t>(key.model)];
     return encoded.segments[static_cast<std::size_t>(key.pass)];
@@ -334,6 +427,8 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
   struct Streams {
     std::vector<std::span<const std::uint8_t>> geometry, normals;
     std::span<const std::uint8_t> geometry_tail, normals_tail;
+    std::span<const std::uint8_t> fine_mask;
+    bool has_fine_mask = false;
   };
   std::vector<Streams> streams(info.models.size());
   for (const ChunkInfo& chunk : info.chunks) {
@@ -341,7 +436,8 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
     const bool geometry = chunk.kind == ChunkKind::kGeometry;
     if (chunk.offset + chunk.size > data.size()) {
       result.status = Status::kTruncated;
-      if (options.partial_chunks && chunk.offset < data.size() && (geometry || options.normals)) {
+      if (options.partial_chunks && chunk.offset < data.size() && chunk.kind != ChunkKind::kHoleMask &&
+          (geometry || options.normals)) {
         const auto tail = data.subspan(static_cast<std::size_t>(chunk.offset));
         (geometry ? s.geometry_tail : s.normals_tail) = tail;
         result.bytes_used = data.size();
@@ -353,7 +449,12 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
       result.status = Status::kCorrupt;
       break;
     }
-    (geometry ? s.geometry : s.normals).push_back(payload);
+    if (chunk.kind == ChunkKind::kHoleMask) {
+      s.fine_mask = payload;
+      s.has_fine_mask = true;
+    } else {
+      (geometry ? s.geometry : s.normals).push_back(payload);
+    }
     ++result.chunks_decoded;
     result.bytes_used = static_cast<std::size_t>(chunk.offset + chunk.size);
   }
@@ -367,6 +468,12 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
     model.seams = model_info.geometry.seams;
     model.hole_mask = model_info.hole_mask;
     model.hole_mask_level = model_info.hole_mask_level;
+    if (s.has_fine_mask) {
+      const int shift = model_info.fine_hole_mask_level - model_info.hole_mask_level;
+      decode_fine_masks(s.fine_mask, model_info.hole_mask, 1 << model_info.fine_hole_mask_level, shift,
+                        model.hole_mask);
+      model.hole_mask_level = model_info.fine_hole_mask_level;
+    }
     model.geometry_passes = s.geometry.size();
     try {
       DecodedGeometry decoded;

@@ -32,7 +32,11 @@ namespace geomip::codec {
 inline constexpr std::size_t kPackHeaderSize = 20;
 inline constexpr std::uint16_t kPackVersion = 1;
 
-enum class ChunkKind : std::uint8_t { kGeometry = 0, kNormals = 1 };
+enum class ChunkKind : std::uint8_t {
+  kGeometry = 0,  ///< one bit-plane pass of a model's geometry stream
+  kNormals = 1,   ///< one bit-plane pass of a model's normal-map stream
+  kHoleMask = 2,  ///< a model's fine hole masks (the manifest holds coarse ones)
+};
 
 struct ChunkInfo {
   int model = 0;
@@ -53,8 +57,11 @@ struct PackModelInfo {
   GeometryCodecHeader normals;  ///< valid when has_normals
   /// Per patch, per quad of the level-hole_mask_level grid (2^L × 2^L, row-major), 1 = the quad covers a
   /// filled hole of the source mesh (geomip repair) and is left out of decoded meshes. Empty = no holes.
+  /// The manifest holds the masks 2 levels coarser than the pack's (a coarse quad is masked when half of its
+  /// quads are); the fine masks arrive in a kHoleMask chunk once the geometry is fine enough to need them.
   std::vector<std::vector<std::uint8_t>> hole_mask;
-  int hole_mask_level = 0;  ///< L ≤ geometry.level
+  int hole_mask_level = 0;       ///< L of hole_mask (the coarse masks)
+  int fine_hole_mask_level = 0;  ///< level of the masks in the kHoleMask chunk (= L when there is none)
 };
 
 struct PackInfo {
@@ -92,6 +99,11 @@ struct PackWriteOptions {
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.
   int normals_delay = 4;
+  /// Hole masks: the manifest carries them this many levels coarser (fewer bytes before the first model);
+  /// the full masks follow in a chunk after the first geometry pass at which the geometry passes of all
+  /// models reach hole_mask_after_bytes.
+  int coarse_hole_mask_levels = 2;
+  std::size_t hole_mask_after_bytes = 4096;
 };
 
 /// Encodes and lays out a pack in memory. Throws std::invalid_argument on bad input (models whose patch

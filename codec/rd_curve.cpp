@@ -40,17 +40,28 @@ std::string xml_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
 }
 
-bool plottable(const RdPoint& p) { return p.bytes > 0 && std::isfinite(p.psnr_db); }
+bool plottable(const RdPoint& p) {
+  return p.bytes > 0 && std::isfinite(p.psnr_db);
+}
 
 }  // namespace
 
@@ -86,8 +97,8 @@ void write_rd_csv(std::ostream& out, const std::vector<RdPoint>& points) {
   out << "method,bytes,psnr_db,hausdorff_pct,decode_ms,rms_pct,faces,vertices,quantization_bits,source\n";
   for (const RdPoint& p : points)
     out << csv_field(p.method) << ',' << p.bytes << ',' << number(p.psnr_db) << ',' << number(p.hausdorff_pct)
-        << ',' << number(p.decode_ms) << ',' << number(p.rms_pct) << ',' << p.faces << ',' << p.vertices << ','
-        << p.quantization_bits << ',' << csv_field(p.source) << '\n';
+        << ',' << number(p.decode_ms) << ',' << number(p.rms_pct) << ',' << p.faces << ',' << p.vertices
+        << ',' << p.quantization_bits << ',' << csv_field(p.source) << '\n';
 }
 
 void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const RdPlotOptions& options) {
@@ -117,7 +128,8 @@ void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const R
       ystep = s;
       break;
     }
-  const double y0 = std::floor(db_lo / ystep) * ystep, y1 = std::max(y0 + ystep, std::ceil(db_hi / ystep) * ystep);
+  const double y0 = std::floor(db_lo / ystep) * ystep,
+               y1 = std::max(y0 + ystep, std::ceil(db_hi / ystep) * ystep);
 
   const double W = options.width, H = options.height;
   const double left = 70, right = 190, top = 40, bottom = 55;
@@ -128,8 +140,8 @@ void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const R
                                   "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
 
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H << "\" viewBox=\"0 0 "
-      << W << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
+      << "\" viewBox=\"0 0 " << W << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
       << "<rect x=\"0\" y=\"0\" width=\"" << W << "\" height=\"" << H << "\" fill=\"white\"/>\n"
       << "<text x=\"" << left + pw / 2 << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">"
       << xml_escape(options.title) << "</text>\n";
@@ -142,8 +154,8 @@ void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const R
       const double kb = m * std::pow(10.0, d);
       if (std::log10(kb) > x1 + 1e-9) break;
       const double x = sx(kb);
-      out << "<line x1=\"" << fmt("%.2f", x) << "\" y1=\"" << top << "\" x2=\"" << fmt("%.2f", x) << "\" y2=\""
-          << top + ph << "\"/>\n";
+      out << "<line x1=\"" << fmt("%.2f", x) << "\" y1=\"" << top << "\" x2=\"" << fmt("%.2f", x)
+          << "\" y2=\"" << top + ph << "\"/>\n";
       labels += "<text x=\"" + fmt("%.2f", x) + "\" y=\"" + fmt("%.2f", top + ph + 18) +
                 "\" text-anchor=\"middle\">" + fmt("%g", kb) + "</text>\n";
     }
@@ -151,8 +163,8 @@ void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const R
     const double y = sy(db);
     out << "<line x1=\"" << left << "\" y1=\"" << fmt("%.2f", y) << "\" x2=\"" << left + pw << "\" y2=\""
         << fmt("%.2f", y) << "\"/>\n";
-    labels += "<text x=\"" + fmt("%.2f", left - 8) + "\" y=\"" + fmt("%.2f", y + 4) + "\" text-anchor=\"end\">" +
-              fmt("%g", db) + "</text>\n";
+    labels += "<text x=\"" + fmt("%.2f", left - 8) + "\" y=\"" + fmt("%.2f", y + 4) +
+              "\" text-anchor=\"end\">" + fmt("%g", db) + "</text>\n";
   }
   out << "</g>\n"
       << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << pw << "\" height=\"" << ph
@@ -166,28 +178,30 @@ void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const R
   for (std::size_t s = 0; s < names.size(); ++s) {
     const std::string& name = names[s];
     std::vector<RdPoint> pts = series[name];
-    std::stable_sort(pts.begin(), pts.end(), [](const RdPoint& a, const RdPoint& b) { return a.bytes < b.bytes; });
+    std::stable_sort(pts.begin(), pts.end(),
+                     [](const RdPoint& a, const RdPoint& b) { return a.bytes < b.bytes; });
     const char* color = kColors[s % (sizeof kColors / sizeof kColors[0])];
-    const bool scatter =
-        std::find(options.scatter_methods.begin(), options.scatter_methods.end(), name) != options.scatter_methods.end();
+    const bool scatter = std::find(options.scatter_methods.begin(), options.scatter_methods.end(), name) !=
+                         options.scatter_methods.end();
     out << "<g class=\"series\" data-method=\"" << xml_escape(name) << "\">\n";
     if (!scatter && pts.size() > 1) {
       out << "<polyline fill=\"none\" stroke=\"" << color << "\" stroke-width=\"1.8\" points=\"";
       for (const RdPoint& p : pts)
-        out << fmt("%.2f", sx(static_cast<double>(p.bytes) / 1000.0)) << ',' << fmt("%.2f", sy(p.psnr_db)) << ' ';
+        out << fmt("%.2f", sx(static_cast<double>(p.bytes) / 1000.0)) << ',' << fmt("%.2f", sy(p.psnr_db))
+            << ' ';
       out << "\"/>\n";
     }
     for (const RdPoint& p : pts) {
       out << "<circle cx=\"" << fmt("%.2f", sx(static_cast<double>(p.bytes) / 1000.0)) << "\" cy=\""
-          << fmt("%.2f", sy(p.psnr_db)) << "\" r=\"" << (scatter ? 2.2 : 3.0) << "\" fill=\"" << color
-          << "\"" << (scatter ? " fill-opacity=\"0.45\"" : "") << "><title>" << xml_escape(name) << ": "
-          << p.bytes << " B, " << fmt("%.2f", p.psnr_db) << " dB, " << p.faces << " faces, Q"
-          << p.quantization_bits << "</title></circle>\n";
+          << fmt("%.2f", sy(p.psnr_db)) << "\" r=\"" << (scatter ? 2.2 : 3.0) << "\" fill=\"" << color << "\""
+          << (scatter ? " fill-opacity=\"0.45\"" : "") << "><title>" << xml_escape(name) << ": " << p.bytes
+          << " B, " << fmt("%.2f", p.psnr_db) << " dB, " << p.faces << " faces, Q" << p.quantization_bits
+          << "</title></circle>\n";
     }
     const double ly = top + 10 + 20.0 * static_cast<double>(s);
     const double lx = left + pw + 15;
-    out << "<line x1=\"" << lx << "\" y1=\"" << ly << "\" x2=\"" << lx + 22 << "\" y2=\"" << ly << "\" stroke=\""
-        << color << "\" stroke-width=\"" << (scatter ? 0 : 1.8) << "\"/>\n"
+    out << "<line x1=\"" << lx << "\" y1=\"" << ly << "\" x2=\"" << lx + 22 << "\" y2=\"" << ly
+        << "\" stroke=\"" << color << "\" stroke-width=\"" << (scatter ? 0 : 1.8) << "\"/>\n"
         << "<circle cx=\"" << lx + 11 << "\" cy=\"" << ly << "\" r=\"3\" fill=\"" << color << "\"/>\n"
         << "<text x=\"" << lx + 28 << "\" y=\"" << ly + 4 << "\">" << xml_escape(name) << "</text>\n"
         << "</g>\n";

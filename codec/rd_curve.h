@@ -14,21 +14,22 @@
 namespace geomip {
 
 struct RdPoint {
-  std::string method;          ///< series name, e.g. "draco", "draco_qem", "draco_envelope", "meshopt"
-  std::size_t bytes = 0;       ///< coded size in bytes
-  double psnr_db = 0;          ///< PSNR of the decoded mesh vs the original, dB (surface_distance)
-  double hausdorff_pct = 0;    ///< symmetric Hausdorff distance, % of the original's bounding-box diagonal
-  double rms_pct = 0;          ///< symmetric RMS distance, % of the diagonal
-  double decode_ms = 0;        ///< decode time, milliseconds
-  std::size_t faces = 0;       ///< faces of the coded mesh (after any decimation)
-  std::size_t vertices = 0;    ///< vertices of the decoded mesh
-  int quantization_bits = 0;   ///< position quantization bits (0 = not quantized / not applicable)
-  std::string source;          ///< for envelope points, the method the point came from; empty otherwise
+  std::string method;         ///< series name, e.g. "draco", "draco_qem", "draco_envelope", "meshopt"
+  std::size_t bytes = 0;      ///< coded size in bytes
+  double psnr_db = 0;         ///< PSNR of the decoded mesh vs the original, dB (surface_distance)
+  double hausdorff_pct = 0;   ///< symmetric Hausdorff distance, % of the original's bounding-box diagonal
+  double rms_pct = 0;         ///< symmetric RMS distance, % of the diagonal
+  double decode_ms = 0;       ///< decode time, milliseconds
+  std::size_t faces = 0;      ///< faces of the coded mesh (after any decimation)
+  std::size_t vertices = 0;   ///< vertices of the decoded mesh
+  int quantization_bits = 0;  ///< position quantization bits (0 = not quantized / not applicable)
+  std::string source;         ///< for envelope points, the method the point came from; empty otherwise
 };
 
 /// The Pareto front of `points` for (fewer bytes, higher PSNR): a point is kept iff no other point has
 /// bytes ≤ and psnr ≥ its own with at least one strict; of exactly equal points the first is kept. The
-/// result is sorted by bytes (ascending), hence also by PSNR (strictly ascending). O(n log n).
+/// result is sorted by bytes (ascending), hence also by PSNR (strictly ascending). Points with a NaN PSNR are
+/// ignored. O(n log n).
 std::vector<RdPoint> upper_envelope(const std::vector<RdPoint>& points);
 
 /// The staircase of a front: the best PSNR among `front`'s points with at most `bytes` bytes, or −infinity

@@ -24,7 +24,9 @@ inline I64 predict(const Even& e, int t, int num_evens, bool cubic) {
   return (sum + 8) >> 4;  // arithmetic shift: floor division
 }
 
-inline std::int32_t wrap(I64 v) { return static_cast<std::int32_t>(static_cast<std::uint32_t>(v)); }
+inline std::int32_t wrap(I64 v) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(v));
+}
 
 /// One pass of one step. `rows` = true: the row pass (lines along i); false: the column pass.
 /// sign = −1: forward (subtract the prediction), +1: inverse (add it).
@@ -47,7 +49,9 @@ void pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int sign) {
     for (int t = 0; t < num_odds; ++t) {
       std::int32_t* odd = g + static_cast<std::ptrdiff_t>(2 * t + 1) * s * line;
       for (int i = 0; i < size; i += s) {
-        auto e = [&](int u) { return static_cast<I64>(g[static_cast<std::ptrdiff_t>(2 * u) * s * line + i]); };
+        auto e = [&](int u) {
+          return static_cast<I64>(g[static_cast<std::ptrdiff_t>(2 * u) * s * line + i]);
+        };
         odd[i] = wrap(odd[i] + sign * predict(e, t, num_evens, cubic));
       }
     }

@@ -2,22 +2,23 @@
 // Deslauriers–Dubuc subdivision wavelets (Deslauriers & Dubuc 1989; lifting form: Sweldens 1996, "The lifting
 // scheme"), separable, exactly reversible on integers.
 //
-// One step at spacing s (s = 1 for the finest step, doubling each step) works on the current grid (the samples
-// at multiples of s):
+// One step at spacing s (s = 1 for the finest step, doubling each step) works on the current grid (the
+// samples at multiples of s):
 //   1. row pass: in every row of the current grid, each odd sample (column an odd multiple of s) is replaced
 //      by d = x − P, P predicted from the even samples (multiples of 2s) of that row;
 //   2. column pass: in every column of the current grid (including the columns that now hold row details),
-//      each odd sample (row an odd multiple of s) is replaced by d = x − P from the even samples of the column.
+//      each odd sample (row an odd multiple of s) is replaced by d = x − P from the even samples of the
+//      column.
 // Prediction: P = floor((Σ w·e + denom/2) / denom), integer weights:
 //   kLinear (order 2): (1, 1)/2 of the two neighbours;
 //   kCubic (order 4): (−1, 9, 9, −1)/16 of the four nearest evens; next to an end, the one-sided cubic
-//     (5, 15, −5, 1)/16 of the four evens nearest that end (mirrored exactly at the far end). Lines with fewer
-//     than four evens (2 or 3) use the linear prediction.
+//     (5, 15, −5, 1)/16 of the four evens nearest that end (mirrored exactly at the far end). Lines with
+//     fewer than four evens (2 or 3) use the linear prediction.
 // Properties (tested): exact reconstruction; no update step, so the coarse band after k steps is exactly the
 // nested (2^(n−k)+1)² subsample of the input; the weights are mirror-symmetric, so transforming a reversed
 // line gives the reversed coefficients; a boundary row or column's coefficients depend only on that row or
-// column (what makes seams between patches consistent); kLinear gives zero details on affine fields, kCubic on
-// separable cubic polynomials (p(i) + q(j), as long as every line has at least four evens).
+// column (what makes seams between patches consistent); kLinear gives zero details on affine fields, kCubic
+// on separable cubic polynomials (p(i) + q(j), as long as every line has at least four evens).
 //
 // Detail bands of step k (s = 2^(k−1)): positions (i, j), multiples of s, not both multiples of 2s —
 // (odd, even) multiples of s: row details; (even, odd): column details; (odd, odd): diagonal details.

@@ -1,8 +1,9 @@
 // geomip rd MESH -o DIR [--json] [--quick] [--lindstrom-turk]: rate–distortion baselines of MESH — Draco on
 // the full mesh over quantization bits, Draco on QEM-decimated copies (faces × bits; meshoptimizer's
 // simplifier, and with --lindstrom-turk also CGAL's) and their upper envelopes, meshoptimizer's codec — each
-// decoded mesh measured against MESH with the Metro-style surface distance. Writes DIR/rd.csv (every point)
-// and DIR/rd.svg (the plot).
+// decoded mesh measured against MESH with the Metro-style surface distance — and geomip: MESH converted to a
+// geometry-only pack (DIR/<stem>.gip), measured at many byte prefixes. Writes DIR/rd.csv (every point) and
+// DIR/rd.svg (the plot).
 //
 // The command is a list of series: each series is a method name and a list of jobs, a job codes one mesh and
 // returns its bytes, decoded mesh and decode time; evaluation, the envelope, the files and the table are the
@@ -16,6 +17,9 @@
 #include "param/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
+#include "tools/convert_pipeline.h"
+#include "tools/model_inputs.h"
+#include "tools/pack_models.h"
 #include "tools/progress.h"
 
 #include <nlohmann/json.hpp>
@@ -48,6 +52,8 @@ struct RdArgs {
   bool lindstrom_turk = false;  // also the draco_lt series (CGAL Lindstrom-Turk decimation) and its envelope
   std::size_t samples = 0;  // face samples per surface for the evaluation; 0 = surface_distance's default
   unsigned threads = 0;     // 0 = hardware_concurrency
+  int level = 8;            // geomip: geometry image level of the pack whose prefixes are measured
+  bool no_geomip = false;   // only the baselines
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -65,10 +71,10 @@ struct Series {
 
 /// The sweep parameters (the full sweep, or the --quick one for tests).
 struct Sweep {
-  std::vector<int> draco_bits;       // Draco on the full mesh
-  std::vector<std::size_t> faces;    // decimation targets (those below the mesh's face count are used)
-  std::vector<int> draco_qem_bits;   // Draco on each decimated mesh
-  std::vector<int> meshopt_bits;     // meshoptimizer's codec on the full mesh
+  std::vector<int> draco_bits;      // Draco on the full mesh
+  std::vector<std::size_t> faces;   // decimation targets (those below the mesh's face count are used)
+  std::vector<int> draco_qem_bits;  // Draco on each decimated mesh
+  std::vector<int> meshopt_bits;    // meshoptimizer's codec on the full mesh
 };
 
 Sweep make_sweep(bool quick) {
@@ -180,7 +186,8 @@ std::vector<Series> plan_series(const std::shared_ptr<const TriMesh>& original, 
 
   if (lindstrom_turk) {
     Series lt{"draco_lt", {}};
-    for (const auto& mesh : decimate_all(original, sweep, DecimationMethod::kLindstromTurk, threads, progress))
+    for (const auto& mesh :
+         decimate_all(original, sweep, DecimationMethod::kLindstromTurk, threads, progress))
       for (int q : sweep.draco_qem_bits) lt.jobs.push_back(draco_job("draco_lt", mesh, q));
     plan.push_back(std::move(lt));
   }
@@ -193,6 +200,65 @@ std::vector<Series> plan_series(const std::shared_ptr<const TriMesh>& original, 
   return plan;
 }
 
+/// The byte sizes at which geomip prefixes are measured: the sizes issue 5 names, plus a geometric sweep from
+/// just after the manifest to the whole pack.
+std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack_size, bool quick) {
+  std::set<std::size_t> sizes;
+  if (!quick)
+    for (std::size_t s : {1500, 2000, 4700, 8800, 12000, 16000, 21100, 32800, 42800}) sizes.insert(s);
+  const double lo = static_cast<double>(manifest_end + 100), hi = static_cast<double>(pack_size);
+  const int count = quick ? 4 : 20;
+  for (int k = 0; k < count && lo < hi; ++k)
+    sizes.insert(static_cast<std::size_t>(std::llround(lo * std::pow(hi / lo, k / double(count - 1)))));
+  std::vector<std::size_t> out;
+  for (std::size_t s : sizes)
+    if (s > manifest_end && s <= pack_size) out.push_back(s);
+  return out;
+}
+
+/// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only pack),
+/// then one job per prefix size: decode the first N bytes and build the level-N mesh.
+Series geomip_series(const std::string& mesh_path, int level, bool quick, std::vector<std::uint8_t>& pack_out,
+                     ProgressBar& progress) {
+  const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true);
+  ConvertOptions options;
+  options.level = level;
+  options.normals = false;
+  options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
+  auto pack = std::make_shared<const std::vector<std::uint8_t>>(convert_models(models, options).pack);
+  pack_out = *pack;
+  codec::PackInfo info;
+  codec::read_pack_info(*pack, info);
+  Series series{"geomip", {}};
+  for (std::size_t size : prefix_sizes(info.manifest_end, pack->size(), quick)) {
+    series.jobs.push_back([pack, size] {
+      codec::PackDecodeOptions decode;
+      decode.max_bytes = size;
+      decode.normals = false;
+      codec::PackDecodeResult result;
+      double best_ms = INFINITY;
+      for (int r = 0; r < 3; ++r) {
+        const auto t0 = std::chrono::steady_clock::now();
+        result = codec::decode_pack(*pack, decode);
+        best_ms = std::min(best_ms,
+                           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      }
+      if (result.models.empty())
+        throw SolverFailure("geomip rd: a " + std::to_string(size) + "-byte prefix of the pack does not decode");
+      Coded c;
+      c.decoded = decoded_mesh(result.models.front());
+      c.point.method = "geomip";
+      c.point.bytes = size;
+      c.point.decode_ms = best_ms;
+      c.point.faces = c.decoded.num_triangles();
+      c.point.vertices = c.decoded.num_vertices();
+      c.point.quantization_bits = 16;
+      return c;
+    });
+  }
+  return series;
+}
+
 /// Envelopes written as series of their own: name and the methods whose points they are taken over. An
 /// envelope is written when one of its methods has points that no earlier envelope covers.
 struct Envelope {
@@ -200,8 +266,9 @@ struct Envelope {
   std::set<std::string> methods;
 };
 const std::vector<Envelope> kEnvelopes = {
-    {"draco_envelope", {"draco", "draco_qem"}},                   // issue 5's Draco baseline
-    {"draco_lt_envelope", {"draco", "draco_qem", "draco_lt"}},  // with the stronger decimation (--lindstrom-turk)
+    {"draco_envelope", {"draco", "draco_qem"}},  // issue 5's Draco baseline
+    {"draco_lt_envelope",
+     {"draco", "draco_qem", "draco_lt"}},  // with the stronger decimation (--lindstrom-turk)
 };
 
 template <typename... T>
@@ -227,18 +294,22 @@ nlohmann::json point_to_json(const RdPoint& p) {
 }
 
 std::string point_row(const RdPoint& p) {
-  return format("%-15s %7zu %3d %9zu %9.2f %8.2f %9.4f %9.3f\n", p.method.c_str(), p.faces, p.quantization_bits,
-                p.bytes, static_cast<double>(p.bytes) / 1000.0, p.psnr_db, p.hausdorff_pct, p.decode_ms);
+  return format("%-15s %7zu %3d %9zu %9.2f %8.2f %9.4f %9.3f\n", p.method.c_str(), p.faces,
+                p.quantization_bits, p.bytes, static_cast<double>(p.bytes) / 1000.0, p.psnr_db,
+                p.hausdorff_pct, p.decode_ms);
 }
 
 int run_rd(const RdArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
-  const unsigned threads = args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads =
+      args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
   const Sweep sweep = make_sweep(args.quick);
 
   ProgressBar progress("rd", !args.json);
-  const std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
+  std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
+  std::vector<std::uint8_t> pack;
+  if (!args.no_geomip) plan.push_back(geomip_series(args.mesh, args.level, args.quick, pack, progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -261,7 +332,8 @@ int run_rd(const RdArgs& args) {
       d = measure_surface_distance(*original, c.decoded, distance_options);
     } catch (const InvalidInput& e) {  // the decoded mesh is ours, not the user's
       throw SolverFailure(c.point.method + " Q" + std::to_string(c.point.quantization_bits) + " " +
-                          std::to_string(c.point.faces) + " faces: cannot measure the decoded mesh: " + e.what());
+                          std::to_string(c.point.faces) +
+                          " faces: cannot measure the decoded mesh: " + e.what());
     }
     c.point.psnr_db = d.psnr_db;
     c.point.hausdorff_pct = d.hausdorff_pct;
@@ -303,6 +375,30 @@ int run_rd(const RdArgs& args) {
   const std::filesystem::path dir(args.output);
   write_file_atomically((dir / "rd.csv").string(), [&](std::ostream& out) { out << csv.str(); });
   write_file_atomically((dir / "rd.svg").string(), [&](std::ostream& out) { out << svg.str(); });
+  const std::string pack_path = (dir / (std::filesystem::path(args.mesh).stem().string() + ".gip")).string();
+  if (!pack.empty()) {
+    write_file_atomically(pack_path, [&](std::ostream& out) {
+      out.write(reinterpret_cast<const char*>(pack.data()), static_cast<std::streamsize>(pack.size()));
+    });
+  }
+
+  // geomip against the Draco envelope at the sizes issue 5 names (staircase readings of both curves).
+  std::vector<RdPoint> geomip_points, envelope_points;
+  for (const RdPoint& p : all) {
+    if (p.method == "geomip") geomip_points.push_back(p);
+    if (p.method == "draco_envelope") envelope_points.push_back(p);
+  }
+  const std::vector<RdPoint> geomip_front = upper_envelope(geomip_points);
+  nlohmann::json comparison = nlohmann::json::array();
+  std::string comparison_text;
+  if (!geomip_front.empty() && !envelope_points.empty()) {
+    comparison_text = format("%-9s %12s %16s %8s\n", "bytes", "geomip dB", "draco_envelope dB", "margin");
+    for (std::size_t size : {1500, 2000, 4700, 8800, 12000, 16000, 21100, 32800, 42800}) {
+      const double g = envelope_at(geomip_front, size), d = envelope_at(envelope_points, size);
+      comparison.push_back({{"bytes", size}, {"geomip_db", g}, {"draco_envelope_db", d}, {"margin_db", g - d}});
+      comparison_text += format("%-9zu %12.2f %16.2f %+8.2f\n", size, g, d, g - d);
+    }
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (args.json) {
@@ -313,6 +409,8 @@ int run_rd(const RdArgs& args) {
     j["csv"] = (dir / "rd.csv").string();
     j["svg"] = (dir / "rd.svg").string();
     j["seconds"] = seconds;
+    if (!pack.empty()) j["pack"] = pack_path;
+    j["geomip_vs_draco_envelope"] = comparison;
     j["points"] = nlohmann::json::array();
     for (const RdPoint& p : all) j["points"].push_back(point_to_json(p));
     std::cout << j.dump(2) << "\n";
@@ -331,6 +429,7 @@ int run_rd(const RdArgs& args) {
     std::cout << point_row(p);
   }
   std::cout << "(" << candidates << " decimate-then-Draco points, the envelopes' candidates, are in rd.csv)\n"
+            << comparison_text
             << "wrote " << (dir / "rd.csv").string() << " and " << (dir / "rd.svg").string()
             << format(" in %.1f s\n", seconds);
   return kExitOk;
@@ -350,12 +449,16 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
   cmd->add_flag("--json", args->json, "Print every point as JSON instead of the table");
   cmd->add_flag("--quick", args->quick, "A few points only, coarser evaluation (for tests)");
-  cmd->add_flag("--lindstrom-turk", args->lindstrom_turk,
-                "Also decimate with CGAL's Lindstrom-Turk edge collapse (series draco_lt, same faces x Q) and "
-                "write draco_lt_envelope over draco, draco_qem and draco_lt (needs a manifold MESH)");
+  cmd->add_flag(
+      "--lindstrom-turk", args->lindstrom_turk,
+      "Also decimate with CGAL's Lindstrom-Turk edge collapse (series draco_lt, same faces x Q) and "
+      "write draco_lt_envelope over draco, draco_qem and draco_lt (needs a manifold MESH)");
   cmd->add_option("--samples", args->samples,
                   "Face samples per surface for the evaluation (default: as `geomip eval`; --quick: 20000)");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)");
+  cmd->add_option("--level", args->level, "geomip: geometry image level of the measured pack (default 8)")
+      ->check(CLI::Range(1, 10));
+  cmd->add_flag("--no-geomip", args->no_geomip, "Only the baselines (no geomip pack)");
   return [args] { return run_rd(*args); };
 }
 

@@ -42,7 +42,8 @@ TEST(DracoBaseline, RoundTripKeepsFacesAndPositionsWithinTheQuantizationBound) {
     EXPECT_EQ(r.decoded.num_triangles(), mesh.num_triangles()) << "Q" << bits;
     EXPECT_EQ(r.decoded.num_vertices(), mesh.num_vertices()) << "Q" << bits;
     EXPECT_GT(r.decode_ms, 0.0);
-    // Each coordinate within half a step of the uniform grid (step = extent / (2^Q - 1)), plus float rounding.
+    // Each coordinate within half a step of the uniform grid (step = extent / (2^Q - 1)), plus float
+    // rounding.
     const double step = largest_extent(mesh) / (std::ldexp(1.0, bits) - 1);
     const double bound = std::sqrt(3.0) * (step / 2) * 1.0001 + 1e-6;
     EXPECT_LE(max_nearest_vertex_distance(r.decoded, mesh), bound) << "Q" << bits;

@@ -26,8 +26,8 @@ std::vector<PatchCoefficients> smooth_coefficients(int level, int steps, int np,
       for (int j = 0; j < n; ++j) {
         for (int i = 0; i < n; ++i) {
           const double u = static_cast<double>(i) / (n - 1), v = static_cast<double>(j) / (n - 1);
-          g[j * n + i] = static_cast<std::int32_t>(std::lround(30000 * std::sin(fx * u + 0.3 * c) * std::cos(fy * v) +
-                                                               20000 * u * v + noise(rng)));
+          g[j * n + i] = static_cast<std::int32_t>(std::lround(
+              30000 * std::sin(fx * u + 0.3 * c) * std::cos(fy * v) + 20000 * u * v + noise(rng)));
         }
       }
       wavelet_forward(g, level, steps, WaveletFilter::kCubic);
@@ -41,7 +41,8 @@ std::vector<std::vector<std::uint8_t>> all_coded(int level, int np) {
   return std::vector<std::vector<std::uint8_t>>(np, std::vector<std::uint8_t>(n * n, 1));
 }
 
-std::vector<std::span<const std::uint8_t>> spans(const std::vector<std::vector<std::uint8_t>>& segs, std::size_t k) {
+std::vector<std::span<const std::uint8_t>> spans(const std::vector<std::vector<std::uint8_t>>& segs,
+                                                 std::size_t k) {
   std::vector<std::span<const std::uint8_t>> out;
   for (std::size_t i = 0; i < k; ++i) out.emplace_back(segs[i]);
   return out;
@@ -122,8 +123,9 @@ TEST(BitplaneCoder, ErrorNeverIncreasesWithMoreBytes) {
 
 TEST(BitplaneCoder, EveryPrefixDecodesExactlyTheCodedBits) {
   // Each decoded coefficient lies in the uncertainty interval of the true one: its known bits are right, so
-  // |decoded − true| < 2^q ≤ |true| + ... ; simplest strong check: sign agrees and the error is below the true
-  // magnitude's interval width, i.e. decoded coefficients never have the wrong sign or a wrong known bit.
+  // |decoded − true| < 2^q ≤ |true| + ... ; simplest strong check: sign agrees and the error is below the
+  // true magnitude's interval width, i.e. decoded coefficients never have the wrong sign or a wrong known
+  // bit.
   const int level = 4;
   const BitplaneLayout layout{level, level, 2};
   const auto coefs = smooth_coefficients(level, level, 2, 5);

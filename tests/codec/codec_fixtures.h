@@ -45,10 +45,14 @@ inline std::vector<Grid3> two_patch_surface(int level, std::vector<PatchSeam>& s
 inline int side_sample(int level, int side, int k) {
   const int m = 1 << level, n = m + 1;
   switch (side) {
-    case 0: return k;
-    case 1: return k * n + m;
-    case 2: return m * n + (m - k);
-    default: return (m - k) * n;
+    case 0:
+      return k;
+    case 1:
+      return k * n + m;
+    case 2:
+      return m * n + (m - k);
+    default:
+      return (m - k) * n;
   }
 }
 

@@ -206,6 +206,42 @@ TEST(Pack, HoleMaskRoundTrips) {
   EXPECT_EQ(r.models[0].hole_mask, m.hole_mask);
 }
 
+// The manifest carries the hole masks two levels coarser; the fine masks arrive in their own chunk, and any
+// prefix before it decodes with the coarse ones.
+TEST(Pack, HoleMaskIsCoarseUntilItsChunkArrives) {
+  PackModelInput m = pillow_model(5, "holey");
+  m.hole_mask.assign(2, std::vector<std::uint8_t>(32 * 32, 0));
+  for (int j = 10; j < 17; ++j)
+    for (int i = 3; i < 12; ++i) m.hole_mask[0][static_cast<std::size_t>(j * 32 + i)] = 1;
+  PackWriteOptions options = geometry_only();
+  options.hole_mask_after_bytes = 200;
+  const std::vector<std::uint8_t> pack = write_pack({m}, options);
+  PackInfo info;
+  ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
+  const auto chunk = std::find_if(info.chunks.begin(), info.chunks.end(),
+                                  [](const ChunkInfo& c) { return c.kind == ChunkKind::kHoleMask; });
+  ASSERT_NE(chunk, info.chunks.end());
+  EXPECT_EQ(info.models[0].hole_mask_level, 3);
+  EXPECT_EQ(info.models[0].fine_hole_mask_level, 5);
+
+  const PackDecodeResult before = decode_pack(pack, {.max_bytes = static_cast<std::size_t>(chunk->offset + chunk->size - 1)});
+  ASSERT_EQ(before.models.size(), 1u);
+  EXPECT_EQ(before.models[0].hole_mask_level, 3);
+  // Coarse quad (ci, cj) covers fine quads [4ci, 4ci+4) × [4cj, 4cj+4): masked when half of them are.
+  const auto& coarse = before.models[0].hole_mask[0];
+  ASSERT_EQ(coarse.size(), 64u);
+  for (int cj = 0; cj < 8; ++cj)
+    for (int ci = 0; ci < 8; ++ci) {
+      int count = 0;
+      for (int j = 4 * cj; j < 4 * cj + 4; ++j)
+        for (int i = 4 * ci; i < 4 * ci + 4; ++i) count += m.hole_mask[0][static_cast<std::size_t>(j * 32 + i)];
+      EXPECT_EQ(coarse[static_cast<std::size_t>(cj * 8 + ci)], count >= 8 ? 1 : 0) << ci << "," << cj;
+    }
+  const PackDecodeResult after = decode_pack(pack, {.max_bytes = static_cast<std::size_t>(chunk->offset + chunk->size)});
+  EXPECT_EQ(after.models[0].hole_mask_level, 5);
+  EXPECT_EQ(after.models[0].hole_mask, m.hole_mask);
+}
+
 TEST(Pack, WriterRejectsBadInput) {
   EXPECT_THROW(write_pack({}), std::invalid_argument);
   PackModelInput m = pillow_model(3, "a");

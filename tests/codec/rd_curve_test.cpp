@@ -90,7 +90,8 @@ TEST(EnvelopeAt, IsAMonotoneStaircase) {
   for (const RdPoint& f : front) EXPECT_EQ(envelope_at(front, f.bytes), f.psnr_db);
 }
 
-// Tag balance of an XML text: every <x ...> closed by </x> in order, self-closing tags and the prolog skipped.
+// Tag balance of an XML text: every <x ...> closed by </x> in order, self-closing tags and the prolog
+// skipped.
 bool balanced_tags(const std::string& xml, std::string& why) {
   std::vector<std::string> stack;
   std::size_t i = 0;
@@ -125,8 +126,8 @@ std::vector<RdPoint> sample_curve() {
   for (int q = 6; q <= 12; ++q) points.push_back(point("draco", 15000 + 2000 * q, 40 + 3.5 * q));
   for (int f = 1; f <= 5; ++f) points.push_back(point("draco_qem", 1000 * f, 50 + 4.0 * f));
   points.push_back(point("meshopt", 60000, 95.5));
-  points.push_back(point("a<b&\"c\"", 3000, 61));  // a method name that needs escaping
-  points.push_back(point("draco", 0, 30));          // not plottable: zero bytes
+  points.push_back(point("a<b&\"c\"", 3000, 61));     // a method name that needs escaping
+  points.push_back(point("draco", 0, 30));            // not plottable: zero bytes
   points.push_back(point("draco", 99000, INFINITY));  // not plottable: lossless
   return points;
 }

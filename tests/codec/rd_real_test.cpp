@@ -27,7 +27,8 @@ TEST(RdReal, DracoOnTheBunnyMatchesTheIssuesFigures) {
     options.quantization_bits = e.bits;
     options.decode_runs = 1;
     const DracoResult r = draco_encode(bunny, options);
-    EXPECT_NEAR(static_cast<double>(r.bytes.size()), static_cast<double>(e.bytes), 0.01 * e.bytes) << "Q" << e.bits;
+    EXPECT_NEAR(static_cast<double>(r.bytes.size()), static_cast<double>(e.bytes), 0.01 * e.bytes)
+        << "Q" << e.bits;
     EXPECT_EQ(r.decoded.num_triangles(), bunny.num_triangles());
     SurfaceDistanceOptions eval;
     eval.face_samples = 200000;

@@ -14,16 +14,6 @@
 
 namespace geomip::test {
 
-inline ParameterizationInput automatic_input(const TriMesh& mesh, const std::string& name) {
-  ParameterizationInput in;
-  in.mesh = mesh;
-  in.name = name;
-  const PartitionPoints points = choose_partition_points(mesh);
-  in.partition_points = points.partition_points;
-  in.auxiliary_points = points.auxiliary_points;
-  return in;
-}
-
 inline ParameterizationOptions quick_options() {
   ParameterizationOptions options;
   options.measure_mvc_baseline = false;

@@ -86,18 +86,8 @@ void expect_valid(const ModelParameterization& m, const std::string& name) {
   EXPECT_EQ(triangles, m.mesh.triangles.size());
 }
 
-ParameterizationInput automatic(const TriMesh& mesh, const std::string& name) {
-  ParameterizationInput in;
-  in.mesh = mesh;
-  in.name = name;
-  const PartitionPoints points = choose_partition_points(mesh);
-  in.partition_points = points.partition_points;
-  in.auxiliary_points = points.auxiliary_points;
-  return in;
-}
-
 TEST(ConsistentParameterization, SphereGivesTwoValidSquares) {
-  const auto result = parameterize_consistently({automatic(test::sphere(4), "sphere")});
+  const auto result = parameterize_consistently({test::automatic_input(test::sphere(4), "sphere")});
   ASSERT_EQ(result.size(), 1u);
   ASSERT_EQ(result[0].patches.size(), 2u);
   expect_valid(result[0], "sphere");
@@ -105,7 +95,7 @@ TEST(ConsistentParameterization, SphereGivesTwoValidSquares) {
 }
 
 TEST(ConsistentParameterization, TorusGivesFourValidSquares) {
-  const auto result = parameterize_consistently({automatic(test::torus(48, 24), "torus")});
+  const auto result = parameterize_consistently({test::automatic_input(test::torus(48, 24), "torus")});
   ASSERT_EQ(result[0].patches.size(), 4u);
   expect_valid(result[0], "torus");
 }
@@ -140,7 +130,7 @@ TEST(ConsistentParameterization, FeaturesAlignAcrossModels) {
 
 TEST(ConsistentParameterization, RejectsBadInput) {
   const TriMesh s = test::sphere(3);
-  ParameterizationInput in = automatic(s, "s");
+  ParameterizationInput in = test::automatic_input(s, "s");
   {
     ParameterizationInput bad = in;
     bad.partition_points[1] = bad.partition_points[0];
@@ -175,7 +165,7 @@ TEST_P(SharedMeshParameterization, EveryPatchIsAValidSquareAndSeamsAgree) {
   TriMesh mesh = read_mesh(path);
   const TopologyReport r = analyze_topology(mesh);
   if (r.boundary_loops > 0 || !r.manifold) mesh = repair_mesh(mesh).mesh;
-  const auto result = parameterize_consistently({automatic(mesh, GetParam())});
+  const auto result = parameterize_consistently({test::automatic_input(mesh, GetParam())});
   expect_valid(result[0], GetParam());
 }
 
@@ -194,7 +184,7 @@ INSTANTIATE_TEST_SUITE_P(Shared, SharedMeshParameterization,
 TEST(ConsistentParameterizationReal, StretchOptimizationBeatsMvcOnTheBunny) {
   GEOMIP_REQUIRE_SHARED_MESH(path, "bunny.obj");
   const TriMesh bunny = repair_mesh(read_mesh(path)).mesh;
-  const auto result = parameterize_consistently({automatic(bunny, "bunny")});
+  const auto result = parameterize_consistently({test::automatic_input(bunny, "bunny")});
   for (const auto& p : result[0].patches) {
     EXPECT_LE(p.stretch.l2, 0.8 * p.mvc_stretch.l2) << "MVC " << p.mvc_stretch.l2 << " → " << p.stretch.l2;
   }

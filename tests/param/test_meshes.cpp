@@ -1,5 +1,7 @@
 #include "tests/param/test_meshes.h"
 
+#include "param/partition_points.h"
+
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -147,6 +149,16 @@ std::string temp_dir(const std::string& tag) {
                    ("geomip-" + tag + "-" + std::to_string(rd()) + std::to_string(rd()));
   std::filesystem::create_directories(dir);
   return dir.string();
+}
+
+ParameterizationInput automatic_input(const TriMesh& mesh, const std::string& name) {
+  ParameterizationInput in;
+  in.mesh = mesh;
+  in.name = name;
+  const PartitionPoints points = choose_partition_points(mesh);
+  in.partition_points = points.partition_points;
+  in.auxiliary_points = points.auxiliary_points;
+  return in;
 }
 
 }  // namespace geomip::test

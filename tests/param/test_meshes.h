@@ -1,6 +1,7 @@
 // Small synthetic meshes for property tests, and access to ../shared/meshes.
 #pragma once
 
+#include "param/consistent_parameterization.h"
 #include "param/mesh.h"
 
 #include <string>
@@ -32,6 +33,9 @@ TriMesh join(const TriMesh& a, const TriMesh& b);
 std::string shared_mesh(const std::string& name);
 /// A fresh empty directory under the system temp dir, for test outputs.
 std::string temp_dir(const std::string& tag);
+
+/// A parameterization input with automatically chosen partition (and auxiliary) points.
+ParameterizationInput automatic_input(const TriMesh& mesh, const std::string& name);
 
 }  // namespace geomip::test
 

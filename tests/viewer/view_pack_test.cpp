@@ -195,6 +195,41 @@ TEST_F(ViewPackTest, ConvertedMeshCoversItsSilhouetteWithoutCracks) {
     EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "no cracks at level " << level;
   }
 }
+
+// An open real mesh (the camel head, cut at the neck): `geomip convert` fills the hole and the pack marks the
+// fill in its hole masks; the viewer leaves those quads out, exactly as the CPU reference does.
+TEST_F(ViewPackTest, RepairedMeshLeavesItsHoleMaskedQuadsOut) {
+  const fs::path mesh = fs::path(GEOMIP_SHARED_MESHES) / "camelhead.obj";
+  if (!fs::exists(mesh)) GTEST_SKIP() << mesh << " not found (../shared/meshes)";
+  const fs::path pack = work_dir() / "camelhead.gip";
+  const std::string convert =
+      std::string(GEOMIP_BINARY) + " convert -q " + mesh.string() + " --level 6 -o " + pack.string();
+  ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+  const auto models = decode_file(pack);
+  ASSERT_EQ(models.size(), 1u);
+  ASSERT_FALSE(models[0].holes.empty()) << "the repaired camel head should carry a hole mask";
+  EXPECT_GT(count(models[0].holes), 0u);
+  SceneModel unmasked = models[0];
+  unmasked.holes.clear();
+  for (float yaw : {0.6f, 2.5f, 4.0f}) {
+    Camera camera;
+    camera.yaw = yaw;
+    camera.distance = 2.0f;
+    const fs::path png = work_dir() / ("camel_" + std::to_string(int(yaw * 10)) + ".png");
+    std::ostringstream args;
+    args << pack.string() << " " << size_args() << " --yaw " << yaw << " --distance 2 --screenshot " << png.string();
+    const ViewRun r = view(args.str());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto image = image_coverage(load(png));
+    const auto reference = cpu_coverage(models[0], models[0].level, camera, kW, kH);
+    EXPECT_GT(iou(image, reference), 0.95) << "yaw " << yaw;
+    EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "yaw " << yaw;
+    EXPECT_LT(count(image), count(cpu_coverage(unmasked, unmasked.level, camera, kW, kH)))
+        << "the filled hole is not drawn (yaw " << yaw << ")";
+    std::cout << "yaw " << yaw << ": " << count(image) << " pixels drawn, "
+              << count(cpu_coverage(unmasked, unmasked.level, camera, kW, kH)) << " with the fill\n";
+  }
+}
 #endif
 
 TEST_F(ViewPackTest, MorphEndPointsAndWaveletMidpoint) {

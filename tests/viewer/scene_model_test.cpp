@@ -71,3 +71,44 @@ TEST(SceneModel, BandsSumToTheFullGeometry) {
 
 }  // namespace
 }  // namespace geomip::viewer
+
+namespace geomip::viewer {
+namespace {
+
+// What the streaming viewer does with every prefix that arrives: decode_scene never throws on a prefix, and
+// gives either nothing (no geometry pass of model 0 yet) or both models at the pack's level, finite, with
+// more bytes never giving fewer models.
+TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
+  const auto bytes = codec::write_pack({testing::pack_input(4, 0), testing::pack_input(4, 1)});
+  bool seen_models = false;
+  for (std::size_t n = 0; n <= bytes.size(); n += (n < 64 ? 1 : 37)) {
+    codec::Status status = codec::Status::kOk;
+    std::size_t used = 0;
+    std::vector<SceneModel> models;
+    for (int bands : {1, 3}) {
+      ASSERT_NO_THROW(models = decode_scene({bytes.data(), n}, DecodeSettings{.bands = bands}, status, used))
+          << n << " bytes";
+      EXPECT_LE(used, n);
+      if (models.empty()) {
+        EXPECT_FALSE(seen_models && bands == 1) << "a longer prefix lost the models at " << n << " bytes";
+        continue;
+      }
+      if (bands == 1) seen_models = true;
+      ASSERT_EQ(models.size(), 2u);
+      for (const auto& m : models) {
+        EXPECT_EQ(m.level, 4);
+        EXPECT_EQ(m.bands, bands);
+        for (float v : m.positions) ASSERT_TRUE(std::isfinite(v)) << n << " bytes";
+      }
+    }
+  }
+  EXPECT_TRUE(seen_models);
+  codec::Status status;
+  std::size_t used = 0;
+  EXPECT_EQ(decode_scene(bytes, {}, status, used).size(), 2u);
+  EXPECT_EQ(status, codec::Status::kOk);
+  EXPECT_EQ(used, bytes.size());
+}
+
+}  // namespace
+}  // namespace geomip::viewer

@@ -24,6 +24,7 @@ struct FetchAccess {
     auto* r = static_cast<Range*>(user);
     const std::size_t n = size * nmemb;
     if (r->self->cancel_.load()) return 0;  // aborts the transfer
+    if (r->at >= r->end) return 0;  // more than asked: the server ignores Range (see fetch_http_whole)
     const std::uint64_t room = r->end - r->at;
     const std::size_t take = static_cast<std::size_t>(std::min<std::uint64_t>(room, n));
     if (r->header) {
@@ -33,7 +34,52 @@ struct FetchAccess {
       r->self->publish(r->at + take);
     }
     r->at += take;
-    return n;  // bytes beyond the range (a server that ignores Range) are dropped, the status check catches it
+    return take == n ? n : 0;
+  }
+
+  // Whole-file GET for servers without Range support: header and manifest first, then the buffer is sized
+  // and the rest streams into it, published as it comes.
+  struct Whole {
+    Fetcher* self;
+    std::vector<std::uint8_t> head;
+    std::size_t manifest_end = 0;
+    std::uint64_t at = 0, total = 0;
+    std::string error;
+  };
+
+  static std::size_t write_whole(char* ptr, std::size_t size, std::size_t nmemb, void* user) {
+    auto* w = static_cast<Whole*>(user);
+    const std::size_t n = size * nmemb;
+    if (w->self->cancel_.load()) return 0;
+    if (w->total == 0) {
+      w->head.insert(w->head.end(), ptr, ptr + n);
+      if (w->manifest_end == 0 && w->head.size() >= codec::kPackHeaderSize) {
+        const codec::Status st = codec::read_pack_header(w->head, w->manifest_end);
+        if (st != codec::Status::kOk) {
+          w->error = "not a .gip pack (" + std::string(codec::status_message(st)) + ")";
+          return 0;
+        }
+      }
+      if (w->manifest_end == 0 || w->head.size() < w->manifest_end) return n;
+      codec::PackInfo info;
+      const codec::Status st = codec::read_pack_info(w->head, info);
+      if (st != codec::Status::kOk) {
+        w->error = "not a readable .gip pack (manifest: " + std::string(codec::status_message(st)) + ")";
+        return 0;
+      }
+      w->total = std::max<std::uint64_t>(info.file_size(), w->manifest_end);
+      w->self->buffer_.assign(w->total, 0);
+      w->at = std::min<std::uint64_t>(w->head.size(), w->total);
+      std::copy(w->head.begin(), w->head.begin() + static_cast<std::ptrdiff_t>(w->at), w->self->buffer_.begin());
+      w->self->total_.store(w->total, std::memory_order_release);
+      w->self->publish(w->at);
+      return n;
+    }
+    const std::size_t take = static_cast<std::size_t>(std::min<std::uint64_t>(w->total - w->at, n));
+    std::memcpy(w->self->buffer_.data() + w->at, ptr, take);
+    w->at += take;
+    w->self->publish(w->at);
+    return n;
   }
 
   // Called by libcurl often, also while no byte arrives: lets the destructor cancel a stalled transfer.
@@ -167,7 +213,8 @@ void Fetcher::fetch_http() {
   if (options_.limit_rate > 0)
     curl_easy_setopt(curl, CURLOPT_MAX_RECV_SPEED_LARGE, static_cast<curl_off_t>(options_.limit_rate));
 
-  // One range request [begin, end) → buffer (or `header`). Returns false with the error set.
+  bool no_ranges = false;
+  // One range request [begin, end) → buffer (or `header`). Returns false with the error set (or no_ranges).
   auto request = [&](std::uint64_t begin, std::uint64_t end, std::vector<std::uint8_t>* header) -> bool {
     FetchAccess::Range r{this, begin, end, begin, header};
     const std::string range = std::to_string(begin) + "-" + std::to_string(end - 1);
@@ -182,12 +229,16 @@ void Fetcher::fetch_http() {
       fail(source_ + ": HTTP " + status_text(code));
       return false;
     }
+    if (code == 200 && begin == 0 && header) {
+      no_ranges = true;  // the server sends the whole file: fetch it in one GET instead
+      return false;
+    }
     if (rc != CURLE_OK) {
       fail(source_ + ": connection failed after " + std::to_string(r.at) + " bytes: " +
            (curl_error[0] ? curl_error : curl_easy_strerror(rc)));
       return false;
     }
-    if (code != 206 && !(code == 200 && begin == 0)) {
+    if (code != 206) {
       fail(source_ + ": server does not answer range requests (HTTP " + std::to_string(code) + ")");
       return false;
     }
@@ -204,6 +255,11 @@ void Fetcher::fetch_http() {
   codec::PackInfo info;
   std::string err;
   bool ok = request(0, codec::kPackHeaderSize, &head);
+  if (no_ranges) {
+    fetch_http_whole(curl, curl_error);
+    curl_easy_cleanup(curl);
+    return;
+  }
   if (ok) {
     const codec::Status st = codec::read_pack_header(head, manifest_end);
     if (st != codec::Status::kOk) {
@@ -233,6 +289,28 @@ void Fetcher::fetch_http() {
     }
   }
   curl_easy_cleanup(curl);
+}
+
+void Fetcher::fetch_http_whole(void* handle, char* curl_error) {
+  CURL* curl = static_cast<CURL*>(handle);
+  FetchAccess::Whole w{this, {}, 0, 0, 0, {}};
+  curl_easy_setopt(curl, CURLOPT_RANGE, nullptr);
+  curl_easy_setopt(curl, CURLOPT_WRITEFUNCTION, &FetchAccess::write_whole);
+  curl_easy_setopt(curl, CURLOPT_WRITEDATA, &w);
+  curl_error[0] = 0;
+  const CURLcode rc = curl_easy_perform(curl);
+  long code = 0;
+  curl_easy_getinfo(curl, CURLINFO_RESPONSE_CODE, &code);
+  if (cancel_) return;
+  if (!w.error.empty()) return fail(source_ + ": " + w.error);
+  if (code >= 400) return fail(source_ + ": HTTP " + status_text(code));
+  if (rc != CURLE_OK)
+    return fail(source_ + ": connection failed after " + std::to_string(w.at) + " bytes: " +
+                (curl_error[0] ? curl_error : curl_easy_strerror(rc)));
+  if (w.total == 0) return fail(source_ + ": not a .gip pack (too short)");
+  if (w.at < w.total)
+    fail(source_ + ": connection closed after " + std::to_string(w.at) + " of " + std::to_string(w.total) +
+         " bytes");
 }
 
 }  // namespace geomip::viewer

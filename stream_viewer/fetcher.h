@@ -45,6 +45,8 @@ class Fetcher {
   void run();
   void fetch_file();
   void fetch_http();
+  /// One plain GET for servers that ignore Range (answer 200 with the whole file); `handle` is the CURL*.
+  void fetch_http_whole(void* handle, char* curl_error);
   void fail(std::string message);
   /// Grows the buffer to `size` (only before readers may see data beyond received()).
   void publish(std::uint64_t received);

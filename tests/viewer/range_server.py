@@ -3,6 +3,7 @@
 
 Python's http.server ignores Range headers; this one answers them (206 + Content-Range). Options:
   --rate BYTES_PER_S   throttle every response body (sleeps between 4 KiB blocks)
+  --no-ranges          ignore Range headers, like Python's http.server (200 + the whole file)
   --die-after BYTES    after sending this many body bytes in total, drop the connection mid-body and exit
                        (the server "killed mid-stream")
 It prints "PORT <n>" on stdout once listening (port 0 = any free port).
@@ -30,7 +31,7 @@ class Handler(BaseHTTPRequestHandler):
             return
         size = os.path.getsize(path)
         begin, end = 0, size - 1
-        m = re.match(r"bytes=(\d+)-(\d*)$", self.headers.get("Range", ""))
+        m = None if args.no_ranges else re.match(r"bytes=(\d+)-(\d*)$", self.headers.get("Range", ""))
         if m:
             begin = int(m.group(1))
             end = min(int(m.group(2)), size - 1) if m.group(2) else size - 1
@@ -76,6 +77,7 @@ def main():
     p.add_argument("--port", type=int, default=0)
     p.add_argument("--rate", type=float, default=0)
     p.add_argument("--die-after", type=int, default=None)
+    p.add_argument("--no-ranges", action="store_true", help="ignore Range headers (answer 200, whole file)")
     args = p.parse_args()
     server = ThreadingHTTPServer(("127.0.0.1", args.port), Handler)
     print("PORT %d" % server.server_address[1], flush=True)

@@ -280,6 +280,24 @@ TEST_F(ViewPackTest, StreamingShowsACoarseModelFromTheFirstFewPercent) {
   EXPECT_GT(iou(image_coverage(load(last)), full), 0.95) << "the final frame is the full model";
 }
 
+TEST_F(ViewPackTest, ServerWithoutRangeSupportStreamsTheWholeFile) {
+  const fs::path pack = pack_file(7);
+  const auto total = fs::file_size(pack);
+  Server server({"--no-ranges", "--rate", std::to_string(total / 4)});
+  ASSERT_GT(server.port(), 0);
+  const fs::path first = work_dir() / "noranges_first.png", last = work_dir() / "noranges_last.png";
+  const ViewRun r = view(server.url(pack.filename().string()) + " " + size_args() + " --first-screenshot " +
+                         first.string() + " --screenshot " + last.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto at = r.out.find("first screenshot from ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::uint64_t shown = 0;
+  std::istringstream(r.out.substr(at + 22)) >> shown;
+  EXPECT_LT(shown, total / 2) << "one plain GET still shows coarse levels before the end";
+  const auto models = decode_file(pack);
+  EXPECT_GT(iou(image_coverage(load(last)), cpu_coverage(models[0], models[0].level, Camera{}, kW, kH)), 0.95);
+}
+
 TEST_F(ViewPackTest, ServerKilledMidStreamKeepsTheLastCompleteLevel) {
   const fs::path pack = pack_file(7);
   const auto total = fs::file_size(pack);

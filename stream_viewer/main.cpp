@@ -275,8 +275,8 @@ int run(const Options& opt) {
     }
     const std::string err = source.error();
     if (!have_models) {
-      std::cerr << "geomip-view: nothing to show from " << opt.source
-                << (err.empty() ? std::string(" (no geometry)") : ": " + err) << "\n";
+      std::cerr << "geomip-view: nothing to show"
+                << (err.empty() ? " from " + opt.source + " (no geometry arrived)" : " (" + err + ")") << "\n";
       exit_code = kExitBadInput;
     } else if (!source.complete()) {
       std::cerr << "geomip-view: incomplete stream: kept the level from " << shown_bytes << " of " << total

@@ -213,7 +213,9 @@ void Renderer::set_models(const std::vector<SceneModel>& models) {
     ModelGpu g;
     g.level = m.level;
     g.num_patches = m.num_patches;
-    g.bands = std::min(m.bands, kMaxBands);
+    if (m.bands < 1 || m.bands > kMaxBands || m.num_patches < 1)
+      throw std::invalid_argument("Renderer::set_models: 1 to 8 bands and at least one patch per model");
+    g.bands = m.bands;
     g.geometry = make_array(GL_RGB32F, GL_RGB, GL_FLOAT, m.size(), m.num_patches * m.bands, m.positions.data(),
                             GL_NEAREST);
     if (m.normal_level >= 0) {

@@ -39,7 +39,7 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  /// Replaces the models (uploads their textures).
+  /// Replaces the models (uploads their textures). Throws std::invalid_argument for more than 8 bands.
   void set_models(const std::vector<SceneModel>& models);
   int model_count() const;
   /// Grid level n of model `i`, or −1.

@@ -94,7 +94,7 @@ struct PackModelInput {
 };
 
 struct PackWriteOptions {
-  GeometryCodecOptions geometry;  ///< defaults: 16 bits, cubic interpolating wavelet
+  GeometryCodecOptions geometry;  ///< defaults: 14 bits, cubic interpolating wavelet
   GeometryCodecOptions normal_codec{.quantization_bits = 10, .filter = WaveletFilter::kCubic, .steps = -1};
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.

@@ -23,7 +23,7 @@ struct ConvertArgs {
   ModelArgs common;
   int level = 8;
   int normal_level = -1;
-  int quantization_bits = 16;
+  int quantization_bits = 14;
   int hole_mask_level = -1;
   bool no_normals = false;
 };
@@ -104,7 +104,7 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_option("--level", args->level, "Grid level N in [1, 10] (default 8: 257² samples per patch)");
   cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
   cmd->add_option("--bits", args->quantization_bits,
-                  "Position quantization bits over the largest bounding-box extent (default 16)");
+                  "Position quantization bits over the largest bounding-box extent (default 14)");
   cmd->add_option("--hole-mask-level", args->hole_mask_level,
                   "Grid level of the mask of filled holes (default: N; coarser costs fewer bytes)");
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack (for rate–distortion comparisons)");

@@ -48,7 +48,7 @@ int run_decode(const DecodeArgs& args) {
   codec::PackDecodeResult decoded = codec::decode_pack(bytes, options);
   const double decode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
-  const bool prefix_asked = args.bytes >= 0 && static_cast<std::size_t>(args.bytes) < bytes.size();
+  const bool prefix_asked = args.bytes >= 0;
   if (decoded.status == codec::Status::kTruncated && !prefix_asked) {
     throw InvalidInput(args.pack + ": the pack is truncated (" + std::to_string(bytes.size()) + " of " +
                        std::to_string(decoded.info.file_size()) +

@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 struct EncodeArgs {
   std::vector<std::string> inputs;
   std::string output;
-  int quantization_bits = 16;
+  int quantization_bits = 14;
   bool no_normals = false;
   bool json = false;
   bool quiet = false;
@@ -139,7 +139,7 @@ CommandRunner add_encode_command(CLI::App& app) {
   cmd->add_option("inputs", args->inputs, "Directories or .geometry.exr files")->required();
   cmd->add_option("-o,--output", args->output, "Output pack file (.gip)")->required();
   cmd->add_option("--bits", args->quantization_bits,
-                  "Position quantization bits over the largest bounding-box extent (default 16)");
+                  "Position quantization bits over the largest bounding-box extent (default 14)");
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack");
   cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No report");

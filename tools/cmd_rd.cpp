@@ -252,7 +252,7 @@ Series geomip_series(const std::string& mesh_path, int level, bool quick, std::v
       c.point.decode_ms = best_ms;
       c.point.faces = c.decoded.num_triangles();
       c.point.vertices = c.decoded.num_vertices();
-      c.point.quantization_bits = 16;
+      c.point.quantization_bits = ConvertOptions{}.quantization_bits;
       return c;
     });
   }

@@ -15,7 +15,7 @@ struct ConvertOptions {
   int level = 8;              ///< geometry image level N: (2^N+1)² samples per patch
   int normal_level = -1;      ///< normal map level (-1: N+1, at most 10)
   bool normals = true;        ///< false: geometry-only pack
-  int quantization_bits = 16; ///< position quantization over the largest bounding-box extent
+  int quantization_bits = 14; ///< position quantization over the largest bounding-box extent
   /// Level of the hole-mask grid (repaired meshes); -1 = the geometry's level.
   int hole_mask_level = -1;
   ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode"

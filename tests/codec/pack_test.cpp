@@ -73,8 +73,8 @@ TEST(Pack, RoundTripWithinQuantization) {
   for (std::size_t m = 0; m < 2; ++m) {
     EXPECT_EQ(r.models[m].name, models[m].name);
     const double extent = m == 0 ? 2.0 : 4.0;
-    // 16 bits over the largest extent: rounding to the step, plus float rounding of the output.
-    EXPECT_LE(max_error(r.models[m].geometry, models[m].geometry), extent / 65536.0 * 0.5 + 1e-6);
+    // 14 bits (the default) over the largest extent: rounding to the step, plus float rounding of the output.
+    EXPECT_LE(max_error(r.models[m].geometry, models[m].geometry), extent / 16384.0 * 0.5 + 1e-6);
     EXPECT_EQ(seam_mismatches(r.models[m].geometry, r.models[m].seams), 0u);
   }
 }
@@ -264,7 +264,7 @@ TEST(Pack, GoldenPackDecodes) {
   const std::vector<PackModelInput> expected = {pillow_model(5, "a", 1.0, true), pillow_model(5, "b", 2.0, true)};
   for (std::size_t m = 0; m < 2; ++m) {
     EXPECT_EQ(r.models[m].name, expected[m].name);
-    EXPECT_LE(max_error(r.models[m].geometry, expected[m].geometry), (m == 0 ? 2.0 : 4.0) / 65536.0);
+    EXPECT_LE(max_error(r.models[m].geometry, expected[m].geometry), (m == 0 ? 2.0 : 4.0) / 16384.0);
     ASSERT_EQ(r.models[m].normals.size(), 2u);
     EXPECT_LE(max_error(r.models[m].normals, expected[m].normals), 4.0 / 1024);
   }

@@ -53,9 +53,25 @@ TEST_F(RdCli, QuickRunWritesCsvAndSvg) {
   std::istringstream lines(csv);
   std::string line;
   std::getline(lines, line);
-  while (std::getline(lines, line)) methods.insert(line.substr(0, line.find(',')));
-  EXPECT_EQ(methods, (std::set<std::string>{"draco", "draco_qem", "draco_envelope", "meshopt"}));
-  for (const char* method : {"draco", "draco_qem", "draco_envelope", "meshopt"})
+  // geomip's prefixes: sizes increasing, and the whole pack never worse than its smallest prefix.
+  std::vector<std::pair<double, double>> geomip_points;  // bytes, psnr
+  while (std::getline(lines, line)) {
+    const std::string method = line.substr(0, line.find(','));
+    methods.insert(method);
+    if (method == "geomip") {
+      std::istringstream fields(line.substr(method.size() + 1));
+      double bytes = 0, psnr = 0;
+      char comma;
+      fields >> bytes >> comma >> psnr;
+      geomip_points.push_back({bytes, psnr});
+    }
+  }
+  EXPECT_EQ(methods, (std::set<std::string>{"draco", "draco_qem", "draco_envelope", "meshopt", "geomip"}));
+  ASSERT_GE(geomip_points.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(geomip_points.begin(), geomip_points.end()));
+  EXPECT_GT(geomip_points.back().second, geomip_points.front().second + 5);
+  EXPECT_TRUE(fs::exists(fs::path(out_dir) / "sphere.gip"));
+  for (const char* method : {"draco", "draco_qem", "draco_envelope", "meshopt", "geomip"})
     EXPECT_NE(svg.find(std::string("data-method=\"") + method + "\""), std::string::npos) << method;
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
   // No temporary files left beside the outputs.
@@ -64,7 +80,7 @@ TEST_F(RdCli, QuickRunWritesCsvAndSvg) {
     (void)entry;
     ++files;
   }
-  EXPECT_EQ(files, 2u);
+  EXPECT_EQ(files, 3u);  // rd.csv, rd.svg, sphere.gip
 }
 
 TEST_F(RdCli, MissingMeshFailsCleanly) {

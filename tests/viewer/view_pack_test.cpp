@@ -232,6 +232,32 @@ TEST_F(ViewPackTest, RepairedMeshLeavesItsHoleMaskedQuadsOut) {
 }
 #endif
 
+// The committed golden pack (format version 1, two pillows, level 5): the viewer reads the codec's own
+// reference stream, each model covers its silhouette, and the morph ends at each model.
+TEST_F(ViewPackTest, GoldenPackRendersBothModelsAndTheirMorph) {
+  const fs::path pack = fs::path(GEOMIP_SOURCE_DIR) / "tests/data/golden-pillow.gip";
+  const auto models = decode_file(pack);
+  ASSERT_EQ(models.size(), 2u);
+  std::vector<std::vector<std::uint8_t>> alone;
+  for (int m = 0; m < 2; ++m) {
+    const fs::path png = work_dir() / ("golden_" + std::to_string(m) + ".png");
+    const ViewRun r = view(pack.string() + " " + size_args() + " --model " + std::to_string(m) + " --screenshot " +
+                           png.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    alone.push_back(load(png));
+    const auto reference = cpu_coverage(models[m], models[m].level, Camera{}, kW, kH);
+    EXPECT_GT(iou(image_coverage(alone.back()), reference), 0.95) << "model " << m;
+    EXPECT_EQ(interior_misses(image_coverage(alone.back()), reference, kW, kH), 0u) << "model " << m;
+  }
+  for (int end = 0; end < 2; ++end) {
+    const fs::path png = work_dir() / ("golden_t" + std::to_string(end) + ".png");
+    const ViewRun r = view(pack.string() + " " + size_args() + " --morph " + std::to_string(end) + " --screenshot " +
+                           png.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_LT(differing(load(png), alone[end], 2), 0.001) << "t = " << end;
+  }
+}
+
 TEST_F(ViewPackTest, MorphEndPointsAndWaveletMidpoint) {
   const fs::path pack = pack_file(6);
   auto shot = [&](const std::string& name, const std::string& args) {

@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
   add(add_encode_command(app));
   add(add_decode_command(app));
   add(add_rd_command(app));
+#ifdef GEOMIP_WITH_MORPH
+  add(add_morph_command(app));
+#endif
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,335 @@
+// geomip-view: progressive file/HTTP streaming viewer of .gip packs (issue 6; Praun, Sweldens, Schröder 2001
+// §6). Exit codes: 0 ok (whole pack shown); 2 bad usage, or nothing could be shown (missing file, HTTP error,
+// not a pack); 3 the stream failed part-way (the last complete level was shown and written); 1 internal
+// failure (OpenGL).
+#include <CLI/CLI.hpp>
+#include <epoxy/gl.h>
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "stream_viewer/pack_source.h"
+#include "stream_viewer/png_write.h"
+#include "stream_viewer/renderer.h"
+
+namespace {
+
+using namespace geomip::viewer;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kExitOk = 0, kExitFailure = 1, kExitBadInput = 2, kExitPartial = 3;
+
+struct Options {
+  std::string source;
+  int level = -1;
+  std::optional<float> morph;
+  std::string schedule = "linear";
+  int bands = 5;
+  int model = 0;
+  bool animate = false;
+  int frames = 0;
+  int width = 1280, height = 720;
+  std::string screenshot, first_screenshot;
+  bool bench = false, checker = false, wireframe = false;
+  std::uint64_t limit_rate = 0;
+  double timeout = 120;
+  float yaw = 0.6f, pitch = 0.35f, distance = 3.2f;
+};
+
+struct Ui {
+  RenderSettings settings;
+  bool auto_level = false;
+  bool animate = false;
+  float anim = 0;  // position in [0, models) when animating
+  bool dragging = false;
+  double last_x = 0, last_y = 0;
+  int max_level = 0;
+};
+
+int auto_level(const RenderSettings& s, int max_level, int patches) {
+  // Screen-space error: aim for grid quads of about 4 pixels.
+  const float px = static_cast<float>(s.height) /
+                   (2.0f * s.camera.distance * std::tan(s.camera.fov_y_deg * 3.14159265f / 360.0f));
+  const float per_patch = px / std::sqrt(static_cast<float>(std::max(patches, 1)));
+  const int k = static_cast<int>(std::ceil(std::log2(std::max(per_patch / 4.0f, 1.0f))));
+  return std::clamp(k, 0, max_level);
+}
+
+void key_callback(GLFWwindow* w, int key, int, int action, int) {
+  if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
+  auto* ui = static_cast<Ui*>(glfwGetWindowUserPointer(w));
+  auto& s = ui->settings;
+  switch (key) {
+    case GLFW_KEY_ESCAPE: case GLFW_KEY_Q: glfwSetWindowShouldClose(w, 1); break;
+    case GLFW_KEY_UP: case GLFW_KEY_EQUAL:
+      ui->auto_level = false;
+      s.level = std::min((s.level < 0 ? ui->max_level : s.level) + 1, ui->max_level);
+      break;
+    case GLFW_KEY_DOWN: case GLFW_KEY_MINUS:
+      ui->auto_level = false;
+      s.level = std::max((s.level < 0 ? ui->max_level : s.level) - 1, 0);
+      break;
+    case GLFW_KEY_L: ui->auto_level = !ui->auto_level; break;
+    case GLFW_KEY_C: s.checker = !s.checker; break;
+    case GLFW_KEY_W: s.wireframe = !s.wireframe; break;
+    case GLFW_KEY_RIGHT: s.t = std::min(s.t + 0.05f, 1.0f); ui->animate = false; break;
+    case GLFW_KEY_LEFT: s.t = std::max(s.t - 0.05f, 0.0f); ui->animate = false; break;
+    case GLFW_KEY_SPACE: ui->animate = !ui->animate; break;
+    case GLFW_KEY_S:
+      s.schedule = s.schedule == MorphSchedule::kLinear ? MorphSchedule::kWavelet : MorphSchedule::kLinear;
+      break;
+    default: break;
+  }
+}
+
+void mouse_button(GLFWwindow* w, int button, int action, int) {
+  auto* ui = static_cast<Ui*>(glfwGetWindowUserPointer(w));
+  if (button == GLFW_MOUSE_BUTTON_LEFT) {
+    ui->dragging = action == GLFW_PRESS;
+    glfwGetCursorPos(w, &ui->last_x, &ui->last_y);
+  }
+}
+
+void cursor_pos(GLFWwindow* w, double x, double y) {
+  auto* ui = static_cast<Ui*>(glfwGetWindowUserPointer(w));
+  if (!ui->dragging) return;
+  ui->settings.camera.yaw -= static_cast<float>(x - ui->last_x) * 0.01f;
+  ui->settings.camera.pitch = std::clamp(ui->settings.camera.pitch + static_cast<float>(y - ui->last_y) * 0.01f,
+                                         -1.5f, 1.5f);
+  ui->last_x = x;
+  ui->last_y = y;
+}
+
+void scroll(GLFWwindow* w, double, double dy) {
+  auto* ui = static_cast<Ui*>(glfwGetWindowUserPointer(w));
+  ui->settings.camera.distance = std::clamp(ui->settings.camera.distance * std::pow(0.9f, static_cast<float>(dy)),
+                                            0.3f, 20.0f);
+}
+
+std::string kb(std::uint64_t bytes) { return std::to_string((bytes + 512) / 1024) + " KB"; }
+
+int run(const Options& opt) {
+  const bool headless = opt.frames > 0;
+  const bool wavelet = opt.schedule == "wavelet";
+  glfwSetErrorCallback([](int, const char* d) { std::cerr << "geomip-view: GLFW: " << d << "\n"; });
+  if (!glfwInit()) {
+    std::cerr << "geomip-view: cannot initialise GLFW (no display? run under xvfb-run)\n";
+    return kExitFailure;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  if (headless) glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);
+  GLFWwindow* window = glfwCreateWindow(opt.width, opt.height, "geomip-view", nullptr, nullptr);
+  if (!window) {
+    std::cerr << "geomip-view: cannot create an OpenGL 3.3 core window\n";
+    glfwTerminate();
+    return kExitFailure;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(headless ? 0 : 1);
+
+  int exit_code = kExitOk;
+  {
+    Renderer renderer;
+    Offscreen target(opt.width, opt.height);
+    PackSource source(opt.source, FetchOptions{.limit_rate = opt.limit_rate},
+                      DecodeSettings{.bands = wavelet ? opt.bands : 1});
+    Ui ui;
+    ui.settings.width = opt.width;
+    ui.settings.height = opt.height;
+    ui.settings.level = opt.level;
+    ui.settings.source = opt.model;
+    ui.settings.t = opt.morph.value_or(0.0f);
+    ui.settings.schedule = wavelet ? MorphSchedule::kWavelet : MorphSchedule::kLinear;
+    ui.settings.checker = opt.checker;
+    ui.settings.wireframe = opt.wireframe;
+    ui.settings.camera = Camera{opt.yaw, opt.pitch, opt.distance, 35.0f};
+    ui.auto_level = !headless && opt.level < 0;
+    ui.animate = opt.animate;
+    glfwSetWindowUserPointer(window, &ui);
+    glfwSetKeyCallback(window, key_callback);
+    glfwSetMouseButtonCallback(window, mouse_button);
+    glfwSetCursorPosCallback(window, cursor_pos);
+    glfwSetScrollCallback(window, scroll);
+
+    const auto start = Clock::now();
+    auto last_title = start;
+    auto last_frame = start;
+    double frame_ms = 0;
+    bool have_models = false, first_written = false, reported_error = false;
+    std::uint64_t shown_bytes = 0, total = 0;
+    int detail = 0;
+    int frames_after_load = 0;
+    double bench_ms = 0;
+    std::vector<std::uint8_t> last_pixels;
+
+    while (!glfwWindowShouldClose(window)) {
+      glfwPollEvents();
+      if (auto u = source.take_update()) {
+        renderer.set_models(u->models);
+        have_models = true;
+        shown_bytes = u->bytes_used;
+        total = u->total;
+        detail = u->models[0].detail_level;
+        ui.max_level = renderer.model_level(std::clamp(opt.model, 0, renderer.model_count() - 1));
+        std::cout << "geomip-view: showing " << shown_bytes << " of " << total << " bytes, detail level " << detail
+                  << "/" << ui.max_level << "\n";
+      }
+      const std::string err = source.error();
+      if (!err.empty() && !reported_error) {
+        std::cerr << "geomip-view: " << err << "\n";
+        reported_error = true;
+      }
+      const bool loaded = source.done();
+
+      // morph / animate
+      RenderSettings s = ui.settings;
+      const int n_models = renderer.model_count();
+      s.source = std::clamp(opt.model, 0, std::max(n_models - 1, 0));
+      if (ui.animate && n_models >= 2) {
+        const float dt = headless ? 1.0f / 60.0f : static_cast<float>(frame_ms / 1000.0);
+        ui.anim = std::fmod(ui.anim + dt * 0.25f, static_cast<float>(n_models));
+        s.source = static_cast<int>(ui.anim) % n_models;
+        s.target = (s.source + 1) % n_models;
+        s.t = ui.anim - std::floor(ui.anim);
+      } else if ((opt.morph || !headless) && n_models >= 2) {
+        s.target = (s.source + 1) % n_models;
+      }
+      if (ui.auto_level && have_models)
+        s.level = auto_level(s, ui.max_level, 1);
+
+      const auto t0 = Clock::now();
+      target.bind();
+      renderer.draw(s);
+      if (headless) {
+        glFinish();
+      } else {
+        int fw = 0, fh = 0;
+        glfwGetFramebufferSize(window, &fw, &fh);
+        target.blit_to_window(fw, fh);
+        glfwSwapBuffers(window);
+      }
+      const auto t1 = Clock::now();
+      frame_ms = std::chrono::duration<double, std::milli>(t1 - last_frame).count();
+      last_frame = t1;
+
+      if (have_models && !first_written && !opt.first_screenshot.empty()) {
+        std::string e;
+        if (!write_png(opt.first_screenshot, opt.width, opt.height, target.read_rgb(), e))
+          std::cerr << "geomip-view: " << e << "\n";
+        std::cout << "geomip-view: first screenshot from " << shown_bytes << " of " << total << " bytes\n";
+        first_written = true;
+      }
+      if (!headless && t1 - last_title > std::chrono::milliseconds(250)) {
+        last_title = t1;
+        const std::string title = "geomip-view — level " + std::to_string(s.level < 0 ? ui.max_level : s.level) +
+                                  (ui.auto_level ? " (auto)" : "") + ", detail " + std::to_string(detail) + " — " +
+                                  kb(source.received()) + " / " + kb(source.total()) + " — " +
+                                  std::to_string(static_cast<int>(frame_ms * 10) / 10.0).substr(0, 5) + " ms" +
+                                  (s.target >= 0 ? " — t " + std::to_string(s.t).substr(0, 4) : "") +
+                                  (err.empty() ? "" : " — ERROR: " + err);
+        glfwSetWindowTitle(window, title.c_str());
+      }
+
+      if (headless) {
+        if (loaded && have_models) {
+          ++frames_after_load;
+          bench_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
+          if (frames_after_load >= opt.frames) {
+            last_pixels = target.read_rgb();
+            break;
+          }
+        } else if (loaded) {
+          break;  // the source ended with nothing to show
+        } else if (std::chrono::duration<double>(t1 - start).count() > opt.timeout) {
+          std::cerr << "geomip-view: timed out after " << opt.timeout << " s waiting for the pack\n";
+          break;
+        } else if (!have_models) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+      }
+    }
+
+    if (headless) {
+      if (!opt.screenshot.empty() && !last_pixels.empty()) {
+        std::string e;
+        if (!write_png(opt.screenshot, opt.width, opt.height, last_pixels, e)) {
+          std::cerr << "geomip-view: " << e << "\n";
+          exit_code = kExitFailure;
+        }
+      }
+      if (opt.bench && frames_after_load > 0)
+        std::cout << "geomip-view: bench " << opt.width << "x" << opt.height << ", " << renderer.model_count()
+                  << " models, level " << (ui.settings.level < 0 ? ui.max_level : ui.settings.level) << ", "
+                  << (opt.morph || opt.animate ? (wavelet ? "wavelet morph" : "linear morph") : "no morph") << ": "
+                  << bench_ms / frames_after_load << " ms/frame over " << frames_after_load << " frames\n";
+    }
+    const std::string err = source.error();
+    if (!have_models) {
+      std::cerr << "geomip-view: nothing to show"
+                << (err.empty() ? " from " + opt.source + " (no geometry arrived)" : " (" + err + ")") << "\n";
+      exit_code = kExitBadInput;
+    } else if (!source.complete()) {
+      std::cerr << "geomip-view: incomplete stream: kept the level from " << shown_bytes << " of " << total
+                << " bytes" << (err.empty() ? "" : " (" + err + ")") << "\n";
+      if (exit_code == kExitOk) exit_code = kExitPartial;
+    }
+  }
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  return exit_code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  CLI::App app{"geomip-view — progressive viewer of .gip packs (file or http:// URL).\n"
+               "Keys: mouse drag orbit, wheel zoom, Up/Down level, L auto level, C checkerboard, W wireframe,\n"
+               "Left/Right morph t, Space animate, S linear/wavelet schedule, Q quit.\n"
+               "Exit codes: 0 ok, 1 internal failure, 2 bad input or nothing to show, 3 stream failed part-way.",
+               "geomip-view"};
+  app.add_option("pack", opt.source, "pack file or http:// URL")->required();
+  app.add_option("--level", opt.level, "grid level to draw (default: finest; interactive: auto)");
+  app.add_option("--morph", opt.morph, "morph time t in [0,1] from --model to the next model");
+  app.add_option("--schedule", opt.schedule, "morph schedule")->check(CLI::IsMember({"linear", "wavelet"}));
+  app.add_option("--bands", opt.bands, "wavelet bands of the wavelet schedule")->check(CLI::Range(2, 8));
+  app.add_option("--model", opt.model, "model index to show (morph source)")->check(CLI::NonNegativeNumber);
+  app.add_flag("--animate", opt.animate, "cycle the morph through all models");
+  app.add_option("--frames", opt.frames, "headless: render N frames after loading, then exit")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--width", opt.width, "framebuffer width")->check(CLI::Range(16, 8192));
+  app.add_option("--height", opt.height, "framebuffer height")->check(CLI::Range(16, 8192));
+  app.add_option("--screenshot", opt.screenshot, "headless: write the last frame as PNG");
+  app.add_option("--first-screenshot", opt.first_screenshot,
+                 "write the first frame that shows a model (streaming: the coarsest level) as PNG");
+  app.add_flag("--bench", opt.bench, "headless: print ms/frame");
+  app.add_flag("--checker", opt.checker, "checkerboard texture in parameter space");
+  app.add_flag("--wireframe", opt.wireframe, "wireframe");
+  app.add_option("--limit-rate", opt.limit_rate, "download at most this many bytes per second");
+  app.add_option("--timeout", opt.timeout, "headless: seconds to wait for the pack");
+  app.add_option("--yaw", opt.yaw, "camera yaw (radians)");
+  app.add_option("--pitch", opt.pitch, "camera pitch (radians)");
+  app.add_option("--distance", opt.distance, "camera distance (normalized units)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitBadInput;
+  }
+  try {
+    return run(opt);
+  } catch (const std::exception& e) {
+    std::cerr << "geomip-view: " << e.what() << "\n";
+    return kExitFailure;
+  }
+}

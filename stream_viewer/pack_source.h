@@ -1,0 +1,62 @@
+// The viewer's glue to the codec: a pack from a file or URL, fetched in the background (fetcher.h) and
+// decoded on a worker thread each time new complete chunks arrive; the render thread polls take_update(),
+// which never blocks on the network or the decoder.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "codec/pack.h"
+#include "stream_viewer/fetcher.h"
+#include "stream_viewer/scene_model.h"
+
+namespace geomip::viewer {
+
+struct SourceUpdate {
+  std::vector<SceneModel> models;
+  std::uint64_t bytes_used = 0;  ///< bytes of the pack those models come from (complete chunks)
+  std::uint64_t total = 0;       ///< the pack's size
+};
+
+class PackSource {
+ public:
+  PackSource(const std::string& source, FetchOptions fetch, DecodeSettings decode);
+  ~PackSource();
+  PackSource(const PackSource&) = delete;
+  PackSource& operator=(const PackSource&) = delete;
+
+  /// The newest decoded models, once per decode; std::nullopt if nothing new.
+  std::optional<SourceUpdate> take_update();
+
+  std::uint64_t received() const { return fetcher_->received(); }
+  std::uint64_t total() const { return fetcher_->total(); }
+  /// Fetch ended (complete or failed) and every byte that arrived has been decoded and taken or queued.
+  bool done() const;
+  /// Fetch or decode error, empty if none.
+  std::string error() const;
+  /// Whole pack received and decoded without error.
+  bool complete() const;
+
+ private:
+  void decode_loop();
+
+  DecodeSettings decode_;
+  std::unique_ptr<Fetcher> fetcher_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  bool decoder_idle_ = false;
+  std::optional<SourceUpdate> pending_;
+  std::string decode_error_;
+  std::uint64_t decoded_end_ = 0;
+  std::thread decoder_;
+};
+
+}  // namespace geomip::viewer

@@ -1,0 +1,74 @@
+// What the viewer draws: decoded models (codec::DecodedModel, a plain value) turned into GPU-ready layers in
+// the normalized frame, and the morph schedules of the paper's §6 (Praun, Sweldens, Schröder 2001, §6.2 and
+// Fig. 9). CPU only (no GL): the renderer uploads these, `geomip morph` and the tests evaluate them directly.
+#pragma once
+
+#include <array>
+#include <span>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "codec/pack.h"
+
+namespace geomip::viewer {
+
+/// One model, ready for upload. Positions are stored as `bands` layers per patch, each a (2^level+1)² grid of
+/// xyz floats in the normalized frame (the pack's normalization already applied): with one band the layer is
+/// the geometry image itself; with B > 1 bands, layer 0 is the coarse base (the wavelet reconstruction with the
+/// finest B−1 steps dropped) and layer m ≥ 1 is the detail D added by step B−1−m+1 (so the layers sum to the
+/// full geometry, and layer B−1 is the finest band).
+struct SceneModel {
+  std::string name;
+  int level = 0;        ///< geometry grid level n: (2^n+1)² samples per patch
+  int num_patches = 0;
+  int bands = 1;
+  std::vector<float> positions;  ///< [(patch·bands + band) · size² + j·size + i] · 3 + c
+  int normal_level = -1;         ///< −1: no normal map (the renderer shades with screen-space derivatives)
+  std::vector<float> normals;    ///< [patch · nsize² + j·nsize + i] · 3 + c, unit length, normalized frame
+  std::vector<std::uint8_t> holes;  ///< [patch · 4^L + j·2^L + i], L = hole_level: 1 = quad not drawn; empty = none
+  int hole_level = 0;               ///< level L ≤ level of the hole mask's grid
+  int detail_level = 0;          ///< finest level that received detail (codec::DecodedModel::detail_level)
+  int size() const { return (1 << level) + 1; }
+};
+
+/// One band: the model as it is. Throws std::invalid_argument if the model has no patches or grids of
+/// different levels.
+SceneModel make_scene_model(const codec::DecodedModel& model);
+
+/// Band-split model for the wavelet-domain morph. `by_drop[d]` is the same bytes decoded with
+/// drop_finest_steps = d, d = 0 … B−1 (B = by_drop.size() ≥ 1).
+SceneModel make_banded_scene_model(const std::vector<codec::DecodedModel>& by_drop);
+
+enum class MorphSchedule { kLinear, kWavelet };
+
+/// Per-band weights of source and target at morph time t ∈ [0,1] for `bands` bands (band 0 coarsest).
+/// Linear: every band (1 − t, t). Wavelet (§6.2, Fig. 9): a band of fineness f = m/(B−1) keeps the source
+/// until it fades out by t = 1 − f/2 and brings the target in from t = f/2, so the source's fine bands leave
+/// early, the coarse bands interpolate gradually and the target's fine bands arrive late. Both schedules give
+/// exactly the source at t = 0 and the target at t = 1.
+struct BandWeights {
+  std::vector<float> source, target;
+};
+BandWeights band_weights(float t, int bands, MorphSchedule schedule);
+
+/// CPU evaluation of the morph between two models of the same layout (and bands): per patch, the
+/// (2^level+1)² xyz grid at time t. Used by `geomip morph` and the tests.
+std::vector<std::vector<float>> evaluate_morph(const SceneModel& source, const SceneModel& target, float t,
+                                               MorphSchedule schedule);
+
+/// True when the models can be morphed (same level, patch count and bands).
+bool same_layout(const SceneModel& a, const SceneModel& b);
+
+struct DecodeSettings {
+  /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 decodes B times with
+  /// drop_finest_steps = 0 … B−1).
+  int bands = 1;
+};
+
+/// Decodes a byte prefix of a pack into scene models. Returns an empty vector (status in `status`) when the
+/// prefix holds no geometry pass of model 0 yet.
+std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
+                                     codec::Status& status, std::size_t& bytes_used);
+
+}  // namespace geomip::viewer

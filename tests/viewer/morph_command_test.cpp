@@ -1,0 +1,107 @@
+// `geomip morph` end to end: N OBJ frames with identical connectivity, the first and last frames are the two
+// models (in the normalized frame), the linear midpoint is the vertex-wise average, the wavelet one is not.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "tests/viewer/viewer_fixtures.h"
+
+namespace geomip::viewer {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Obj {
+  std::vector<std::array<double, 3>> v;
+  std::vector<std::string> faces;
+};
+
+Obj read_obj(const fs::path& path) {
+  Obj o;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("v ", 0) == 0) {
+      std::array<double, 3> p{};
+      std::istringstream(line.substr(2)) >> p[0] >> p[1] >> p[2];
+      o.v.push_back(p);
+    } else if (line.rfind("f ", 0) == 0) {
+      o.faces.push_back(line);
+    }
+  }
+  return o;
+}
+
+class MorphCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("geomip_morph_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    const auto bytes = codec::write_pack({testing::pack_input(5, 0), testing::pack_input(5, 1)});
+    std::ofstream(dir_ / "two.gip", std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+  int morph(const std::string& args) {
+    const std::string cmd = std::string(GEOMIP_BINARY) + " morph " + (dir_ / "two.gip").string() + " " + args +
+                            " > " + (dir_ / "log.txt").string() + " 2>&1";
+    const int status = std::system(cmd.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  fs::path dir_;
+};
+
+double extent(const Obj& o) {
+  double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+  for (const auto& p : o.v)
+    for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], p[c]), hi[c] = std::max(hi[c], p[c]);
+  return std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+}
+
+TEST_F(MorphCommandTest, FramesShareConnectivityAndInterpolateTheModels) {
+  ASSERT_EQ(morph("--frames 5 -o " + (dir_ / "linear").string()), 0);
+  ASSERT_EQ(morph("--frames 5 --schedule wavelet -o " + (dir_ / "wavelet").string()), 0);
+  std::vector<Obj> linear, wavelet;
+  for (int k = 0; k < 5; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "morph_%04d.obj", k);
+    linear.push_back(read_obj(dir_ / "linear" / name));
+    wavelet.push_back(read_obj(dir_ / "wavelet" / name));
+  }
+  ASSERT_FALSE(linear[0].faces.empty());
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_EQ(linear[k].faces, linear[0].faces) << "frame " << k;
+    EXPECT_EQ(wavelet[k].faces, linear[0].faces) << "frame " << k;
+    ASSERT_EQ(linear[k].v.size(), linear[0].v.size());
+  }
+  EXPECT_NEAR(extent(linear[0]), 1.0, 1e-3) << "frames are in the normalized frame";
+  EXPECT_NEAR(extent(linear[4]), 1.0, 1e-3);
+  double mid_err = 0, wavelet_gap = 0, ends = 0;
+  for (std::size_t i = 0; i < linear[0].v.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double avg = 0.5 * (linear[0].v[i][c] + linear[4].v[i][c]);
+      mid_err = std::max(mid_err, std::abs(linear[2].v[i][c] - avg));
+      wavelet_gap = std::max(wavelet_gap, std::abs(wavelet[2].v[i][c] - linear[2].v[i][c]));
+      ends = std::max({ends, std::abs(wavelet[0].v[i][c] - linear[0].v[i][c]),
+                       std::abs(wavelet[4].v[i][c] - linear[4].v[i][c])});
+    }
+  EXPECT_LT(mid_err, 1e-4) << "linear midpoint = vertex-wise average";
+  EXPECT_LT(ends, 1e-4) << "both schedules start and end at the models";
+  EXPECT_GT(wavelet_gap, 1e-3) << "the wavelet schedule's midpoint differs";
+}
+
+TEST_F(MorphCommandTest, BadModelIndexIsBadInput) {
+  EXPECT_EQ(morph("--frames 2 --to 7 -o " + (dir_ / "x").string()), 2);
+}
+
+}  // namespace
+}  // namespace geomip::viewer

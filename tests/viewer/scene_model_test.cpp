@@ -1,0 +1,114 @@
+// Morph schedules and band-split models (CPU only).
+#include "stream_viewer/scene_model.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/viewer/viewer_fixtures.h"
+
+namespace geomip::viewer {
+namespace {
+
+TEST(BandWeights, EndPointsAreExactlySourceAndTarget) {
+  for (auto schedule : {MorphSchedule::kLinear, MorphSchedule::kWavelet})
+    for (int bands : {1, 2, 5, 8}) {
+      const auto w0 = band_weights(0, bands, schedule), w1 = band_weights(1, bands, schedule);
+      for (int b = 0; b < bands; ++b) {
+        EXPECT_EQ(w0.source[b], 1.0f);
+        EXPECT_EQ(w0.target[b], 0.0f);
+        EXPECT_EQ(w1.source[b], 0.0f);
+        EXPECT_EQ(w1.target[b], 1.0f);
+      }
+    }
+}
+
+TEST(BandWeights, WaveletScheduleFadesFineSourceEarlyAndBringsFineTargetLate) {
+  const int bands = 5;
+  for (float t = 0; t <= 1.0f; t += 0.05f) {
+    const auto w = band_weights(t, bands, MorphSchedule::kWavelet);
+    EXPECT_NEAR(w.source[0] + w.target[0], 1.0f, 1e-6f) << "the coarse band interpolates";
+    EXPECT_NEAR(w.target[0], t, 1e-6f);
+    for (int b = 1; b < bands; ++b) {
+      EXPECT_LE(w.source[b], w.source[b - 1] + 1e-6f) << "finer source bands leave no later";
+      EXPECT_LE(w.target[b], w.target[b - 1] + 1e-6f) << "finer target bands arrive no earlier";
+    }
+    // monotone in t
+    const auto w2 = band_weights(t + 0.05f, bands, MorphSchedule::kWavelet);
+    for (int b = 0; b < bands; ++b) {
+      EXPECT_LE(w2.source[b], w.source[b] + 1e-6f);
+      EXPECT_GE(w2.target[b], w.target[b] - 1e-6f);
+    }
+  }
+  const auto mid = band_weights(0.5f, bands, MorphSchedule::kWavelet);
+  EXPECT_EQ(mid.source[bands - 1], 0.0f);
+  EXPECT_EQ(mid.target[bands - 1], 0.0f);
+}
+
+TEST(SceneModel, NormalizationMapsToTheUnitBox) {
+  const auto m = make_scene_model(testing::decoded_model(4, 1));
+  float lo[3] = {1e9f, 1e9f, 1e9f}, hi[3] = {-1e9f, -1e9f, -1e9f};
+  for (std::size_t k = 0; k < m.positions.size(); ++k)
+    lo[k % 3] = std::min(lo[k % 3], m.positions[k]), hi[k % 3] = std::max(hi[k % 3], m.positions[k]);
+  EXPECT_NEAR(std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}), 1.0f, 1e-5f);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(lo[c] + hi[c], 0.0f, 1e-5f);
+  for (std::size_t k = 0; k < m.normals.size(); k += 3)
+    EXPECT_NEAR(std::hypot(m.normals[k], m.normals[k + 1], m.normals[k + 2]), 1.0f, 1e-4f);
+}
+
+TEST(SceneModel, BandsSumToTheFullGeometry) {
+  std::vector<codec::DecodedModel> by_drop;
+  for (int d = 0; d < 3; ++d) {
+    auto m = testing::decoded_model(4, d == 0 ? 1 : 0);  // any grids of one layout
+    by_drop.push_back(m);
+  }
+  const auto banded = make_banded_scene_model(by_drop);
+  const auto full = make_scene_model(by_drop[0]);
+  ASSERT_EQ(banded.bands, 3);
+  const auto sum = evaluate_morph(banded, banded, 0.0f, MorphSchedule::kWavelet);
+  const std::size_t per = 3u * full.size() * full.size();
+  for (int p = 0; p < full.num_patches; ++p)
+    for (std::size_t k = 0; k < per; ++k) EXPECT_NEAR(sum[p][k], full.positions[p * per + k], 1e-5f);
+}
+
+}  // namespace
+}  // namespace geomip::viewer
+
+namespace geomip::viewer {
+namespace {
+
+// What the streaming viewer does with every prefix that arrives: decode_scene never throws on a prefix, and
+// gives either nothing (no geometry pass of model 0 yet) or both models at the pack's level, finite, with
+// more bytes never giving fewer models.
+TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
+  const auto bytes = codec::write_pack({testing::pack_input(4, 0), testing::pack_input(4, 1)});
+  bool seen_models = false;
+  for (std::size_t n = 0; n <= bytes.size(); n += (n < 64 ? 1 : 37)) {
+    codec::Status status = codec::Status::kOk;
+    std::size_t used = 0;
+    std::vector<SceneModel> models;
+    for (int bands : {1, 3}) {
+      ASSERT_NO_THROW(models = decode_scene({bytes.data(), n}, DecodeSettings{.bands = bands}, status, used))
+          << n << " bytes";
+      EXPECT_LE(used, n);
+      if (models.empty()) {
+        EXPECT_FALSE(seen_models && bands == 1) << "a longer prefix lost the models at " << n << " bytes";
+        continue;
+      }
+      if (bands == 1) seen_models = true;
+      ASSERT_EQ(models.size(), 2u);
+      for (const auto& m : models) {
+        EXPECT_EQ(m.level, 4);
+        EXPECT_EQ(m.bands, bands);
+        for (float v : m.positions) ASSERT_TRUE(std::isfinite(v)) << n << " bytes";
+      }
+    }
+  }
+  EXPECT_TRUE(seen_models);
+  codec::Status status;
+  std::size_t used = 0;
+  EXPECT_EQ(decode_scene(bytes, {}, status, used).size(), 2u);
+  EXPECT_EQ(status, codec::Status::kOk);
+  EXPECT_EQ(used, bytes.size());
+}
+
+}  // namespace
+}  // namespace geomip::viewer

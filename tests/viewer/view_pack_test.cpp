@@ -1,0 +1,384 @@
+// geomip-view end to end on real .gip packs (written here with codec::write_pack from synthetic consistent
+// models): screenshots cover the decoded model's silhouette, morph end points equal the models alone, the
+// wavelet schedule's midpoint differs from the linear one's; streaming over HTTP from a local Range-capable
+// server (range_server.py) with a bandwidth limit shows a coarse model early, survives the server dying
+// mid-stream, and reports 404 / non-pack URLs. Runs under xvfb-run (CTest); skips without a display.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "stream_viewer/pack_source.h"
+#include "stream_viewer/png_write.h"
+#include "tests/viewer/viewer_fixtures.h"
+
+extern char** environ;
+
+namespace geomip::viewer {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace testing;
+
+constexpr int kW = 320, kH = 240;
+
+fs::path work_dir() {
+  static const fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("geomip_view_test_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+/// A two-model pack (ellipsoid, bumpy body) of grid level `level`, written once per level.
+fs::path pack_file(int level) {
+  const fs::path path = work_dir() / ("two_models_" + std::to_string(level) + ".gip");
+  if (!fs::exists(path)) {
+    const auto bytes = codec::write_pack({pack_input(level, 0), pack_input(level, 1)});
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                                static_cast<std::streamsize>(bytes.size()));
+  }
+  return path;
+}
+
+std::vector<std::uint8_t> read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+struct ViewRun {
+  int code = -1;
+  std::string out, err;
+};
+
+ViewRun view(const std::string& args) {
+  static int counter = 0;
+  const fs::path out = work_dir() / ("out" + std::to_string(counter) + ".txt");
+  const fs::path err = work_dir() / ("err" + std::to_string(counter++) + ".txt");
+  const std::string cmd = std::string(GEOMIP_VIEW_BINARY) + " " + args + " > " + out.string() + " 2> " + err.string();
+  const int status = std::system(cmd.c_str());
+  ViewRun r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::stringstream so, se;
+  so << std::ifstream(out).rdbuf();
+  se << std::ifstream(err).rdbuf();
+  r.out = so.str();
+  r.err = se.str();
+  return r;
+}
+
+std::string size_args() { return "--frames 2 --width " + std::to_string(kW) + " --height " + std::to_string(kH); }
+
+std::vector<std::uint8_t> load(const fs::path& png) {
+  int w = 0, h = 0;
+  std::vector<std::uint8_t> rgb;
+  EXPECT_TRUE(read_png(png.string(), w, h, rgb)) << png;
+  EXPECT_EQ(w, kW);
+  EXPECT_EQ(h, kH);
+  return rgb;
+}
+
+/// The range server on a free port; killed on destruction.
+class Server {
+ public:
+  explicit Server(const std::vector<std::string>& extra) {
+    const fs::path log = work_dir() / ("server" + std::to_string(++count_) + ".txt");
+    std::vector<std::string> args = {GEOMIP_PYTHON, std::string(GEOMIP_SOURCE_DIR) + "/tests/viewer/range_server.py",
+                                     "--root", work_dir().string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&actions);
+    for (int i = 0; i < 200 && pid_ > 0 && port_ == 0; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      std::ifstream in(log);
+      std::string word;
+      if (in >> word >> port_ && word == "PORT") break;
+      port_ = 0;
+    }
+  }
+  ~Server() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGTERM);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  int port() const { return port_; }
+  std::string url(const std::string& name) const { return "http://127.0.0.1:" + std::to_string(port_) + "/" + name; }
+
+ private:
+  static inline int count_ = 0;
+  pid_t pid_ = -1;
+  int port_ = 0;
+};
+
+class ViewPackTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    context_ = new GlContext(64, 64);  // only to learn whether a display is there
+  }
+  static void TearDownTestSuite() {
+    delete context_;
+    context_ = nullptr;
+    std::error_code ignored;
+    if (!std::getenv("GEOMIP_VIEW_TEST_KEEP")) fs::remove_all(work_dir(), ignored);  // keep: for debugging
+  }
+  void SetUp() override {
+    if (!context_->ok()) GTEST_SKIP() << "no OpenGL 3.3 display (run under xvfb-run)";
+  }
+  static GlContext* context_;
+};
+GlContext* ViewPackTest::context_ = nullptr;
+
+std::vector<SceneModel> decode_file(const fs::path& path) {
+  const auto bytes = read_bytes(path);
+  codec::Status status;
+  std::size_t used = 0;
+  auto models = decode_scene(bytes, {}, status, used);
+  EXPECT_EQ(status, codec::Status::kOk);
+  EXPECT_EQ(used, bytes.size());
+  return models;
+}
+
+TEST_F(ViewPackTest, ScreenshotCoversTheDecodedModelsSilhouette) {
+  const fs::path pack = pack_file(6);
+  const auto models = decode_file(pack);
+  ASSERT_EQ(models.size(), 2u);
+  for (int m = 0; m < 2; ++m)
+    for (int level : {6, 3}) {
+      const fs::path png = work_dir() / ("model" + std::to_string(m) + "_" + std::to_string(level) + ".png");
+      const ViewRun r = view(pack.string() + " " + size_args() + " --model " + std::to_string(m) + " --level " +
+                         std::to_string(level) + " --screenshot " + png.string());
+      ASSERT_EQ(r.code, 0) << r.err;
+      const auto image = image_coverage(load(png));
+      const auto reference = cpu_coverage(models[m], level, Camera{}, kW, kH);
+      EXPECT_GT(count(reference), std::size_t(kW * kH / 20));
+      EXPECT_GT(iou(image, reference), 0.95) << "model " << m << " level " << level;
+      EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "no cracks: model " << m << " level " << level;
+    }
+}
+
+#ifdef GEOMIP_BINARY
+// A real model: data/spot.obj through `geomip convert` (partition, parameterization, geometry images, normal
+// maps, codec). Its many patches meet along seams the codec keeps bit-identical: no cracks at any level.
+TEST_F(ViewPackTest, ConvertedMeshCoversItsSilhouetteWithoutCracks) {
+  const fs::path pack = work_dir() / "spot.gip";
+  const std::string convert = std::string(GEOMIP_BINARY) + " convert -q " + GEOMIP_SOURCE_DIR +
+                              "/data/spot.obj --level 6 -o " + pack.string();
+  ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+  const auto models = decode_file(pack);
+  ASSERT_EQ(models.size(), 1u);
+  EXPECT_GE(models[0].num_patches, 2);
+  for (int level : {6, 4, 2}) {
+    const fs::path png = work_dir() / ("spot_" + std::to_string(level) + ".png");
+    const ViewRun r = view(pack.string() + " " + size_args() + " --level " + std::to_string(level) +
+                           " --screenshot " + png.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto image = image_coverage(load(png));
+    const auto reference = cpu_coverage(models[0], level, Camera{}, kW, kH);
+    EXPECT_GT(count(reference), std::size_t(kW * kH / 20));
+    EXPECT_GT(iou(image, reference), 0.95) << "level " << level;
+    EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "no cracks at level " << level;
+  }
+}
+
+// An open real mesh (the camel head, cut at the neck): `geomip convert` fills the hole and the pack marks the
+// fill in its hole masks; the viewer leaves those quads out, exactly as the CPU reference does.
+TEST_F(ViewPackTest, RepairedMeshLeavesItsHoleMaskedQuadsOut) {
+  const fs::path mesh = fs::path(GEOMIP_SHARED_MESHES) / "camelhead.obj";
+  if (!fs::exists(mesh)) GTEST_SKIP() << mesh << " not found (../shared/meshes)";
+  const fs::path pack = work_dir() / "camelhead.gip";
+  const std::string convert =
+      std::string(GEOMIP_BINARY) + " convert -q " + mesh.string() + " --level 6 -o " + pack.string();
+  ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+  const auto models = decode_file(pack);
+  ASSERT_EQ(models.size(), 1u);
+  ASSERT_FALSE(models[0].holes.empty()) << "the repaired camel head should carry a hole mask";
+  EXPECT_GT(count(models[0].holes), 0u);
+  SceneModel unmasked = models[0];
+  unmasked.holes.clear();
+  for (float yaw : {0.6f, 2.5f, 4.0f}) {
+    Camera camera;
+    camera.yaw = yaw;
+    camera.distance = 2.0f;
+    const fs::path png = work_dir() / ("camel_" + std::to_string(int(yaw * 10)) + ".png");
+    std::ostringstream args;
+    args << pack.string() << " " << size_args() << " --yaw " << yaw << " --distance 2 --screenshot " << png.string();
+    const ViewRun r = view(args.str());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto image = image_coverage(load(png));
+    const auto reference = cpu_coverage(models[0], models[0].level, camera, kW, kH);
+    EXPECT_GT(iou(image, reference), 0.95) << "yaw " << yaw;
+    EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "yaw " << yaw;
+    EXPECT_LT(count(image), count(cpu_coverage(unmasked, unmasked.level, camera, kW, kH)))
+        << "the filled hole is not drawn (yaw " << yaw << ")";
+    std::cout << "yaw " << yaw << ": " << count(image) << " pixels drawn, "
+              << count(cpu_coverage(unmasked, unmasked.level, camera, kW, kH)) << " with the fill\n";
+  }
+}
+#endif
+
+// The committed golden pack (format version 1, two pillows, level 5): the viewer reads the codec's own
+// reference stream, each model covers its silhouette, and the morph ends at each model.
+TEST_F(ViewPackTest, GoldenPackRendersBothModelsAndTheirMorph) {
+  const fs::path pack = fs::path(GEOMIP_SOURCE_DIR) / "tests/data/golden-pillow.gip";
+  const auto models = decode_file(pack);
+  ASSERT_EQ(models.size(), 2u);
+  std::vector<std::vector<std::uint8_t>> alone;
+  for (int m = 0; m < 2; ++m) {
+    const fs::path png = work_dir() / ("golden_" + std::to_string(m) + ".png");
+    const ViewRun r = view(pack.string() + " " + size_args() + " --model " + std::to_string(m) + " --screenshot " +
+                           png.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    alone.push_back(load(png));
+    const auto reference = cpu_coverage(models[m], models[m].level, Camera{}, kW, kH);
+    EXPECT_GT(iou(image_coverage(alone.back()), reference), 0.95) << "model " << m;
+    EXPECT_EQ(interior_misses(image_coverage(alone.back()), reference, kW, kH), 0u) << "model " << m;
+  }
+  for (int end = 0; end < 2; ++end) {
+    const fs::path png = work_dir() / ("golden_t" + std::to_string(end) + ".png");
+    const ViewRun r = view(pack.string() + " " + size_args() + " --morph " + std::to_string(end) + " --screenshot " +
+                           png.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_LT(differing(load(png), alone[end], 2), 0.001) << "t = " << end;
+  }
+}
+
+TEST_F(ViewPackTest, MorphEndPointsAndWaveletMidpoint) {
+  const fs::path pack = pack_file(6);
+  auto shot = [&](const std::string& name, const std::string& args) {
+    const fs::path png = work_dir() / (name + ".png");
+    const ViewRun r = view(pack.string() + " " + size_args() + " " + args + " --screenshot " + png.string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    return load(png);
+  };
+  for (std::string schedule : {"linear", "wavelet"}) {
+    const auto a = shot("a_" + schedule, "--model 0 --schedule " + schedule);
+    const auto b = shot("b_" + schedule, "--model 1 --schedule " + schedule);
+    const auto t0 = shot("t0_" + schedule, "--morph 0 --schedule " + schedule);
+    const auto t1 = shot("t1_" + schedule, "--morph 1 --schedule " + schedule);
+    EXPECT_LT(differing(t0, a, 2), 0.001) << schedule;
+    EXPECT_LT(differing(t1, b, 2), 0.001) << schedule;
+    EXPECT_GT(differing(a, b, 2), 0.05);
+  }
+  const auto linear = shot("mid_linear", "--morph 0.5 --schedule linear");
+  const auto wavelet = shot("mid_wavelet", "--morph 0.5 --schedule wavelet");
+  EXPECT_GT(differing(linear, wavelet, 8), 0.02);
+}
+
+TEST_F(ViewPackTest, StreamingShowsACoarseModelFromTheFirstFewPercent) {
+  const fs::path pack = pack_file(7);
+  const auto total = fs::file_size(pack);
+  const auto full_models = decode_file(pack);
+  // ~10 s for the whole pack: the first decodable prefix arrives long before the rest
+  Server server({"--rate", std::to_string(std::max<std::uintmax_t>(total / 10, 1000))});
+  ASSERT_GT(server.port(), 0);
+  const fs::path first = work_dir() / "stream_first.png", last = work_dir() / "stream_last.png";
+  const ViewRun r = view(server.url(pack.filename().string()) + " " + size_args() + " --first-screenshot " +
+                     first.string() + " --screenshot " + last.string());
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  // "geomip-view: first screenshot from B of T bytes"
+  const auto at = r.out.find("first screenshot from ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::uint64_t shown = 0, of = 0;
+  std::string word;
+  std::istringstream(r.out.substr(at + 22)) >> shown >> word >> of;
+  EXPECT_EQ(of, total);
+  EXPECT_LE(shown, total / 20) << "first model should come from at most 5% of the pack";
+  const auto coarse = image_coverage(load(first));
+  const auto full = cpu_coverage(full_models[0], full_models[0].level, Camera{}, kW, kH);
+  EXPECT_GT(count(coarse), count(full) / 4) << "the coarse model should be visible";
+  EXPECT_GT(iou(coarse, full), 0.6) << "and overlap the full model";
+  EXPECT_GT(iou(image_coverage(load(last)), full), 0.95) << "the final frame is the full model";
+}
+
+TEST_F(ViewPackTest, ServerWithoutRangeSupportStreamsTheWholeFile) {
+  const fs::path pack = pack_file(7);
+  const auto total = fs::file_size(pack);
+  Server server({"--no-ranges", "--rate", std::to_string(total / 4)});
+  ASSERT_GT(server.port(), 0);
+  const fs::path first = work_dir() / "noranges_first.png", last = work_dir() / "noranges_last.png";
+  const ViewRun r = view(server.url(pack.filename().string()) + " " + size_args() + " --first-screenshot " +
+                         first.string() + " --screenshot " + last.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto at = r.out.find("first screenshot from ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::uint64_t shown = 0;
+  std::istringstream(r.out.substr(at + 22)) >> shown;
+  EXPECT_LT(shown, total / 2) << "one plain GET still shows coarse levels before the end";
+  const auto models = decode_file(pack);
+  EXPECT_GT(iou(image_coverage(load(last)), cpu_coverage(models[0], models[0].level, Camera{}, kW, kH)), 0.95);
+}
+
+TEST_F(ViewPackTest, ServerKilledMidStreamKeepsTheLastCompleteLevel) {
+  const fs::path pack = pack_file(7);
+  const auto total = fs::file_size(pack);
+  Server server({"--rate", std::to_string(total / 4), "--die-after", std::to_string(total / 3)});
+  ASSERT_GT(server.port(), 0);
+  const fs::path last = work_dir() / "killed_last.png";
+  const ViewRun r = view(server.url(pack.filename().string()) + " " + size_args() + " --screenshot " + last.string());
+  EXPECT_EQ(r.code, 3) << "3 = the stream failed part-way\n" << r.err;
+  EXPECT_NE(r.err.find("connection"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("kept the level"), std::string::npos) << r.err;
+  const auto models = decode_file(pack);
+  EXPECT_GT(iou(image_coverage(load(last)), cpu_coverage(models[0], models[0].level, Camera{}, kW, kH)), 0.8)
+      << "the last complete level is still shown";
+}
+
+TEST_F(ViewPackTest, StalledServerTimesOutAndExitsPromptly) {
+  const fs::path pack = pack_file(6);
+  Server server({"--rate", "20"});  // 20 bytes/s: not even the manifest arrives in time
+  ASSERT_GT(server.port(), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  const ViewRun r = view(server.url(pack.filename().string()) + " " + size_args() + " --timeout 2");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("timed out"), std::string::npos) << r.err;
+  EXPECT_LT(seconds, 10.0) << "cancelling the transfer must not wait for the stalled connection";
+}
+
+TEST_F(ViewPackTest, MissingOrNonPackSourcesGiveAClearMessage) {
+  Server server({});
+  ASSERT_GT(server.port(), 0);
+  std::ofstream(work_dir() / "readme.txt") << "this is not a pack, just some text long enough to have a header\n";
+  ViewRun r = view(server.url("nothing_here.gip") + " " + size_args());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("404"), std::string::npos) << r.err;
+  r = view(server.url("readme.txt") + " " + size_args());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("not a .gip pack"), std::string::npos) << r.err;
+  r = view((work_dir() / "readme.txt").string() + " " + size_args());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("not a .gip pack"), std::string::npos) << r.err;
+  r = view((work_dir() / "missing.gip").string() + " " + size_args());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("cannot open"), std::string::npos) << r.err;
+}
+
+TEST_F(ViewPackTest, BenchTwoModelLevel8MorphAt1280x720) {
+  const fs::path pack = pack_file(8);
+  for (std::string schedule : {"linear", "wavelet"}) {
+    const ViewRun r = view(pack.string() + " --frames 30 --width 1280 --height 720 --animate --bench --schedule " + schedule);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto at = r.out.find("bench ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    std::cout << r.out.substr(at);  // the figure for the report
+  }
+}
+
+}  // namespace
+}  // namespace geomip::viewer

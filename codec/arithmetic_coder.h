@@ -34,9 +34,8 @@ struct Context {
   /// P(bit = 0) · 2^16 in [1, 65535].
   std::uint32_t p0() const { return (static_cast<std::uint32_t>(fast) + slow) >> 1; }
   void update(int bit) {
-    static constexpr std::uint8_t kFastShift[8] = {1, 2, 3, 4, 5, 5, 5, 5};
-    static constexpr std::uint8_t kSlowShift[8] = {1, 2, 3, 4, 5, 6, 7, 8};
-    const int fs = kFastShift[count], ss = kSlowShift[count];
+    // Warm-up shifts: fast 1, 2, 3, 4, 5, 5, ...; slow 1, 2, ..., 8, 8, ... (count saturates at 7).
+    const int ss = count + 1, fs = ss < 5 ? ss : 5;
     count = static_cast<std::uint8_t>(count + (count < 7));
     // Written as selects rather than branches: refinement bits are close to random, and a mispredicted branch
     // per symbol would dominate the decoder's time. The results stay in [1, 65535]: x − (x >> s) ≥ 1 for

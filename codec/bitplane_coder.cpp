@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
+#include <exception>
 #include <stdexcept>
 #include <string>
 
 #include "codec/arithmetic_coder.h"
+#include "codec/parallel.h"
 
 namespace geomip::codec {
 namespace {
@@ -56,13 +58,17 @@ bool layout_ok(const BitplaneLayout& layout) {
          layout.num_patches >= 1;
 }
 
+/// The bands of every patch (only_patch < 0) or of one patch, in coding order; Band::parent indexes the
+/// returned list.
 std::vector<Band> make_bands(const BitplaneLayout& layout,
-                             const std::vector<std::vector<std::uint8_t>>& coded) {
+                             const std::vector<std::vector<std::uint8_t>>& coded, int only_patch = -1) {
   const int size = (1 << layout.level) + 1;
-  const int np = layout.num_patches, steps = layout.steps;
+  const int steps = layout.steps;
+  const int first = only_patch < 0 ? 0 : only_patch;
+  const int np = only_patch < 0 ? layout.num_patches : 1;  // patches in the list
   std::vector<Band> bands;
   bands.reserve(static_cast<std::size_t>(np) * (1 + 3 * steps));
-  for (int p = 0; p < np; ++p) {
+  for (int p = first; p < first + np; ++p) {
     Band b;
     b.patch = p;
     b.k = steps + 1;
@@ -77,7 +83,7 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
   for (int k = steps; k >= 1; --k) {
     const int s = 1 << (k - 1), intervals = (size - 1) / s;
     for (int orient = 1; orient <= 3; ++orient) {
-      for (int p = 0; p < np; ++p) {
+      for (int p = first; p < first + np; ++p) {
         Band b;
         b.patch = p;
         b.k = k;
@@ -91,7 +97,7 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
         b.y0 = odd_y ? s : 0;
         b.w = odd_x ? intervals / 2 : intervals / 2 + 1;
         b.h = odd_y ? intervals / 2 : intervals / 2 + 1;
-        if (k < steps) b.parent = np + ((steps - (k + 1)) * 3 + (orient - 1)) * np + p;
+        if (k < steps) b.parent = np + ((steps - (k + 1)) * 3 + (orient - 1)) * np + (p - first);
         bands.push_back(std::move(b));
       }
     }
@@ -136,53 +142,62 @@ constexpr int kNodeContexts = 3 * 3 * 4 * 3 * 2;
 template <bool kDecode>
 class PlaneCoder {
  public:
-  PlaneCoder(const BitplaneLayout& layout, std::vector<Band>& bands,
+  /// Codes the bands of `bands` whose patch is `patch` (−1: all of them) with its own contexts.
+  PlaneCoder(const BitplaneLayout& layout, std::vector<Band>& bands, int patch,
              const std::vector<PatchCoefficients>* coefs)
-      : size_((1 << layout.level) + 1), bands_(bands), coefs_(coefs) {}
-
-  void set_encoder(ArithmeticEncoder* enc) { enc_ = enc; }
-  void set_decoder(ArithmeticDecoder* dec, bool check) {
-    dec_ = dec;
-    check_ = check;
+      : size_((1 << layout.level) + 1), bands_(bands), coefs_(coefs) {
+    for (auto& b : bands) {
+      if (patch < 0 || b.patch == patch) mine_.push_back(&b);
+    }
   }
 
+  void set_encoder(ArithmeticEncoder* enc) { enc_ = enc; }
+  /// Decodes the next plane from `bytes` (held by value: a decoder behind a pointer costs a dependent load
+  /// per symbol).
+  void set_decoder(std::span<const std::uint8_t> bytes) { dec_ = ArithmeticDecoder(bytes); }
+
   /// One weighted bit-plane: sorting pass over every band, then refinement pass over every band.
+  /// kCheck: the stream may be a byte prefix; stop (throw Stop) before the first symbol that needs a byte
+  /// past it.
+  template <bool kCheck>
   void code_plane(int b) {
-    for (auto& band : bands_) band.refine_count = band.lsp.size();
-    for (std::size_t bi = 0; bi < bands_.size(); ++bi) {
-      Band& band = bands_[bi];
+    for (Band* band : mine_) band->refine_count = band->lsp.size();
+    for (Band* bp : mine_) {
+      Band& band = *bp;
       const int p = b - band.offset;
       if (p < 0 || band.lis.empty()) continue;
       band.lis_next.clear();
       // lis is swapped only after the loop; process() appends to lis_next only.
       for (std::size_t n = 0; n < band.lis.size(); ++n) {
         const std::uint32_t packed = band.lis[n];
-        process(band, static_cast<int>(packed >> 28), static_cast<int>((packed >> 14) & 0x3FFF),
-                static_cast<int>(packed & 0x3FFF), p, false);
+        process<kCheck>(band, static_cast<int>(packed >> 28), static_cast<int>((packed >> 14) & 0x3FFF),
+                        static_cast<int>(packed & 0x3FFF), p, false);
       }
       std::swap(band.lis, band.lis_next);
     }
-    for (auto& band : bands_) {
-      const int p = b - band.offset;
+    for (Band* bp : mine_) {
+      const int p = b - bp->offset;
       if (p < 0) continue;
-      refine(band, p);
+      refine<kCheck>(*bp, p);
     }
   }
 
  private:
+  template <bool kCheck>
   int sym(int bit, Context& ctx) {
     if constexpr (kDecode) {
-      if (check_ && dec_->exhausted()) throw Stop{};
-      return dec_->decode(ctx);
+      if (kCheck && dec_.exhausted()) throw Stop{};
+      return dec_.decode(ctx);
     } else {
       enc_->encode(bit, ctx);
       return bit;
     }
   }
+  template <bool kCheck>
   int raw(int bit) {
     if constexpr (kDecode) {
-      if (check_ && dec_->exhausted()) throw Stop{};
-      return dec_->decode_bypass();
+      if (kCheck && dec_.exhausted()) throw Stop{};
+      return dec_.decode_bypass();
     } else {
       enc_->encode_bypass(bit);
       return bit;
@@ -214,12 +229,13 @@ class PlaneCoder {
 
   /// Tests node (l, x, y) of `band` at plain plane p (known significant when `inferred`); splits it if
   /// significant.
+  template <bool kCheck>
   void process(Band& band, int l, int x, int y, int p, bool inferred) {
     const std::size_t idx = band.node(l, x, y);
     int bit = 1;
     if (!inferred) {
       if constexpr (!kDecode) bit = band.msb[idx] >= p;
-      bit = sym(bit, node_ctx_[node_context(band, l, x, y)]);
+      bit = sym<kCheck>(bit, node_ctx_[node_context(band, l, x, y)]);
       if (!bit) {
         band.lis_next.push_back(pack(l, x, y));
         return;
@@ -230,7 +246,7 @@ class PlaneCoder {
     }
     band.state[idx] |= kSig;
     if (l == 0) {
-      new_sample(band, x, y, p);
+      new_sample<kCheck>(band, x, y, p);
       return;
     }
     // Children at level l − 1; the last active one is significant for sure when no sibling was.
@@ -250,11 +266,12 @@ class PlaneCoder {
     for (int i = 0; i < count; ++i) {
       const int cx = children[i][0], cy = children[i][1];
       const bool infer = (i == count - 1) && !any;
-      process(band, cl, cx, cy, p, infer);
+      process<kCheck>(band, cl, cx, cy, p, infer);
       any = any || (band.state[band.node(cl, cx, cy)] & kSig);
     }
   }
 
+  template <bool kCheck>
   void new_sample(Band& band, int x, int y, int p) {
     const std::uint32_t index = band.grid_index(x, y, size_);
     band.lsp.push_back(Sample{index, {0, 0, 0}, {0, 0, 0}, 0});
@@ -269,9 +286,9 @@ class PlaneCoder {
         bit = (m >> p) & 1;
         negative = v < 0;
       }
-      if (c < 2 || any) bit = sym(bit, chan_ctx_[(band.cls * 3 + c) * 2 + any]);
+      if (c < 2 || any) bit = sym<kCheck>(bit, chan_ctx_[(band.cls * 3 + c) * 2 + any]);
       if (bit) {
-        negative = raw(negative);
+        negative = raw<kCheck>(negative);
         s.mag[c] = 1u << p;
         s.q[c] = static_cast<std::uint8_t>(p);
         s.flags |= static_cast<std::uint8_t>((1 << c) | (negative << (3 + c)));
@@ -280,7 +297,12 @@ class PlaneCoder {
     }
   }
 
+  template <bool kCheck>
   void refine(Band& band, int p) {
+    if constexpr (kDecode && !kCheck) {
+      refine_fast(band, p);
+      return;
+    }
     for (std::size_t n = 0; n < band.refine_count; ++n) {
       Sample& s = band.lsp[n];
       for (int c = 0; c < 3; ++c) {
@@ -300,15 +322,15 @@ class PlaneCoder {
             const std::int32_t v = coef(band, s.index, c);
             known = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v) >> (p + 1);
           }
-          bit = known == 1 ? sym(bit, ref_ctx_[band.cls]) : raw(bit);
+          bit = known == 1 ? sym<kCheck>(bit, ref_ctx_[band.cls]) : raw<kCheck>(bit);
           if constexpr (kDecode) {
             s.mag[c] |= static_cast<std::uint32_t>(bit) << p;
             s.q[c] = static_cast<std::uint8_t>(p);
           }
         } else {
-          bit = sym(bit, late_ctx_[band.cls * 3 + c]);
+          bit = sym<kCheck>(bit, late_ctx_[band.cls * 3 + c]);
           if (bit) {
-            negative = raw(negative);
+            negative = raw<kCheck>(negative);
             s.mag[c] = 1u << p;
             s.q[c] = static_cast<std::uint8_t>(p);
             s.flags |= static_cast<std::uint8_t>((1 << c) | (negative << (3 + c)));
@@ -318,12 +340,41 @@ class PlaneCoder {
     }
   }
 
+  /// The decoder's refinement pass over complete segments: the same decisions as refine(), with the range
+  /// decoder's state in locals (stores through Sample would otherwise force it back to memory per symbol).
+  void refine_fast(Band& band, int p) {
+    ArithmeticDecoder d = dec_;
+    Sample* lsp = band.lsp.data();
+    const std::size_t count = band.refine_count;
+    Context* ref = &ref_ctx_[band.cls];
+    Context* late = &late_ctx_[band.cls * 3];
+    for (std::size_t n = 0; n < count; ++n) {
+      Sample& s = lsp[n];
+      std::uint32_t flags = s.flags;
+      for (int c = 0; c < 3; ++c) {
+        if (flags & (1u << c)) {
+          const std::uint32_t known = s.mag[c] >> (p + 1);
+          const int bit = known == 1 ? d.decode(*ref) : d.decode_bypass();
+          s.mag[c] |= static_cast<std::uint32_t>(bit) << p;
+          s.q[c] = static_cast<std::uint8_t>(p);
+        } else if (d.decode(late[c])) {
+          const std::uint32_t negative = static_cast<std::uint32_t>(d.decode_bypass());
+          s.mag[c] = 1u << p;
+          s.q[c] = static_cast<std::uint8_t>(p);
+          flags |= (1u << c) | (negative << (3 + c));
+        }
+      }
+      s.flags = static_cast<std::uint8_t>(flags);
+    }
+    dec_ = d;
+  }
+
   int size_;
-  std::vector<Band>& bands_;
+  std::vector<Band>& bands_;  // all bands (parents are looked up here; they belong to the same patch)
+  std::vector<Band*> mine_;   // the bands this coder codes, in coding order
   const std::vector<PatchCoefficients>* coefs_;
   ArithmeticEncoder* enc_ = nullptr;
-  ArithmeticDecoder* dec_ = nullptr;
-  bool check_ = false;
+  ArithmeticDecoder dec_{{}};
   Context node_ctx_[kNodeContexts];
   Context chan_ctx_[3 * 3 * 2];
   Context late_ctx_[3 * 3];
@@ -380,21 +431,132 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
   }
   BitplaneEncoding result;
   result.top_bitplane = top;
-  PlaneCoder<false> coder(layout, bands, &coefficients);
+  if (!layout.independent_patches) {
+    PlaneCoder<false> coder(layout, bands, -1, &coefficients);
+    for (int b = top; b >= 0; --b) {
+      ArithmeticEncoder enc;
+      coder.set_encoder(&enc);
+      coder.template code_plane<false>(b);
+      result.segments.push_back(enc.finish());
+    }
+    return result;
+  }
+  // One coder (own contexts, own stream) per patch; a segment is the varint sizes of streams 0..P−2, then
+  // the streams.
+  const int np = layout.num_patches;
+  std::vector<PlaneCoder<false>> coders;
+  coders.reserve(static_cast<std::size_t>(np));
+  for (int p = 0; p < np; ++p) coders.emplace_back(layout, bands, p, &coefficients);
   for (int b = top; b >= 0; --b) {
-    ArithmeticEncoder enc;
-    coder.set_encoder(&enc);
-    coder.code_plane(b);
-    result.segments.push_back(enc.finish());
+    std::vector<std::vector<std::uint8_t>> streams;
+    for (auto& coder : coders) {
+      ArithmeticEncoder enc;
+      coder.set_encoder(&enc);
+      coder.template code_plane<false>(b);
+      streams.push_back(enc.finish());
+    }
+    std::vector<std::uint8_t> segment;
+    for (int p = 0; p + 1 < np; ++p) {
+      std::uint64_t v = streams[static_cast<std::size_t>(p)].size();
+      while (v >= 0x80) {
+        segment.push_back(static_cast<std::uint8_t>(v | 0x80));
+        v >>= 7;
+      }
+      segment.push_back(static_cast<std::uint8_t>(v));
+    }
+    for (const auto& st : streams) segment.insert(segment.end(), st.begin(), st.end());
+    result.segments.push_back(std::move(segment));
   }
   return result;
 }
+
+namespace {
+
+/// What one coder decodes of one plane: its stream's bytes, and whether they are the whole stream.
+struct StreamPart {
+  std::span<const std::uint8_t> bytes;
+  bool complete = false;
+  bool present = false;  ///< false: nothing of this plane arrived for this coder
+};
+
+struct CoderOutcome {
+  std::size_t planes_complete = 0;
+  bool partial = false;
+  bool corrupt = false;
+  std::exception_ptr error;  ///< anything else (allocation failure): rethrown by the caller's thread
+};
+
+/// Decodes the planes of one coder; parts[t] is its stream of plane t (planes after the first absent or
+/// incomplete one are not decoded).
+void decode_planes(PlaneCoder<true>& coder, int top_bitplane, const std::vector<StreamPart>& parts,
+                   CoderOutcome& outcome) {
+  try {
+    for (std::size_t t = 0; t < parts.size(); ++t) {
+      const StreamPart& part = parts[t];
+      if (!part.present) break;
+      const int b = top_bitplane - static_cast<int>(t);
+      coder.set_decoder(part.bytes);
+      if (part.complete) {
+        coder.code_plane<false>(b);
+        ++outcome.planes_complete;
+      } else {
+        outcome.partial = true;
+        try {
+          coder.code_plane<true>(b);
+        } catch (const Stop&) {
+        }
+        break;
+      }
+    }
+  } catch (const Corrupt&) {
+    outcome.corrupt = true;
+  } catch (...) {
+    outcome.error = std::current_exception();
+  }
+}
+
+/// Splits a segment (or a byte prefix of one, `complete` = false) into its per-patch streams. Returns false
+/// when a complete segment's sizes do not fit its bytes (or a varint is malformed).
+bool split_segment(std::span<const std::uint8_t> seg, bool complete, int np, std::vector<StreamPart>& parts) {
+  parts.assign(static_cast<std::size_t>(np), StreamPart{});
+  std::size_t pos = 0;
+  std::vector<std::uint64_t> sizes;
+  for (int p = 0; p + 1 < np; ++p) {
+    std::uint64_t v = 0;
+    for (int i = 0;; ++i) {
+      if (pos >= seg.size()) return !complete;  // a prefix that ends inside the sizes: nothing arrived
+      if (i == 5) return false;
+      const std::uint8_t byte = seg[pos++];
+      v |= static_cast<std::uint64_t>(byte & 0x7F) << (7 * i);
+      if (!(byte & 0x80)) break;
+    }
+    sizes.push_back(v);
+  }
+  for (int p = 0; p < np; ++p) {
+    const bool last = p + 1 == np;
+    const std::size_t left = seg.size() - pos;
+    const std::uint64_t want = last ? left : sizes[static_cast<std::size_t>(p)];
+    if (want > left) {
+      if (complete) return false;
+      // A prefix ending inside this stream: its first bytes; later patches get nothing.
+      parts[static_cast<std::size_t>(p)] = {seg.subspan(pos), false, left > 0};
+      return true;
+    }
+    // Inside a prefix the last stream is never known to be whole; the others are when their bytes are here.
+    parts[static_cast<std::size_t>(p)] = {seg.subspan(pos, static_cast<std::size_t>(want)), complete || !last,
+                                          complete || !last || want > 0};
+    pos += static_cast<std::size_t>(want);
+  }
+  return true;
+}
+
+}  // namespace
 
 Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,
                         std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
-                        BitplaneDecodeResult& result) {
+                        BitplaneDecodeResult& result, int max_threads) {
   result = {};
   if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) ||
       top_bitplane < 0 || top_bitplane > 64) {
@@ -405,52 +567,67 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
     if (m.size() != samples) return Status::kInvalidArgument;
   }
   out.assign(static_cast<std::size_t>(layout.num_patches), PatchCoefficients{});
-  for (auto& patch : out) {
-    for (auto& ch : patch) ch.assign(samples, 0);
-  }
   const std::size_t planes = static_cast<std::size_t>(top_bitplane) + 1;
   Status status = Status::kOk;
   if (segments.size() > planes || (segments.size() == planes && !partial_tail.empty())) {
     status = Status::kCorrupt;  // decode what fits, then report
   }
-  std::vector<Band> bands = make_bands(layout, coded);
-  PlaneCoder<true> coder(layout, bands, nullptr);
-  try {
-    for (std::size_t t = 0; t < planes; ++t) {
-      const int b = top_bitplane - static_cast<int>(t);
-      if (t < segments.size()) {
-        ArithmeticDecoder dec(segments[t]);
-        coder.set_decoder(&dec, false);
-        coder.code_plane(b);
-        ++result.segments_complete;
-      } else {
-        if (!partial_tail.empty()) {
-          ArithmeticDecoder dec(partial_tail);
-          coder.set_decoder(&dec, true);
-          result.partial = true;
-          try {
-            coder.code_plane(b);
-          } catch (const Stop&) {
-          }
+  // Per coder (one for the joint stream, or one per patch): its stream of each plane that arrived.
+  const int np = layout.num_patches;
+  const int num_coders = layout.independent_patches ? np : 1;
+  const std::size_t arrived =
+      std::min(segments.size(), planes) + (segments.size() < planes && !partial_tail.empty());
+  std::vector<std::vector<StreamPart>> parts(static_cast<std::size_t>(num_coders),
+                                             std::vector<StreamPart>(arrived));
+  std::vector<StreamPart> split;
+  for (std::size_t t = 0; t < arrived; ++t) {
+    const bool complete = t < segments.size();
+    const std::span<const std::uint8_t> seg = complete ? segments[t] : partial_tail;
+    if (!layout.independent_patches) {
+      parts[0][t] = {seg, complete, true};
+      continue;
+    }
+    if (!split_segment(seg, complete, np, split)) {
+      status = Status::kCorrupt;  // sizes that do not fit: decode the planes before this one
+      for (auto& pc : parts) pc.resize(t);
+      break;
+    }
+    for (int c = 0; c < np; ++c) parts[static_cast<std::size_t>(c)][t] = split[static_cast<std::size_t>(c)];
+  }
+  std::vector<CoderOutcome> outcomes(static_cast<std::size_t>(num_coders));
+  const auto run = [&](int c) {
+    std::vector<Band> bands = make_bands(layout, coded, layout.independent_patches ? c : -1);
+    PlaneCoder<true> coder(layout, bands, -1, nullptr);
+    decode_planes(coder, top_bitplane, parts[static_cast<std::size_t>(c)],
+                  outcomes[static_cast<std::size_t>(c)]);
+    for (int p = 0; p < np; ++p) {
+      if (layout.independent_patches && p != c) continue;
+      for (auto& ch : out[static_cast<std::size_t>(p)]) ch.assign(samples, 0);
+    }
+    // Reconstruct this coder's bands (each band belongs to one patch; patches of different coders differ).
+    for (const auto& band : bands) {
+      auto& patch = out[static_cast<std::size_t>(band.patch)];
+      for (const Sample& sm : band.lsp) {
+        for (int ch = 0; ch < 3; ++ch) {
+          if (!(sm.flags & (1 << ch))) continue;
+          // The middle of the interval [mag, mag + 2^q) (see the header).
+          const std::int64_t v = static_cast<std::int64_t>(sm.mag[ch]) +
+                                 (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
+          patch[ch][sm.index] = static_cast<std::int32_t>((sm.flags >> (3 + ch)) & 1 ? -v : v);
         }
-        break;
       }
     }
-  } catch (const Corrupt&) {
-    status = Status::kCorrupt;
+  };
+  // Independent streams decode in parallel: coder 0 on this thread, the others on threads of their own.
+  parallel_for(num_coders, max_threads, run);
+  std::size_t complete = planes;
+  for (const CoderOutcome& o : outcomes) {
+    if (o.error) std::rethrow_exception(o.error);
+    if (o.corrupt) status = Status::kCorrupt;
+    complete = std::min(complete, o.planes_complete);
+    result.partial = result.partial || o.partial;
   }
-  for (const auto& band : bands) {
-    auto& patch = out[band.patch];
-    for (const Sample& s : band.lsp) {
-      for (int c = 0; c < 3; ++c) {
-        if (!(s.flags & (1 << c))) continue;
-        // The middle of the interval [mag, mag + 2^q) (see the header).
-        const std::int64_t v =
-            static_cast<std::int64_t>(s.mag[c]) + (s.q[c] > 0 ? (std::int64_t{1} << (s.q[c] - 1)) : 0);
-        patch[c][s.index] = static_cast<std::int32_t>((s.flags >> (3 + c)) & 1 ? -v : v);
-      }
-    }
-  }
+  result.segments_complete = complete;
   return status;
 }
 

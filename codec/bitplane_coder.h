@@ -34,6 +34,15 @@
 // at each segment end and the contexts carry over. Samples whose `coded` mask entry is 0 (seam copies owned
 // by another sample) are never coded and decode as 0.
 //
+// Independent patches (BitplaneLayout::independent_patches, codec header version 2). Each patch has its own
+// bands, contexts and range coder (parents are in the same patch anyway), and a segment is
+//   varint byte size of patch 0's stream, ..., of patch P−2's | stream 0 | ... | stream P−1,
+// so the patches decode in parallel. A byte prefix of a segment gives the patches whose streams are complete
+// in it, then a byte prefix of the next one: inside a plane the order is patch-major. Cost measured on the
+// bunny (2 patches of 257², 14 bits): +191 bytes (+0.1 %) for the separate contexts and sizes, grid PSNR at
+// plane boundaries unchanged (the same bits arrive); full decode 20 → 9 ms on 2 cores. Version 1 (false): one
+// stream for all patches, bands interleaved across patches; still decoded (packs of format version 1).
+//
 // Decoding reconstructs each significant coefficient at the middle of its remaining uncertainty interval
 // (known bits down to plane q: |c| ∈ [known, known + 2^q), reconstructed as known + 2^(q−1)); insignificant
 // ones as 0. (3/8 of the interval, the usual choice for Laplacian data, gave +0.03–0.17 dB grid PSNR but
@@ -60,6 +69,10 @@ struct BitplaneLayout {
   int level = 0;        ///< grid level n of every patch (0..12)
   int steps = 0;        ///< wavelet steps applied (0..level)
   int num_patches = 0;  ///< patches (≥ 1)
+  /// true: each patch has its own contexts and its own stream in every segment (the segment is the varint
+  /// byte sizes of streams 0..P−2, then the P streams), so patches decode in parallel. false: one joint
+  /// stream (format of codec header version 1).
+  bool independent_patches = true;
 };
 
 /// Largest plain bit-plane a coefficient may reach: magnitudes must stay below 2^(kMaxCoefficientPlane + 1).
@@ -84,13 +97,15 @@ struct BitplaneDecodeResult {
 
 /// Decodes: `segments` are complete segments in order, `partial_tail` (possibly empty) a byte prefix of the
 /// next. `out` is resized to num_patches patches of 3 zero-filled channels and receives the reconstruction.
-/// Returns kOk, kInvalidArgument (layout or mask sizes wrong) or kCorrupt (more segments than planes, a tail
-/// after the last plane, a coefficient beyond kMaxCoefficientPlane); never throws on bytes, never reads
-/// outside them, and always leaves `out` holding the reconstruction of what was decoded.
+/// Independent patches decode on up to `max_threads` threads (0: one per hardware thread); the result does
+/// not depend on the thread count. Returns kOk, kInvalidArgument (layout or mask sizes wrong) or kCorrupt
+/// (more segments than planes, a tail after the last plane, stream sizes that do not fit their segment, a
+/// coefficient beyond kMaxCoefficientPlane); never throws on bytes, never reads outside them, and always
+/// leaves `out` holding the reconstruction of what was decoded.
 Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,
                         std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
-                        BitplaneDecodeResult& result);
+                        BitplaneDecodeResult& result, int max_threads = 0);
 
 }  // namespace geomip::codec

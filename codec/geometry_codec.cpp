@@ -1,5 +1,7 @@
 #include "codec/geometry_codec.h"
 
+#include "codec/parallel.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -14,7 +16,8 @@
 namespace geomip::codec {
 namespace {
 
-constexpr std::uint8_t kHeaderVersion = 1;
+// Version 1: one joint bit-plane stream for all patches; version 2: a stream per patch (parallel decoding).
+constexpr std::uint8_t kHeaderVersion = 2;
 constexpr int kMaxLevel = 12;
 constexpr int kMaxTopBitplane = 48;
 constexpr std::uint64_t kMaxTotalSamples = std::uint64_t{1} << 26;  // patches · (2^level+1)²
@@ -112,7 +115,8 @@ bool seam_ok(const PatchSeam& s, int num_patches) {
 
 /// The checks parse() applies, shared with decode_geometry() for headers built by hand.
 bool header_ok(const GeometryCodecHeader& h) {
-  if (h.level < 0 || h.level > kMaxLevel || h.num_patches < 1 || h.steps < 0 || h.steps > h.level)
+  if (h.version < 1 || h.version > kHeaderVersion || h.level < 0 || h.level > kMaxLevel ||
+      h.num_patches < 1 || h.steps < 0 || h.steps > h.level)
     return false;
   const std::uint64_t size = static_cast<std::uint64_t>(grid_size(h.level));
   if (static_cast<std::uint64_t>(h.num_patches) * size * size > kMaxTotalSamples) return false;
@@ -190,7 +194,7 @@ class Reader {
 
 std::vector<std::uint8_t> GeometryCodecHeader::serialize() const {
   std::vector<std::uint8_t> out;
-  out.push_back(kHeaderVersion);
+  out.push_back(static_cast<std::uint8_t>(version));
   put_varint(out, static_cast<std::uint64_t>(level));
   put_varint(out, static_cast<std::uint64_t>(num_patches));
   put_varint(out, static_cast<std::uint64_t>(steps));
@@ -211,7 +215,8 @@ Status GeometryCodecHeader::parse(std::span<const std::uint8_t> bytes, GeometryC
   Reader r(bytes);
   GeometryCodecHeader h;
   std::uint8_t version, filter;
-  if (!r.byte(version) || version != kHeaderVersion) return Status::kCorrupt;
+  if (!r.byte(version) || version < 1 || version > kHeaderVersion) return Status::kCorrupt;
+  h.version = version;
   if (!r.small_int(h.level, kMaxLevel) || !r.small_int(h.num_patches, 1 << 20) ||
       !r.small_int(h.steps, kMaxLevel) || !r.byte(filter) || filter > 1) {
     return Status::kCorrupt;
@@ -314,7 +319,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   for (auto& pc : coefs) {
     for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter);
   }
-  BitplaneEncoding enc = encode_bitplanes({level, h.steps, np}, coefs, own.coded);
+  h.version = kHeaderVersion;
+  BitplaneEncoding enc = encode_bitplanes({level, h.steps, np, true}, coefs, own.coded);
   h.top_bitplane = enc.top_bitplane;
   result.segments = std::move(enc.segments);
   return result;
@@ -331,8 +337,8 @@ Status decode_geometry(const GeometryCodecHeader& header,
   const Ownership own = seam_ownership(level, np, header.seams);
   std::vector<PatchCoefficients> coefs;
   BitplaneDecodeResult r;
-  const Status status =
-      decode_bitplanes({level, steps, np}, header.top_bitplane, own.coded, segments, partial_tail, coefs, r);
+  const Status status = decode_bitplanes({level, steps, np, header.version >= 2}, header.top_bitplane,
+                                         own.coded, segments, partial_tail, coefs, r, options.max_threads);
   out.segments_complete = r.segments_complete;
   out.partial = r.partial;
   if (coefs.size() != static_cast<std::size_t>(np)) return status == Status::kOk ? Status::kCorrupt : status;
@@ -340,42 +346,59 @@ Status decode_geometry(const GeometryCodecHeader& header,
     for (int c = 0; c < 3; ++c)
       coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
   }
-  // Drop the finest details, then find the finest step with a non-zero detail.
+  // Per patch (in parallel): drop the finest details, find the finest step with a non-zero detail, inverse
+  // transform, dequantize.
   const int drop = std::min(options.drop_finest_steps, steps);
-  int finest_step = steps + 1;  // none
-  for (auto& pc : coefs) {
-    for (auto& ch : pc) {
-      for (std::size_t j = 0; j < size; ++j) {
-        for (std::size_t i = 0; i < size; ++i) {
-          std::int32_t& v = ch[j * size + i];
-          if (v == 0) continue;
-          // The step that introduced (i, j): 1 + trailing zeros of i | j; beyond `steps`: the coarse band.
-          const unsigned both = static_cast<unsigned>(i | j);
-          const int k = both == 0 ? steps + 1 : std::min(std::countr_zero(both) + 1, steps + 1);
-          if (k > steps) continue;
-          if (k <= drop) {
-            v = 0;
-          } else {
-            finest_step = std::min(finest_step, k);
-          }
-        }
-      }
-    }
-  }
-  out.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
+  std::vector<int> finest(static_cast<std::size_t>(np), steps + 1);  // steps + 1: none
   out.patches.resize(static_cast<std::size_t>(np));
-  for (int p = 0; p < np; ++p) {
-    Grid3& g = out.patches[p];
+  parallel_for(np, options.max_threads, [&](int p) {
+    Grid3& g = out.patches[static_cast<std::size_t>(p)];
     g.level = level;
     g.values.resize(3 * samples);
     for (int c = 0; c < 3; ++c) {
-      auto& ch = coefs[p][c];
+      auto& ch = coefs[static_cast<std::size_t>(p)][static_cast<std::size_t>(c)];
+      int& f = finest[static_cast<std::size_t>(p)];
+      if (drop == 0) {
+        // Only the finest non-zero step is needed: scan the steps from the finest, stop at the first hit.
+        for (int k = 1; k < f; ++k) {
+          const std::size_t sk = std::size_t{1} << (k - 1);
+          bool hit = false;
+          for (std::size_t j = 0; j < size && !hit; j += sk) {
+            const bool odd_row = (j / sk) & 1;
+            for (std::size_t i = odd_row ? 0 : sk; i < size; i += odd_row ? sk : 2 * sk) {
+              if (ch[j * size + i] != 0) {
+                hit = true;
+                break;
+              }
+            }
+          }
+          if (hit) f = k;
+        }
+      } else {
+        for (std::size_t j = 0; j < size; ++j) {
+          for (std::size_t i = 0; i < size; ++i) {
+            std::int32_t& v = ch[j * size + i];
+            if (v == 0) continue;
+            // The step that introduced (i, j): 1 + trailing zeros of i | j; beyond `steps`: the coarse band.
+            const unsigned both = static_cast<unsigned>(i | j);
+            const int k = both == 0 ? steps + 1 : std::min(std::countr_zero(both) + 1, steps + 1);
+            if (k > steps) continue;
+            if (k <= drop) {
+              v = 0;
+            } else {
+              f = std::min(f, k);
+            }
+          }
+        }
+      }
       wavelet_inverse(ch, level, steps, header.filter);
       for (std::size_t i = 0; i < samples; ++i) {
         g.values[3 * i + c] = to_float(header.origin[c] + header.step * static_cast<double>(ch[i]));
       }
     }
-  }
+  });
+  const int finest_step = *std::min_element(finest.begin(), finest.end());
+  out.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
   return status;
 }
 

@@ -26,8 +26,8 @@ namespace geomip::codec {
 
 /// How two patch sides are glued (same convention as geomip::SideLink in param/mesh_partition.h, repeated
 /// here so codec/ builds without param/). Side s of a (2^n+1)² grid, parameter k ∈ [0, 2^n]:
-/// s = 0: (i, j) = (k, 0); s = 1: (2^n, k); s = 2: (2^n − k, 2^n); s = 3: (0, 2^n − k). `reversed`: sample k of
-/// this side is sample 2^n − k of the other side.
+/// s = 0: (i, j) = (k, 0); s = 1: (2^n, k); s = 2: (2^n − k, 2^n); s = 3: (0, 2^n − k). `reversed`: sample k
+/// of this side is sample 2^n − k of the other side.
 struct PatchSeam {
   int patch = 0;
   int side = 0;
@@ -63,6 +63,9 @@ struct GeometryCodecOptions {
 /// The small fixed parameters the decoder needs besides the segments (stored in the pack manifest).
 /// serialize()/parse() give a compact byte form; parse() never trusts bytes.
 struct GeometryCodecHeader {
+  /// Stream layout: 1 = one joint stream for all patches (packs of format version 1), 2 = one stream per
+  /// patch in every segment, decoded in parallel (written by this encoder).
+  int version = 2;
   int level = 0;        ///< grid level n of every patch
   int num_patches = 0;  ///< patches per model
   int steps = 0;        ///< wavelet steps actually applied
@@ -73,7 +76,8 @@ struct GeometryCodecHeader {
   std::vector<PatchSeam> seams;
 
   std::vector<std::uint8_t> serialize() const;
-  /// Parses `bytes` exactly (all of them); kCorrupt on any inconsistency (level > 12, seams out of range, ...).
+  /// Parses `bytes` exactly (all of them); kCorrupt on any inconsistency (level > 12, seams out of range,
+  /// ...).
   static Status parse(std::span<const std::uint8_t> bytes, GeometryCodecHeader& out);
 };
 
@@ -82,9 +86,9 @@ struct EncodedGeometry {
   std::vector<std::vector<std::uint8_t>> segments;  ///< one per bit-plane, most significant first
 };
 
-/// Encodes the patches (all of one level, same number as seams describe; seam samples must be bit-identical in
-/// the glued patches — resample_geometry() guarantees it). Throws std::invalid_argument on bad input (sizes
-/// differ, NaN, level > 12): this is the encoder, its inputs come from the program, not from bytes.
+/// Encodes the patches (all of one level, same number as seams describe; seam samples must be bit-identical
+/// in the glued patches — resample_geometry() guarantees it). Throws std::invalid_argument on bad input
+/// (sizes differ, NaN, level > 12): this is the encoder, its inputs come from the program, not from bytes.
 EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::vector<PatchSeam>& seams,
                                 const GeometryCodecOptions& options = {});
 
@@ -92,24 +96,27 @@ struct GeometryDecodeOptions {
   /// Zero the details of the finest `drop_finest_steps` wavelet steps (0 = keep all). The result stays on the
   /// full grid: the coarser level interpolated by the wavelet's own subdivision (for band-wise morphing).
   int drop_finest_steps = 0;
+  /// Threads for the per-patch streams of a version-2 stream (0 = one per hardware thread, capped at the
+  /// number of patches; 1 = decode on the calling thread only).
+  int max_threads = 0;
 };
 
 struct DecodedGeometry {
-  std::vector<Grid3> patches;  ///< header.num_patches grids of header.level, in the encoder's units
+  std::vector<Grid3> patches;         ///< header.num_patches grids of header.level, in the encoder's units
   std::size_t segments_complete = 0;  ///< complete segments decoded
   bool partial = false;               ///< a byte prefix of one more segment was also used
   /// Finest wavelet level that received any non-zero detail (0..level): the level of detail these bytes give.
   int detail_level = 0;
 };
 
-/// Decodes `segments` (complete, in order); `partial_tail`, if not empty, is a byte prefix of the next segment.
-/// Never throws on bytes: returns kOk, or kCorrupt (bytes that cannot come from the encoder — the result is
-/// then the best reconstruction up to that point, still watertight). A partial tail is not an error.
-/// kCorrupt also for more segments than header.top_bitplane + 1, or a tail after the last one (the planes that
-/// exist are still decoded). kInvalidArgument (and no patches) for a header that parse() would refuse (built by
-/// hand) or a negative drop_finest_steps. Cost: proportional to the bytes decoded — measured on the bunny
-/// (2 patches of 257²): about 2 ms for 2 KB, 4–5 ms for 16 KB, 25 ms for the full 254 KB of 16-bit
-/// quantization (one core, see tests/bench/codec_bench.cpp).
+/// Decodes `segments` (complete, in order); `partial_tail`, if not empty, is a byte prefix of the next
+/// segment. Never throws on bytes: returns kOk, or kCorrupt (bytes that cannot come from the encoder — the
+/// result is then the best reconstruction up to that point, still watertight). A partial tail is not an
+/// error. kCorrupt also for more segments than header.top_bitplane + 1, or a tail after the last one (the
+/// planes that exist are still decoded). kInvalidArgument (and no patches) for a header that parse() would
+/// refuse (built by hand) or a negative drop_finest_steps. Cost: proportional to the bytes decoded — measured
+/// on the bunny (2 patches of 257²): about 2 ms for 2 KB, 4–5 ms for 16 KB, 25 ms for the full 254 KB of
+/// 16-bit quantization (one core, see tests/bench/codec_bench.cpp).
 Status decode_geometry(const GeometryCodecHeader& header,
                        std::span<const std::span<const std::uint8_t>> segments,
                        std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,

@@ -122,8 +122,8 @@ bool read_mask(ByteReader& r, int side, std::vector<std::uint8_t>& mask) {
 // The fine hole masks of one model (all patches, `side` × `side` quads each) in one arithmetic-coded chunk,
 // each bit in a context of its coded neighbours and of the coarse mask bit above it (`shift` levels coarser):
 // far from the coarse mask's border the bits are nearly free.
-int fine_mask_context(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& coarse, int side,
-                      int shift, int i, int j) {
+int fine_mask_context(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& coarse,
+                      int side, int shift, int i, int j) {
   const int coarse_side = side >> shift;
   return mask_context(mask, side, i, j) |
          coarse[static_cast<std::size_t>(j >> shift) * coarse_side + (i >> shift)] << 4;
@@ -145,16 +145,17 @@ std::vector<std::uint8_t> encode_fine_masks(const std::vector<std::vector<std::u
   return encoder.finish();
 }
 
-void decode_fine_masks(std::span<const std::uint8_t> bytes, const std::vector<std::vector<std::uint8_t>>& coarse,
-                       int side, int shift, std::vector<std::vector<std::uint8_t>>& masks) {
+void decode_fine_masks(std::span<const std::uint8_t> bytes,
+                       const std::vector<std::vector<std::uint8_t>>& coarse, int side, int shift,
+                       std::vector<std::vector<std::uint8_t>>& masks) {
   ArithmeticDecoder decoder(bytes);
   Context contexts[32];
   masks.assign(coarse.size(), std::vector<std::uint8_t>(static_cast<std::size_t>(side) * side, 0));
   for (std::size_t p = 0; p < coarse.size(); ++p)
     for (int j = 0; j < side; ++j)
       for (int i = 0; i < side; ++i)
-        masks[p][static_cast<std::size_t>(j) * side + i] =
-            static_cast<std::uint8_t>(decoder.decode(contexts[fine_mask_context(masks[p], coarse[p], side, shift, i, j)]));
+        masks[p][static_cast<std::size_t>(j) * side + i] = static_cast<std::uint8_t>(
+            decoder.decode(contexts[fine_mask_context(masks[p], coarse[p], side, shift, i, j)]));
 }
 
 /// The coarse mask `shift` levels above `mask`: a coarse quad is masked when at least half of its quads are.
@@ -165,7 +166,8 @@ std::vector<std::uint8_t> coarsen_mask(const std::vector<std::uint8_t>& mask, in
     for (int ci = 0; ci < coarse_side; ++ci) {
       int count = 0;
       for (int j = cj * block; j < (cj + 1) * block; ++j)
-        for (int i = ci * block; i < (ci + 1) * block; ++i) count += mask[static_cast<std::size_t>(j) * side + i] != 0;
+        for (int i = ci * block; i < (ci + 1) * block; ++i)
+          count += mask[static_cast<std::size_t>(j) * side + i] != 0;
       coarse[static_cast<std::size_t>(cj) * coarse_side + ci] = 2 * count >= block * block;
     }
   return coarse;
@@ -176,8 +178,9 @@ std::vector<std::uint8_t> coarsen_mask(const std::vector<std::uint8_t>& mask, in
 struct ChunkKey {
   int stage, kind, model, pass;
 };
-std::vector<ChunkKey> chunk_order(const std::vector<int>& geometry_passes, const std::vector<int>& normal_passes,
-                                  const std::vector<bool>& fine_mask, int normals_delay, int mask_stage) {
+std::vector<ChunkKey> chunk_order(const std::vector<int>& geometry_passes,
+                                  const std::vector<int>& normal_passes, const std::vector<bool>& fine_mask,
+                                  int normals_delay, int mask_stage) {
   std::vector<ChunkKey> keys;
   for (std::size_t m = 0; m < geometry_passes.size(); ++m) {
     for (int p = 0; p < geometry_passes[m]; ++p) keys.push_back({p, 0, static_cast<int>(m), p});
@@ -190,7 +193,9 @@ std::vector<ChunkKey> chunk_order(const std::vector<int>& geometry_passes, const
   return keys;
 }
 
-int passes_of(const GeometryCodecHeader& h) { return h.top_bitplane + 1; }
+int passes_of(const GeometryCodecHeader& h) {
+  return h.top_bitplane + 1;
+}
 
 std::uint64_t samples_of(const GeometryCodecHeader& h) {
   const std::uint64_t n = (std::uint64_t{1} << h.level) + 1;
@@ -214,6 +219,8 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
         !r.bytes(header, 1 << 20) || GeometryCodecHeader::parse(header, model.geometry) != Status::kOk ||
         !r.u8(has_normals) || has_normals > 1)
       return Status::kCorrupt;
+    // Pack version 1 holds joint streams (codec header version 1), version 2 per-patch ones (version 2).
+    if (model.geometry.version != out.version) return Status::kCorrupt;
     if (model.geometry.level > kMaxPackLevel || passes_of(model.geometry) < 1 ||
         passes_of(model.geometry) > static_cast<int>(kMaxPasses))
       return Status::kCorrupt;
@@ -221,14 +228,16 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     model.has_normals = has_normals == 1;
     if (model.has_normals) {
       if (!r.bytes(header, 1 << 20) || GeometryCodecHeader::parse(header, model.normals) != Status::kOk ||
-          model.normals.level > kMaxPackLevel || model.normals.num_patches != model.geometry.num_patches ||
-          passes_of(model.normals) < 1 || passes_of(model.normals) > static_cast<int>(kMaxPasses))
+          model.normals.version != out.version || model.normals.level > kMaxPackLevel ||
+          model.normals.num_patches != model.geometry.num_patches || passes_of(model.normals) < 1 ||
+          passes_of(model.normals) > static_cast<int>(kMaxPasses))
         return Status::kCorrupt;
       samples += samples_of(model.normals);
     }
     if (samples > kMaxSamplesPerPack) return Status::kCorrupt;
     std::uint64_t mask_patches;
-    if (!r.bounded(mask_patches, static_cast<std::uint64_t>(model.geometry.num_patches))) return Status::kCorrupt;
+    if (!r.bounded(mask_patches, static_cast<std::uint64_t>(model.geometry.num_patches)))
+      return Status::kCorrupt;
     if (mask_patches != 0 && mask_patches != static_cast<std::uint64_t>(model.geometry.num_patches))
       return Status::kCorrupt;
     model.hole_mask.resize(static_cast<std::size_t>(mask_patches));
@@ -246,8 +255,9 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     geometry_passes.push_back(passes_of(model.geometry));
     normal_passes.push_back(model.has_normals ? passes_of(model.normals) : 0);
   }
-  const std::vector<ChunkKey> order = chunk_order(geometry_passes, normal_passes, fine_mask,
-                                                  static_cast<int>(normals_delay), static_cast<int>(mask_stage));
+  const std::vector<ChunkKey> order =
+      chunk_order(geometry_passes, normal_passes, fine_mask, static_cast<int>(normals_delay),
+                  static_cast<int>(mask_stage));
   std::uint64_t chunk_count;
   if (!r.varint(chunk_count) || chunk_count != order.size()) return Status::kCorrupt;
   out.chunks.resize(order.size());
@@ -282,13 +292,14 @@ std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
 
 Status read_pack_header(std::span<const std::uint8_t> bytes, std::size_t& manifest_end) {
   const std::size_t n = std::min(bytes.size(), sizeof kMagic);
-  if (!std::equal(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n), kMagic)) return Status::kCorrupt;
+  if (!std::equal(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n), kMagic))
+    return Status::kCorrupt;
   if (bytes.size() < kPackHeaderSize) return Status::kTruncated;
   ByteReader r(bytes.subspan(sizeof kMagic));
   std::uint16_t version = 0, flags = 0;
   std::uint32_t manifest_size = 0, manifest_crc = 0;
   r.u16(version), r.u16(flags), r.u32(manifest_size), r.u32(manifest_crc);
-  if (version != kPackVersion) return Status::kUnsupportedVersion;
+  if (version < kOldestPackVersion || version > kPackVersion) return Status::kUnsupportedVersion;
   if (flags != 0 || manifest_size > kMaxManifestSize) return Status::kCorrupt;
   manifest_end = kPackHeaderSize + manifest_size;
   return Status::kOk;
@@ -305,12 +316,14 @@ Status read_pack_info(std::span<const std::uint8_t> bytes, PackInfo& out) {
   const auto manifest = bytes.subspan(kPackHeaderSize, manifest_end - kPackHeaderSize);
   if (kCheckCrc && crc32(manifest) != manifest_crc) return Status::kCorrupt;
   out.manifest_end = manifest_end;
+  out.version = static_cast<std::uint16_t>(bytes[8] | bytes[9] << 8);
   const Status s = parse_manifest(manifest, manifest_end, out);
   if (s != Status::kOk) out = {};
   return s;
 }
 
-std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, const PackWriteOptions& options) {
+std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
+                                     const PackWriteOptions& options) {
   if (models.empty()) throw std::invalid_argument("write_pack: no models");
   if (models.size() > kMaxModels) throw std::invalid_argument("write_pack: more than 64 models");
   if (options.normals_delay < 0 || options.normals_delay > static_cast<int>(kMaxPasses))
@@ -320,7 +333,8 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
   for (std::size_t m = 0; m < models.size(); ++m) {
     const PackModelInput& model = models[m];
     if (model.name.size() > kMaxNameSize) throw std::invalid_argument("write_pack: model name too long");
-    if (model.geometry.empty()) throw std::invalid_argument("write_pack: model '" + model.name + "' has no patches");
+    if (model.geometry.empty())
+      throw std::invalid_argument("write_pack: model '" + model.name + "' has no patches");
     if (model.geometry.front().level > kMaxPackLevel)
       throw std::invalid_argument("write_pack: level above " + std::to_string(kMaxPackLevel));
     geometry[m] = encode_geometry(model.geometry, model.seams, options.geometry);
@@ -341,7 +355,8 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
       if (model.hole_mask.size() != model.geometry.size() ||
           std::any_of(model.hole_mask.begin(), model.hole_mask.end(),
                       [&](const auto& mask) { return mask.size() != quads; }))
-        throw std::invalid_argument("write_pack: model '" + model.name + "': hole mask does not match the grid");
+        throw std::invalid_argument("write_pack: model '" + model.name +
+                                    "': hole mask does not match the grid");
     }
   }
 
@@ -367,7 +382,8 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, 
     const int max_passes = *std::max_element(geometry_passes.begin(), geometry_passes.end());
     for (mask_stage = 0; mask_stage + 1 < max_passes; ++mask_stage) {
       for (std::size_t m = 0; m < models.size(); ++m)
-        if (mask_stage < geometry_passes[m]) total += geometry[m].segments[static_cast<std::size_t>(mask_stage)].size();
+        if (mask_stage < geometry_passes[m])
+          total += geometry[m].segments[static_cast<std::size_t>(mask_stage)].size();
       if (total >= options.hole_mask_after_bytes) break;
     }
   }
@@ -477,14 +493,16 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
     model.geometry_passes = s.geometry.size();
     try {
       DecodedGeometry decoded;
-      const Status g = decode_geometry(model_info.geometry, s.geometry, s.geometry_tail, decoded,
-                                       {.drop_finest_steps = options.drop_finest_steps});
+      const Status g = decode_geometry(
+          model_info.geometry, s.geometry, s.geometry_tail, decoded,
+          {.drop_finest_steps = options.drop_finest_steps, .max_threads = options.max_threads});
       if (g != Status::kOk) result.status = Status::kCorrupt;
       model.geometry = std::move(decoded.patches);
       model.detail_level = decoded.detail_level;
       if (options.normals && model_info.has_normals && (!s.normals.empty() || !s.normals_tail.empty())) {
         DecodedGeometry decoded_normals;
-        if (decode_geometry(model_info.normals, s.normals, s.normals_tail, decoded_normals) != Status::kOk)
+        if (decode_geometry(model_info.normals, s.normals, s.normals_tail, decoded_normals,
+                            {.max_threads = options.max_threads}) != Status::kOk)
           result.status = Status::kCorrupt;
         model.normals = std::move(decoded_normals.patches);
         for (Grid3& grid : model.normals) {

@@ -30,7 +30,10 @@
 namespace geomip::codec {
 
 inline constexpr std::size_t kPackHeaderSize = 20;
-inline constexpr std::uint16_t kPackVersion = 1;
+/// Format version written. Version 2 (this one): bit-plane segments hold one stream per patch (codec header
+/// version 2), decoded in parallel. Version 1: one joint stream per segment; still read.
+inline constexpr std::uint16_t kPackVersion = 2;
+inline constexpr std::uint16_t kOldestPackVersion = 1;
 
 enum class ChunkKind : std::uint8_t {
   kGeometry = 0,  ///< one bit-plane pass of a model's geometry stream
@@ -41,8 +44,8 @@ enum class ChunkKind : std::uint8_t {
 struct ChunkInfo {
   int model = 0;
   ChunkKind kind = ChunkKind::kGeometry;
-  int pass = 0;             ///< bit-plane pass of that model's stream (0 = most significant)
-  std::uint64_t offset = 0; ///< from the start of the file (derived from the sizes)
+  int pass = 0;              ///< bit-plane pass of that model's stream (0 = most significant)
+  std::uint64_t offset = 0;  ///< from the start of the file (derived from the sizes)
   std::uint32_t size = 0;
   std::uint32_t crc32 = 0;
 };
@@ -90,7 +93,7 @@ struct PackModelInput {
   std::vector<Grid3> normals;   ///< per patch, or empty (geometry-only pack)
   std::vector<PatchSeam> seams;
   std::vector<std::vector<std::uint8_t>> hole_mask;  ///< as PackModelInfo::hole_mask; may be empty
-  int hole_mask_level = -1;  ///< level of hole_mask's grid; -1 = the geometry's level
+  int hole_mask_level = -1;                          ///< level of hole_mask's grid; -1 = the geometry's level
 };
 
 struct PackWriteOptions {
@@ -108,34 +111,36 @@ struct PackWriteOptions {
 
 /// Encodes and lays out a pack in memory. Throws std::invalid_argument on bad input (models whose patch
 /// layouts differ, NaN, ...).
-std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models, const PackWriteOptions& options = {});
+std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
+                                     const PackWriteOptions& options = {});
 
 // ---- decoding ------------------------------------------------------------------------------------------
 
 struct PackDecodeOptions {
   /// Use only the first max_bytes bytes of the buffer (as if only they had arrived).
   std::size_t max_bytes = std::numeric_limits<std::size_t>::max();
-  bool normals = true;        ///< decode normal maps when the pack has them
-  bool partial_chunks = true; ///< also use a byte prefix of the first incomplete chunk (embedded streams)
-  int drop_finest_steps = 0;  ///< see GeometryDecodeOptions
+  bool normals = true;         ///< decode normal maps when the pack has them
+  bool partial_chunks = true;  ///< also use a byte prefix of the first incomplete chunk (embedded streams)
+  int drop_finest_steps = 0;   ///< see GeometryDecodeOptions
+  int max_threads = 0;         ///< per-patch decoding threads, see GeometryDecodeOptions
 };
 
 struct DecodedModel {
   std::string name;
   std::array<double, 16> normalization{};
-  std::vector<Grid3> geometry;                        ///< per patch, model units
-  std::vector<Grid3> normals;                         ///< per patch (empty when not decoded / not in pack)
+  std::vector<Grid3> geometry;  ///< per patch, model units
+  std::vector<Grid3> normals;   ///< per patch (empty when not decoded / not in pack)
   std::vector<PatchSeam> seams;
-  std::vector<std::vector<std::uint8_t>> hole_mask;   ///< as PackModelInfo::hole_mask
+  std::vector<std::vector<std::uint8_t>> hole_mask;  ///< as PackModelInfo::hole_mask
   int hole_mask_level = 0;
-  int detail_level = 0;                               ///< finest level that received detail
-  std::size_t geometry_passes = 0;                    ///< complete geometry passes decoded
+  int detail_level = 0;             ///< finest level that received detail
+  std::size_t geometry_passes = 0;  ///< complete geometry passes decoded
 };
 
 struct PackDecodeResult {
   /// kOk: every chunk decoded. kTruncated: the bytes end early; `models` hold what the prefix gives (empty if
-  /// it ends inside the manifest). kCorrupt: a chunk failed its CRC (decoding stopped at the last good pass of
-  /// every model) or the manifest is damaged. kUnsupportedVersion: another format version.
+  /// it ends inside the manifest). kCorrupt: a chunk failed its CRC (decoding stopped at the last good pass
+  /// of every model) or the manifest is damaged. kUnsupportedVersion: another format version.
   Status status = Status::kOk;
   PackInfo info;
   std::vector<DecodedModel> models;

@@ -1,5 +1,8 @@
 // Codec benchmarks (Google Benchmark): encode and full decode of a synthetic two-patch level-8 model.
 //
+// Pack decode times (the benchmark: a whole level-8 bunny pack, in-process):
+//   codec_bench --pack FILE.gip     (CODEC_DECODE_REPS = repetitions, best taken; default 20)
+//
 // Rate–distortion report instead of benchmarks:
 //   codec_bench --rd FILE.geometry.exr|synthetic [--filter linear|cubic|both] [--steps N] [--bits B] [--mesh
 //   M | --surface on]
@@ -18,10 +21,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "codec/geometry_codec.h"
+#include "codec/pack.h"
 #include "gimage/exr_io.h"
 #include "gimage/surface_distance.h"
 #include "param/mesh_io.h"
@@ -192,7 +199,8 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
     // Full decode timing: best of 10.
     std::vector<std::span<const std::uint8_t>> all(enc.segments.begin(), enc.segments.end());
     double best = 1e30;
-    for (int r = 0; r < 10; ++r) {
+    const int reps = std::getenv("CODEC_DECODE_REPS") ? std::atoi(std::getenv("CODEC_DECODE_REPS")) : 10;
+    for (int r = 0; r < reps; ++r) {
       DecodedGeometry dec;
       const auto d0 = std::chrono::steady_clock::now();
       decode_geometry(enc.header, all, {}, dec);
@@ -204,9 +212,46 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
   return 0;
 }
 
+/// --pack FILE: in-process decode time of a .gip (best of `reps`), whole and for a few prefixes, geometry
+/// only and with normal maps, on one thread and on every hardware thread.
+int pack_report(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::fprintf(stderr, "codec_bench: cannot open %s\n", path.c_str());
+    return 2;
+  }
+  const std::vector<std::uint8_t> pack((std::istreambuf_iterator<char>(in)),
+                                       std::istreambuf_iterator<char>());
+  const int reps = std::getenv("CODEC_DECODE_REPS") ? std::atoi(std::getenv("CODEC_DECODE_REPS")) : 20;
+  std::printf("%s: %zu bytes, %u hardware threads, best of %d\n", path.c_str(), pack.size(),
+              std::thread::hardware_concurrency(), reps);
+  std::vector<std::size_t> sizes = {2048, 4700, 8800, 16384, 65536, pack.size()};
+  for (bool normals : {false, true}) {
+    for (int threads : {1, 0}) {
+      for (std::size_t n : sizes) {
+        if (n > pack.size()) continue;
+        double best = 1e30;
+        PackDecodeResult r;
+        for (int k = 0; k < reps; ++k) {
+          const auto t0 = std::chrono::steady_clock::now();
+          r = decode_pack(pack, {.max_bytes = n, .normals = normals, .max_threads = threads});
+          best = std::min(
+              best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        }
+        std::printf("  %-14s %-9s %7zu bytes: %6.2f ms  (%s, detail level %d)\n",
+                    normals ? "with normals" : "geometry only", threads == 1 ? "1 thread" : "threads", n,
+                    best, std::string(status_message(r.status)).c_str(),
+                    r.models.empty() ? -1 : r.models[0].detail_level);
+      }
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::strcmp(argv[1], "--pack") == 0) return pack_report(argv[2]);
   if (argc >= 3 && std::strcmp(argv[1], "--rd") == 0) {
     std::string filters = "both";
     int steps = -1, bits = 16;

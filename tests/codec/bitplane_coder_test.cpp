@@ -62,21 +62,23 @@ double squared_error(const std::vector<PatchCoefficients>& a, const std::vector<
 }
 
 TEST(BitplaneCoder, AllSegmentsAreLossless) {
-  for (int level : {0, 1, 2, 3, 5, 7}) {
-    for (int steps : {0, level / 2, level}) {
-      const BitplaneLayout layout{level, steps, 2};
-      const auto coefs = smooth_coefficients(level, steps, 2, static_cast<std::uint32_t>(level * 10 + steps));
-      const auto coded = all_coded(level, 2);
-      const auto enc = encode_bitplanes(layout, coefs, coded);
-      ASSERT_EQ(enc.segments.size(), static_cast<std::size_t>(enc.top_bitplane) + 1);
-      std::vector<PatchCoefficients> out;
-      BitplaneDecodeResult r;
-      const auto segs = spans(enc.segments, enc.segments.size());
-      ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, segs, {}, out, r), Status::kOk);
-      EXPECT_EQ(r.segments_complete, enc.segments.size());
-      EXPECT_EQ(squared_error(out, coefs), 0) << "level " << level << " steps " << steps;
+  for (bool independent : {true, false})
+    for (int level : {0, 1, 2, 3, 5, 7}) {
+      for (int steps : {0, level / 2, level}) {
+        const BitplaneLayout layout{level, steps, 2, independent};
+        const auto coefs =
+            smooth_coefficients(level, steps, 2, static_cast<std::uint32_t>(level * 10 + steps));
+        const auto coded = all_coded(level, 2);
+        const auto enc = encode_bitplanes(layout, coefs, coded);
+        ASSERT_EQ(enc.segments.size(), static_cast<std::size_t>(enc.top_bitplane) + 1);
+        std::vector<PatchCoefficients> out;
+        BitplaneDecodeResult r;
+        const auto segs = spans(enc.segments, enc.segments.size());
+        ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, segs, {}, out, r), Status::kOk);
+        EXPECT_EQ(r.segments_complete, enc.segments.size());
+        EXPECT_EQ(squared_error(out, coefs), 0) << "level " << level << " steps " << steps;
+      }
     }
-  }
 }
 
 TEST(BitplaneCoder, UncodedSamplesDecodeAsZeroAndDoNotDisturbOthers) {
@@ -127,24 +129,26 @@ TEST(BitplaneCoder, EveryPrefixDecodesExactlyTheCodedBits) {
   // true magnitude's interval width, i.e. decoded coefficients never have the wrong sign or a wrong known
   // bit.
   const int level = 4;
-  const BitplaneLayout layout{level, level, 2};
-  const auto coefs = smooth_coefficients(level, level, 2, 5);
-  const auto coded = all_coded(level, 2);
-  const auto enc = encode_bitplanes(layout, coefs, coded);
-  for (std::size_t k = 0; k < enc.segments.size(); ++k) {
-    const auto segs = spans(enc.segments, k);
-    for (std::size_t len = 0; len <= enc.segments[k].size(); ++len) {
-      std::vector<PatchCoefficients> out;
-      BitplaneDecodeResult r;
-      const std::span<const std::uint8_t> tail(enc.segments[k].data(), len);
-      ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, segs, tail, out, r), Status::kOk);
-      for (int p = 0; p < 2; ++p) {
-        for (int c = 0; c < 3; ++c) {
-          for (std::size_t i = 0; i < out[p][c].size(); ++i) {
-            const std::int64_t d = out[p][c][i], t = coefs[p][c][i];
-            if (d != 0) {
-              ASSERT_TRUE((d > 0) == (t > 0)) << "wrong sign";
-              ASSERT_LE(std::abs(d - t), std::abs(t)) << "decoded value outside the true interval";
+  for (bool independent : {true, false}) {
+    const BitplaneLayout layout{level, level, 2, independent};
+    const auto coefs = smooth_coefficients(level, level, 2, 5);
+    const auto coded = all_coded(level, 2);
+    const auto enc = encode_bitplanes(layout, coefs, coded);
+    for (std::size_t k = 0; k < enc.segments.size(); ++k) {
+      const auto segs = spans(enc.segments, k);
+      for (std::size_t len = 0; len <= enc.segments[k].size(); ++len) {
+        std::vector<PatchCoefficients> out;
+        BitplaneDecodeResult r;
+        const std::span<const std::uint8_t> tail(enc.segments[k].data(), len);
+        ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, segs, tail, out, r), Status::kOk);
+        for (int p = 0; p < 2; ++p) {
+          for (int c = 0; c < 3; ++c) {
+            for (std::size_t i = 0; i < out[p][c].size(); ++i) {
+              const std::int64_t d = out[p][c][i], t = coefs[p][c][i];
+              if (d != 0) {
+                ASSERT_TRUE((d > 0) == (t > 0)) << "wrong sign";
+                ASSERT_LE(std::abs(d - t), std::abs(t)) << "decoded value outside the true interval";
+              }
             }
           }
         }
@@ -153,26 +157,75 @@ TEST(BitplaneCoder, EveryPrefixDecodesExactlyTheCodedBits) {
   }
 }
 
+// Per-patch streams decode on several threads; the result must not depend on how many.
+TEST(BitplaneCoder, ThreadCountDoesNotChangeAnyPrefix) {
+  const int level = 5, np = 3;
+  const BitplaneLayout layout{level, level, np, true};
+  const auto coefs = smooth_coefficients(level, level, np, 21);
+  const auto coded = all_coded(level, np);
+  const auto enc = encode_bitplanes(layout, coefs, coded);
+  for (std::size_t k = 0; k < enc.segments.size(); ++k) {
+    const auto segs = spans(enc.segments, k);
+    for (std::size_t len = 0; len <= enc.segments[k].size(); len += 1 + len / 8) {
+      const std::span<const std::uint8_t> tail(enc.segments[k].data(), len);
+      std::vector<PatchCoefficients> one, many;
+      BitplaneDecodeResult r1, r4;
+      ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, segs, tail, one, r1, 1), Status::kOk);
+      ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, segs, tail, many, r4, 4), Status::kOk);
+      ASSERT_EQ(squared_error(one, many), 0) << k << " segments + " << len << " bytes";
+      ASSERT_EQ(r1.segments_complete, r4.segments_complete);
+      ASSERT_EQ(r1.partial, r4.partial);
+    }
+  }
+}
+
+// A segment whose stream sizes claim more bytes than it has is corrupt; the planes before it still decode.
+TEST(BitplaneCoder, StreamSizesBeyondTheSegmentAreCorrupt) {
+  const int level = 4;
+  const BitplaneLayout layout{level, level, 2, true};
+  const auto coefs = smooth_coefficients(level, level, 2, 8);
+  const auto coded = all_coded(level, 2);
+  auto enc = encode_bitplanes(layout, coefs, coded);
+  const std::size_t bad = enc.segments.size() / 2;
+  auto& seg = enc.segments[bad];
+  // Replace patch 0's size varint with one larger than the whole segment.
+  std::size_t varint_len = 0;
+  while (seg[varint_len] & 0x80) ++varint_len;
+  seg.erase(seg.begin(), seg.begin() + static_cast<std::ptrdiff_t>(varint_len + 1));
+  const std::uint64_t big = seg.size() + 100;
+  seg.insert(seg.begin(), {static_cast<std::uint8_t>(big | 0x80), static_cast<std::uint8_t>(big >> 7)});
+  std::vector<PatchCoefficients> out, before;
+  BitplaneDecodeResult r, rb;
+  const auto segs = spans(enc.segments, enc.segments.size());
+  EXPECT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, segs, {}, out, r), Status::kCorrupt);
+  EXPECT_EQ(r.segments_complete, bad);
+  ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, spans(enc.segments, bad), {}, before, rb),
+            Status::kOk);
+  EXPECT_EQ(squared_error(out, before), 0);
+}
+
 TEST(BitplaneCoder, GarbageNeverCrashes) {
   const int level = 5;
-  const BitplaneLayout layout{level, level, 2};
-  const auto coded = all_coded(level, 2);
-  std::mt19937 rng(77);
-  for (int trial = 0; trial < 200; ++trial) {
-    const int top = static_cast<int>(rng() % 50);
-    std::vector<std::vector<std::uint8_t>> segs(rng() % 40);
-    for (auto& s : segs) {
-      s.resize(rng() % 200);
-      for (auto& b : s) b = static_cast<std::uint8_t>(rng());
+  for (bool independent : {true, false}) {
+    const BitplaneLayout layout{level, level, 2, independent};
+    const auto coded = all_coded(level, 2);
+    std::mt19937 rng(77);
+    for (int trial = 0; trial < 200; ++trial) {
+      const int top = static_cast<int>(rng() % 50);
+      std::vector<std::vector<std::uint8_t>> segs(rng() % 40);
+      for (auto& s : segs) {
+        s.resize(rng() % 200);
+        for (auto& b : s) b = static_cast<std::uint8_t>(rng());
+      }
+      std::vector<std::uint8_t> tail(rng() % 50);
+      for (auto& b : tail) b = static_cast<std::uint8_t>(rng());
+      std::vector<PatchCoefficients> out;
+      BitplaneDecodeResult r;
+      const auto sp = spans(segs, segs.size());
+      const Status st = decode_bitplanes(layout, top, coded, sp, tail, out, r);
+      EXPECT_TRUE(st == Status::kOk || st == Status::kCorrupt);
+      EXPECT_EQ(out.size(), 2u);
     }
-    std::vector<std::uint8_t> tail(rng() % 50);
-    for (auto& b : tail) b = static_cast<std::uint8_t>(rng());
-    std::vector<PatchCoefficients> out;
-    BitplaneDecodeResult r;
-    const auto sp = spans(segs, segs.size());
-    const Status st = decode_bitplanes(layout, top, coded, sp, tail, out, r);
-    EXPECT_TRUE(st == Status::kOk || st == Status::kCorrupt);
-    EXPECT_EQ(out.size(), 2u);
   }
 }
 

@@ -1,4 +1,5 @@
-// The .gip pack: round trip, every prefix, corruption, versions, trailing bytes, and the committed golden pack.
+// The .gip pack: round trip, every prefix, corruption, versions, trailing bytes, and the committed golden
+// pack.
 #include "codec/pack.h"
 
 #include "tests/codec/pillow.h"
@@ -80,7 +81,8 @@ TEST(Pack, RoundTripWithinQuantization) {
 }
 
 TEST(Pack, ChunksAreOrderedCoarseToFineAcrossModels) {
-  const std::vector<std::uint8_t> pack = write_pack({pillow_model(5, "a", 1.0, true), pillow_model(5, "b", 1.0, true)});
+  const std::vector<std::uint8_t> pack =
+      write_pack({pillow_model(5, "a", 1.0, true), pillow_model(5, "b", 1.0, true)});
   PackInfo info;
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   // Geometry pass p of model 1 never precedes pass p of model 0, nor pass p+1 of model 0 precede pass p of 1.
@@ -162,8 +164,8 @@ TEST(Pack, CorruptChunkStopsAtLastGoodPass) {
   EXPECT_EQ(r.status, Status::kCorrupt);
   EXPECT_EQ(r.chunks_decoded, victim);
   ASSERT_EQ(r.models.size(), 1u);
-  const PackDecodeResult good_prefix =
-      decode_pack(pack, {.max_bytes = static_cast<std::size_t>(info.chunks[victim].offset), .partial_chunks = false});
+  const PackDecodeResult good_prefix = decode_pack(
+      pack, {.max_bytes = static_cast<std::size_t>(info.chunks[victim].offset), .partial_chunks = false});
   EXPECT_EQ(r.models[0].geometry[0].values, good_prefix.models[0].geometry[0].values);
 }
 
@@ -224,7 +226,8 @@ TEST(Pack, HoleMaskIsCoarseUntilItsChunkArrives) {
   EXPECT_EQ(info.models[0].hole_mask_level, 3);
   EXPECT_EQ(info.models[0].fine_hole_mask_level, 5);
 
-  const PackDecodeResult before = decode_pack(pack, {.max_bytes = static_cast<std::size_t>(chunk->offset + chunk->size - 1)});
+  const PackDecodeResult before =
+      decode_pack(pack, {.max_bytes = static_cast<std::size_t>(chunk->offset + chunk->size - 1)});
   ASSERT_EQ(before.models.size(), 1u);
   EXPECT_EQ(before.models[0].hole_mask_level, 3);
   // Coarse quad (ci, cj) covers fine quads [4ci, 4ci+4) × [4cj, 4cj+4): masked when half of them are.
@@ -234,10 +237,12 @@ TEST(Pack, HoleMaskIsCoarseUntilItsChunkArrives) {
     for (int ci = 0; ci < 8; ++ci) {
       int count = 0;
       for (int j = 4 * cj; j < 4 * cj + 4; ++j)
-        for (int i = 4 * ci; i < 4 * ci + 4; ++i) count += m.hole_mask[0][static_cast<std::size_t>(j * 32 + i)];
+        for (int i = 4 * ci; i < 4 * ci + 4; ++i)
+          count += m.hole_mask[0][static_cast<std::size_t>(j * 32 + i)];
       EXPECT_EQ(coarse[static_cast<std::size_t>(cj * 8 + ci)], count >= 8 ? 1 : 0) << ci << "," << cj;
     }
-  const PackDecodeResult after = decode_pack(pack, {.max_bytes = static_cast<std::size_t>(chunk->offset + chunk->size)});
+  const PackDecodeResult after =
+      decode_pack(pack, {.max_bytes = static_cast<std::size_t>(chunk->offset + chunk->size)});
   EXPECT_EQ(after.models[0].hole_mask_level, 5);
   EXPECT_EQ(after.models[0].hole_mask, m.hole_mask);
 }
@@ -252,16 +257,26 @@ TEST(Pack, WriterRejectsBadInput) {
   EXPECT_THROW(write_pack({nan}), std::invalid_argument);
 }
 
-// The committed golden pack (tests/data/golden-pillow.gip, written by format version 1) must keep decoding to
-// the pillow it was made from: decoders of old streams do not silently change.
-TEST(Pack, GoldenPackDecodes) {
-  std::ifstream in(std::string(GEOMIP_SOURCE_DIR) + "/tests/data/golden-pillow.gip", std::ios::binary);
-  ASSERT_TRUE(in) << "missing tests/data/golden-pillow.gip";
-  const std::vector<std::uint8_t> pack((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+// The committed golden packs (tests/data/golden-pillow.gip written by format version 1, golden-pillow-v2.gip
+// by version 2) must keep decoding to the pillow they were made from: decoders of old streams do not silently
+// change.
+class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
+
+TEST_P(GoldenPack, Decodes) {
+  const auto [file, version] = GetParam();
+  std::ifstream in(std::string(GEOMIP_SOURCE_DIR) + "/tests/data/" + file, std::ios::binary);
+  ASSERT_TRUE(in) << "missing tests/data/" << file;
+  const std::vector<std::uint8_t> pack((std::istreambuf_iterator<char>(in)),
+                                       std::istreambuf_iterator<char>());
+  PackInfo info;
+  ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
+  EXPECT_EQ(info.version, version);
+  EXPECT_EQ(info.models.at(0).geometry.version, version);
   const PackDecodeResult r = decode_pack(pack);
   ASSERT_EQ(r.status, Status::kOk);
   ASSERT_EQ(r.models.size(), 2u);
-  const std::vector<PackModelInput> expected = {pillow_model(5, "a", 1.0, true), pillow_model(5, "b", 2.0, true)};
+  const std::vector<PackModelInput> expected = {pillow_model(5, "a", 1.0, true),
+                                                pillow_model(5, "b", 2.0, true)};
   for (std::size_t m = 0; m < 2; ++m) {
     EXPECT_EQ(r.models[m].name, expected[m].name);
     EXPECT_LE(max_error(r.models[m].geometry, expected[m].geometry), (m == 0 ? 2.0 : 4.0) / 16384.0);
@@ -275,6 +290,10 @@ TEST(Pack, GoldenPackDecodes) {
     for (const DecodedModel& model : p.models) EXPECT_EQ(seam_mismatches(model.geometry, model.seams), 0u);
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Versions, GoldenPack,
+                         ::testing::Values(std::pair<const char*, int>{"golden-pillow.gip", 1},
+                                           std::pair<const char*, int>{"golden-pillow-v2.gip", 2}));
 
 }  // namespace
 }  // namespace geomip::codec

@@ -50,18 +50,50 @@ inline std::uint32_t pack(int l, int x, int y) {
          static_cast<std::uint32_t>(y);
 }
 
+/// The order in which the bytes of P streams are interleaved in a segment, a function of their sizes only:
+/// byte k of stream p sits at "time" (k + ½)/size_p, and the bytes are merged by time (ties: lower p
+/// first). A byte prefix of the segment therefore holds about the same fraction of every patch's stream, as
+/// the joint coder of version 1 would have sent them, and a decoder that knows the sizes takes its streams
+/// apart without decoding anything.
+constexpr std::uint64_t kMaxStreamBytes = std::uint64_t{1} << 30;
+
+class Interleaver {
+ public:
+  explicit Interleaver(std::span<const std::uint64_t> sizes) : sizes_(sizes), taken_(sizes.size(), 0) {}
+  /// The stream the next byte belongs to, or −1 when all are exhausted.
+  int next() {
+    int best = -1;
+    for (std::size_t p = 0; p < sizes_.size(); ++p) {
+      if (taken_[p] >= sizes_[p]) continue;
+      // (2·taken_p + 1) / size_p < (2·taken_b + 1) / size_b, cross-multiplied (sizes ≤ kMaxStreamBytes:
+      // the products stay below 2^63).
+      const auto b = static_cast<std::size_t>(best);
+      if (best < 0 || (2 * taken_[p] + 1) * sizes_[b] < (2 * taken_[b] + 1) * sizes_[p]) {
+        best = static_cast<int>(p);
+      }
+    }
+    if (best >= 0) ++taken_[static_cast<std::size_t>(best)];
+    return best;
+  }
+
+ private:
+  std::span<const std::uint64_t> sizes_;
+  std::vector<std::uint64_t> taken_;
+};
+
 struct Stop {};     // the partial tail is exhausted
 struct Corrupt {};  // bytes that no encoder writes
 
 bool layout_ok(const BitplaneLayout& layout) {
   return layout.level >= 0 && layout.level <= 12 && layout.steps >= 0 && layout.steps <= layout.level &&
-         layout.num_patches >= 1;
+         layout.num_patches >= 1 && layout.joint_segments >= 0;
 }
 
 /// The bands of every patch (only_patch < 0) or of one patch, in coding order; Band::parent indexes the
-/// returned list.
+/// returned list. The bands' quadtrees are set up on up to `max_threads` threads (by patch).
 std::vector<Band> make_bands(const BitplaneLayout& layout,
-                             const std::vector<std::vector<std::uint8_t>>& coded, int only_patch = -1) {
+                             const std::vector<std::vector<std::uint8_t>>& coded, int only_patch = -1,
+                             int max_threads = 1) {
   const int size = (1 << layout.level) + 1;
   const int steps = layout.steps;
   const int first = only_patch < 0 ? 0 : only_patch;
@@ -102,7 +134,7 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
       }
     }
   }
-  for (auto& b : bands) {
+  const auto set_up = [&](Band& b) {
     int w = b.w, h = b.h;
     std::size_t total = 0;
     b.levels = 0;
@@ -131,7 +163,12 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
     }
     const int top = b.levels - 1;
     if (b.state[b.node(top, 0, 0)] & kActive) b.lis.push_back(pack(top, 0, 0));
-  }
+  };
+  parallel_for(np, max_threads, [&](int i) {
+    for (auto& b : bands) {
+      if (b.patch == first + i) set_up(b);
+    }
+  });
   return bands;
 }
 
@@ -152,6 +189,13 @@ class PlaneCoder {
   }
 
   void set_encoder(ArithmeticEncoder* enc) { enc_ = enc; }
+  /// Continues from another coder's adaptive state (the joint coder's, at the fork to per-patch coders).
+  void copy_contexts(const PlaneCoder& other) {
+    std::copy(std::begin(other.node_ctx_), std::end(other.node_ctx_), std::begin(node_ctx_));
+    std::copy(std::begin(other.chan_ctx_), std::end(other.chan_ctx_), std::begin(chan_ctx_));
+    std::copy(std::begin(other.late_ctx_), std::end(other.late_ctx_), std::begin(late_ctx_));
+    std::copy(std::begin(other.ref_ctx_), std::end(other.ref_ctx_), std::begin(ref_ctx_));
+  }
   /// Decodes the next plane from `bytes` (held by value: a decoder behind a pointer costs a dependent load
   /// per symbol).
   void set_decoder(std::span<const std::uint8_t> bytes) { dec_ = ArithmeticDecoder(bytes); }
@@ -385,7 +429,8 @@ class PlaneCoder {
 
 BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
                                   const std::vector<PatchCoefficients>& coefficients,
-                                  const std::vector<std::vector<std::uint8_t>>& coded) {
+                                  const std::vector<std::vector<std::uint8_t>>& coded,
+                                  std::size_t joint_bytes) {
   if (!layout_ok(layout)) throw std::invalid_argument("encode_bitplanes: layout out of range");
   const std::size_t size = (std::size_t{1} << layout.level) + 1, samples = size * size;
   if (coefficients.size() != static_cast<std::size_t>(layout.num_patches) ||
@@ -431,40 +476,59 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
   }
   BitplaneEncoding result;
   result.top_bitplane = top;
-  if (!layout.independent_patches) {
-    PlaneCoder<false> coder(layout, bands, -1, &coefficients);
-    for (int b = top; b >= 0; --b) {
-      ArithmeticEncoder enc;
-      coder.set_encoder(&enc);
-      coder.template code_plane<false>(b);
-      result.segments.push_back(enc.finish());
-    }
-    return result;
+  // Joint planes first (all of them in version 1), then one coder per patch from the joint contexts.
+  PlaneCoder<false> joint(layout, bands, -1, &coefficients);
+  std::size_t joint_total = 0;
+  int plane = top;
+  const auto stay_joint = [&] {
+    if (!layout.independent_patches) return true;
+    return joint_bytes > 0 ? joint_total < joint_bytes : result.joint_segments < layout.joint_segments;
+  };
+  for (; plane >= 0 && stay_joint(); --plane) {
+    ArithmeticEncoder enc;
+    joint.set_encoder(&enc);
+    joint.template code_plane<false>(plane);
+    result.segments.push_back(enc.finish());
+    joint_total += result.segments.back().size();
+    if (layout.independent_patches) ++result.joint_segments;
   }
-  // One coder (own contexts, own stream) per patch; a segment is the varint sizes of streams 0..P−2, then
-  // the streams.
+  if (plane < 0) return result;
+  // A segment is the varint sizes of the P streams, then their bytes interleaved in proportion to their
+  // sizes (see Interleaver).
   const int np = layout.num_patches;
   std::vector<PlaneCoder<false>> coders;
   coders.reserve(static_cast<std::size_t>(np));
-  for (int p = 0; p < np; ++p) coders.emplace_back(layout, bands, p, &coefficients);
-  for (int b = top; b >= 0; --b) {
+  for (int p = 0; p < np; ++p) {
+    coders.emplace_back(layout, bands, p, &coefficients);
+    coders.back().copy_contexts(joint);
+  }
+  for (; plane >= 0; --plane) {
     std::vector<std::vector<std::uint8_t>> streams;
     for (auto& coder : coders) {
       ArithmeticEncoder enc;
       coder.set_encoder(&enc);
-      coder.template code_plane<false>(b);
+      coder.template code_plane<false>(plane);
       streams.push_back(enc.finish());
     }
     std::vector<std::uint8_t> segment;
-    for (int p = 0; p + 1 < np; ++p) {
-      std::uint64_t v = streams[static_cast<std::size_t>(p)].size();
+    std::vector<std::uint64_t> sizes;
+    for (const auto& st : streams) {
+      if (st.size() > kMaxStreamBytes)
+        throw std::length_error("encode_bitplanes: a patch stream of one plane over 1 GiB");
+      sizes.push_back(st.size());
+      std::uint64_t v = st.size();
       while (v >= 0x80) {
         segment.push_back(static_cast<std::uint8_t>(v | 0x80));
         v >>= 7;
       }
       segment.push_back(static_cast<std::uint8_t>(v));
     }
-    for (const auto& st : streams) segment.insert(segment.end(), st.begin(), st.end());
+    std::vector<std::size_t> taken(streams.size(), 0);
+    Interleaver order(sizes);
+    for (int p; (p = order.next()) >= 0;) {
+      auto& t = taken[static_cast<std::size_t>(p)];
+      segment.push_back(streams[static_cast<std::size_t>(p)][t++]);
+    }
     result.segments.push_back(std::move(segment));
   }
   return result;
@@ -486,15 +550,15 @@ struct CoderOutcome {
   std::exception_ptr error;  ///< anything else (allocation failure): rethrown by the caller's thread
 };
 
-/// Decodes the planes of one coder; parts[t] is its stream of plane t (planes after the first absent or
-/// incomplete one are not decoded).
-void decode_planes(PlaneCoder<true>& coder, int top_bitplane, const std::vector<StreamPart>& parts,
-                   CoderOutcome& outcome) {
+/// Decodes the planes of one coder; parts[i] is its stream of plane `first` + i (planes after the first
+/// absent or incomplete one are not decoded).
+void decode_planes(PlaneCoder<true>& coder, int top_bitplane, std::size_t first,
+                   const std::vector<StreamPart>& parts, CoderOutcome& outcome) {
   try {
     for (std::size_t t = 0; t < parts.size(); ++t) {
       const StreamPart& part = parts[t];
       if (!part.present) break;
-      const int b = top_bitplane - static_cast<int>(t);
+      const int b = top_bitplane - static_cast<int>(first + t);
       coder.set_decoder(part.bytes);
       if (part.complete) {
         coder.code_plane<false>(b);
@@ -515,13 +579,17 @@ void decode_planes(PlaneCoder<true>& coder, int top_bitplane, const std::vector<
   }
 }
 
-/// Splits a segment (or a byte prefix of one, `complete` = false) into its per-patch streams. Returns false
-/// when a complete segment's sizes do not fit its bytes (or a varint is malformed).
-bool split_segment(std::span<const std::uint8_t> seg, bool complete, int np, std::vector<StreamPart>& parts) {
+/// Splits a segment (or a byte prefix of one, `complete` = false) into its per-patch streams, copied into
+/// `buffers`. Returns false when the sizes do not add up to a complete segment's bytes, when a prefix holds
+/// more bytes than they announce, or when a varint is malformed.
+bool split_segment(std::span<const std::uint8_t> seg, bool complete, int np,
+                   std::vector<std::vector<std::uint8_t>>& buffers, std::vector<StreamPart>& parts) {
   parts.assign(static_cast<std::size_t>(np), StreamPart{});
+  buffers.resize(static_cast<std::size_t>(np));
   std::size_t pos = 0;
   std::vector<std::uint64_t> sizes;
-  for (int p = 0; p + 1 < np; ++p) {
+  std::uint64_t total = 0;
+  for (int p = 0; p < np; ++p) {
     std::uint64_t v = 0;
     for (int i = 0;; ++i) {
       if (pos >= seg.size()) return !complete;  // a prefix that ends inside the sizes: nothing arrived
@@ -530,22 +598,50 @@ bool split_segment(std::span<const std::uint8_t> seg, bool complete, int np, std
       v |= static_cast<std::uint64_t>(byte & 0x7F) << (7 * i);
       if (!(byte & 0x80)) break;
     }
+    if (v > kMaxStreamBytes) return false;
     sizes.push_back(v);
+    total += v;
+  }
+  const std::uint64_t arrived = seg.size() - pos;
+  if (complete ? arrived != total : arrived > total) return false;
+  for (int p = 0; p < np; ++p) {
+    buffers[static_cast<std::size_t>(p)].clear();
+    buffers[static_cast<std::size_t>(p)].reserve(
+        static_cast<std::size_t>(sizes[static_cast<std::size_t>(p)]));
+  }
+  if (np == 2) {
+    // The same merge as Interleaver, incrementally: d = (2·a + 1)·s1 − (2·b + 1)·s0 after a bytes of
+    // stream 0 and b of stream 1; stream 0 is next while d ≤ 0 (ties to the lower index) or stream 1 is
+    // exhausted.
+    const std::uint64_t s0 = sizes[0], s1 = sizes[1];
+    auto& out0 = buffers[0];
+    auto& out1 = buffers[1];
+    out0.resize(static_cast<std::size_t>(s0));
+    out1.resize(static_cast<std::size_t>(s1));
+    std::size_t a = 0, b = 0;
+    std::int64_t d = static_cast<std::int64_t>(s1) - static_cast<std::int64_t>(s0);
+    const std::uint8_t* in = seg.data() + pos;
+    for (std::uint64_t j = 0; j < arrived; ++j) {
+      if (a < s0 && (d <= 0 || b >= s1)) {
+        out0[a++] = in[j];
+        d += 2 * static_cast<std::int64_t>(s1);
+      } else {
+        out1[b++] = in[j];
+        d -= 2 * static_cast<std::int64_t>(s0);
+      }
+    }
+    out0.resize(a);
+    out1.resize(b);
+  } else {
+    Interleaver order(sizes);
+    for (std::uint64_t j = 0; j < arrived; ++j) {
+      buffers[static_cast<std::size_t>(order.next())].push_back(seg[pos++]);
+    }
   }
   for (int p = 0; p < np; ++p) {
-    const bool last = p + 1 == np;
-    const std::size_t left = seg.size() - pos;
-    const std::uint64_t want = last ? left : sizes[static_cast<std::size_t>(p)];
-    if (want > left) {
-      if (complete) return false;
-      // A prefix ending inside this stream: its first bytes; later patches get nothing.
-      parts[static_cast<std::size_t>(p)] = {seg.subspan(pos), false, left > 0};
-      return true;
-    }
-    // Inside a prefix the last stream is never known to be whole; the others are when their bytes are here.
-    parts[static_cast<std::size_t>(p)] = {seg.subspan(pos, static_cast<std::size_t>(want)), complete || !last,
-                                          complete || !last || want > 0};
-    pos += static_cast<std::size_t>(want);
+    const auto& buf = buffers[static_cast<std::size_t>(p)];
+    const bool whole = buf.size() == sizes[static_cast<std::size_t>(p)];
+    parts[static_cast<std::size_t>(p)] = {std::span<const std::uint8_t>(buf), whole, whole || !buf.empty()};
   }
   return true;
 }
@@ -572,54 +668,67 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
   if (segments.size() > planes || (segments.size() == planes && !partial_tail.empty())) {
     status = Status::kCorrupt;  // decode what fits, then report
   }
-  // Per coder (one for the joint stream, or one per patch): its stream of each plane that arrived.
+  // Planes [0, joint) are one joint stream; planes [joint, arrived) one stream per patch.
   const int np = layout.num_patches;
-  const int num_coders = layout.independent_patches ? np : 1;
   const std::size_t arrived =
       std::min(segments.size(), planes) + (segments.size() < planes && !partial_tail.empty());
-  std::vector<std::vector<StreamPart>> parts(static_cast<std::size_t>(num_coders),
-                                             std::vector<StreamPart>(arrived));
+  const std::size_t joint = layout.independent_patches
+                                ? std::min(arrived, static_cast<std::size_t>(layout.joint_segments))
+                                : arrived;
+  const auto segment = [&](std::size_t t) { return t < segments.size() ? segments[t] : partial_tail; };
+  std::vector<StreamPart> joint_parts(joint);
+  for (std::size_t t = 0; t < joint; ++t) joint_parts[t] = {segment(t), t < segments.size(), true};
+  std::vector<std::vector<StreamPart>> parts(static_cast<std::size_t>(np));
+  std::vector<std::vector<std::vector<std::uint8_t>>> buffers(arrived - joint);  // [plane − joint][patch]
   std::vector<StreamPart> split;
-  for (std::size_t t = 0; t < arrived; ++t) {
-    const bool complete = t < segments.size();
-    const std::span<const std::uint8_t> seg = complete ? segments[t] : partial_tail;
-    if (!layout.independent_patches) {
-      parts[0][t] = {seg, complete, true};
-      continue;
-    }
-    if (!split_segment(seg, complete, np, split)) {
+  for (std::size_t t = joint; t < arrived; ++t) {
+    if (!split_segment(segment(t), t < segments.size(), np, buffers[t - joint], split)) {
       status = Status::kCorrupt;  // sizes that do not fit: decode the planes before this one
-      for (auto& pc : parts) pc.resize(t);
       break;
     }
-    for (int c = 0; c < np; ++c) parts[static_cast<std::size_t>(c)][t] = split[static_cast<std::size_t>(c)];
+    for (int p = 0; p < np; ++p)
+      parts[static_cast<std::size_t>(p)].push_back(split[static_cast<std::size_t>(p)]);
   }
-  std::vector<CoderOutcome> outcomes(static_cast<std::size_t>(num_coders));
+
+  std::vector<Band> bands = make_bands(layout, coded, -1, max_threads);
+  CoderOutcome joint_outcome;
+  PlaneCoder<true> joint_coder(layout, bands, -1, nullptr);
+  decode_planes(joint_coder, top_bitplane, 0, joint_parts, joint_outcome);
+  if (joint_outcome.error) std::rethrow_exception(joint_outcome.error);
+  if (joint_outcome.corrupt) status = Status::kCorrupt;
+  result.partial = joint_outcome.partial;
+  result.segments_complete = joint_outcome.planes_complete;
+  // The per-patch planes follow only a complete, clean joint part.
+  const bool fork = joint_outcome.planes_complete == joint && !joint_outcome.corrupt && !parts[0].empty();
+  std::vector<CoderOutcome> outcomes(static_cast<std::size_t>(np));
+  // Per patch, in parallel (patch 0 on this thread): its planes after the fork, then its reconstruction.
   const auto run = [&](int c) {
-    std::vector<Band> bands = make_bands(layout, coded, layout.independent_patches ? c : -1);
-    PlaneCoder<true> coder(layout, bands, -1, nullptr);
-    decode_planes(coder, top_bitplane, parts[static_cast<std::size_t>(c)],
-                  outcomes[static_cast<std::size_t>(c)]);
-    for (int p = 0; p < np; ++p) {
-      if (layout.independent_patches && p != c) continue;
-      for (auto& ch : out[static_cast<std::size_t>(p)]) ch.assign(samples, 0);
-    }
-    // Reconstruct this coder's bands (each band belongs to one patch; patches of different coders differ).
-    for (const auto& band : bands) {
-      auto& patch = out[static_cast<std::size_t>(band.patch)];
-      for (const Sample& sm : band.lsp) {
-        for (int ch = 0; ch < 3; ++ch) {
-          if (!(sm.flags & (1 << ch))) continue;
-          // The middle of the interval [mag, mag + 2^q) (see the header).
-          const std::int64_t v = static_cast<std::int64_t>(sm.mag[ch]) +
-                                 (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
-          patch[ch][sm.index] = static_cast<std::int32_t>((sm.flags >> (3 + ch)) & 1 ? -v : v);
+    CoderOutcome& outcome = outcomes[static_cast<std::size_t>(c)];
+    try {
+      if (fork) {
+        PlaneCoder<true> coder(layout, bands, c, nullptr);
+        coder.copy_contexts(joint_coder);
+        decode_planes(coder, top_bitplane, joint, parts[static_cast<std::size_t>(c)], outcome);
+      }
+      auto& patch = out[static_cast<std::size_t>(c)];
+      for (auto& ch : patch) ch.assign(samples, 0);
+      for (const auto& band : bands) {
+        if (band.patch != c) continue;
+        for (const Sample& sm : band.lsp) {
+          for (int ch = 0; ch < 3; ++ch) {
+            if (!(sm.flags & (1 << ch))) continue;
+            // The middle of the interval [mag, mag + 2^q) (see the header).
+            const std::int64_t v = static_cast<std::int64_t>(sm.mag[ch]) +
+                                   (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
+            patch[ch][sm.index] = static_cast<std::int32_t>((sm.flags >> (3 + ch)) & 1 ? -v : v);
+          }
         }
       }
+    } catch (...) {
+      outcome.error = std::current_exception();  // rethrown below, on the caller's thread
     }
   };
-  // Independent streams decode in parallel: coder 0 on this thread, the others on threads of their own.
-  parallel_for(num_coders, max_threads, run);
+  parallel_for(np, max_threads, run);
   std::size_t complete = planes;
   for (const CoderOutcome& o : outcomes) {
     if (o.error) std::rethrow_exception(o.error);
@@ -627,7 +736,7 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
     complete = std::min(complete, o.planes_complete);
     result.partial = result.partial || o.partial;
   }
-  result.segments_complete = complete;
+  if (fork) result.segments_complete = joint + complete;
   return status;
 }
 

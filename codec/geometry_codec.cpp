@@ -126,6 +126,9 @@ bool header_ok(const GeometryCodecHeader& h) {
   }
   if (!std::isfinite(h.step) || !(h.step > 0)) return false;
   if (h.top_bitplane < 0 || h.top_bitplane > kMaxTopBitplane) return false;
+  if (h.joint_segments < 0 || h.joint_segments > h.top_bitplane + 1 ||
+      (h.version < 2 && h.joint_segments != 0))
+    return false;
   if (h.seams.size() > 4 * static_cast<std::size_t>(h.num_patches)) return false;
   for (const auto& s : h.seams) {
     if (!seam_ok(s, h.num_patches)) return false;
@@ -202,6 +205,7 @@ std::vector<std::uint8_t> GeometryCodecHeader::serialize() const {
   for (double o : origin) put_double(out, o);
   put_double(out, step);
   put_varint(out, static_cast<std::uint64_t>(top_bitplane));
+  if (version >= 2) put_varint(out, static_cast<std::uint64_t>(joint_segments));
   put_varint(out, seams.size());
   for (const auto& s : seams) {
     put_varint(out, static_cast<std::uint64_t>(s.patch));
@@ -226,7 +230,9 @@ Status GeometryCodecHeader::parse(std::span<const std::uint8_t> bytes, GeometryC
     if (!r.f64(o)) return Status::kCorrupt;
   }
   int num_seams = 0;
-  if (!r.f64(h.step) || !r.small_int(h.top_bitplane, kMaxTopBitplane) || !r.small_int(num_seams, 1 << 22)) {
+  if (!r.f64(h.step) || !r.small_int(h.top_bitplane, kMaxTopBitplane) ||
+      (h.version >= 2 && !r.small_int(h.joint_segments, kMaxTopBitplane + 1)) ||
+      !r.small_int(num_seams, 1 << 22)) {
     return Status::kCorrupt;
   }
   if (num_seams > 4 * h.num_patches) return Status::kCorrupt;
@@ -320,8 +326,12 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
     for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter);
   }
   h.version = kHeaderVersion;
-  BitplaneEncoding enc = encode_bitplanes({level, h.steps, np, true}, coefs, own.coded);
+  // joint_bytes 0 means per patch from the first plane: a joint_segments of 0 (encode_bitplanes reads 0 as
+  // "no automatic choice").
+  BitplaneEncoding enc =
+      encode_bitplanes({level, h.steps, np, true, 0}, coefs, own.coded, options.joint_bytes);
   h.top_bitplane = enc.top_bitplane;
+  h.joint_segments = enc.joint_segments;
   result.segments = std::move(enc.segments);
   return result;
 }
@@ -337,8 +347,9 @@ Status decode_geometry(const GeometryCodecHeader& header,
   const Ownership own = seam_ownership(level, np, header.seams);
   std::vector<PatchCoefficients> coefs;
   BitplaneDecodeResult r;
-  const Status status = decode_bitplanes({level, steps, np, header.version >= 2}, header.top_bitplane,
-                                         own.coded, segments, partial_tail, coefs, r, options.max_threads);
+  const Status status =
+      decode_bitplanes({level, steps, np, header.version >= 2, header.joint_segments}, header.top_bitplane,
+                       own.coded, segments, partial_tail, coefs, r, options.max_threads);
   out.segments_complete = r.segments_complete;
   out.partial = r.partial;
   if (coefs.size() != static_cast<std::size_t>(np)) return status == Status::kOk ? Status::kCorrupt : status;

@@ -119,43 +119,95 @@ bool read_mask(ByteReader& r, int side, std::vector<std::uint8_t>& mask) {
   return true;
 }
 
-// The fine hole masks of one model (all patches, `side` × `side` quads each) in one arithmetic-coded chunk,
-// each bit in a context of its coded neighbours and of the coarse mask bit above it (`shift` levels coarser):
-// far from the coarse mask's border the bits are nearly free.
-int fine_mask_context(const std::vector<std::uint8_t>& mask, const std::vector<std::uint8_t>& coarse,
-                      int side, int shift, int i, int j) {
-  const int coarse_side = side >> shift;
-  return mask_context(mask, side, i, j) |
-         coarse[static_cast<std::size_t>(j >> shift) * coarse_side + (i >> shift)] << 4;
+// The fine hole masks of one model (all patches, `side` × `side` quads each) in one arithmetic-coded chunk.
+// Per coarse quad (a block of 2^shift × 2^shift fine quads, raster order) one bit says whether the whole
+// block equals the coarse bit — nearly always, far from a hole's border — in a context of the coarse bit and
+// of the neighbouring blocks' flags; the fine bits of the other blocks follow one by one in a context of
+// their coded neighbours (not yet coded = 0) and the coarse bit. On the bunny (2 × 256² quads) this decodes
+// about 9k decisions instead of 131k.
+constexpr int kUniformContexts = 8, kFineContexts = 32;
+
+int uniform_context(const std::vector<std::uint8_t>& uniform, int coarse_side, int ci, int cj,
+                    int coarse_bit) {
+  const int left = ci > 0 ? uniform[static_cast<std::size_t>(cj) * coarse_side + ci - 1] : 1;
+  const int up = cj > 0 ? uniform[static_cast<std::size_t>(cj - 1) * coarse_side + ci] : 1;
+  return coarse_bit | left << 1 | up << 2;
 }
 
 std::vector<std::uint8_t> encode_fine_masks(const std::vector<std::vector<std::uint8_t>>& masks,
                                             const std::vector<std::vector<std::uint8_t>>& coarse, int side,
                                             int shift) {
   ArithmeticEncoder encoder;
-  Context contexts[32];
+  Context uniform_ctx[kUniformContexts], fine_ctx[kFineContexts];
+  const int block = 1 << shift, coarse_side = side >> shift;
   for (std::size_t p = 0; p < masks.size(); ++p) {
-    std::vector<std::uint8_t> bits(masks[p].size());
-    for (std::size_t k = 0; k < bits.size(); ++k) bits[k] = masks[p][k] ? 1 : 0;
-    for (int j = 0; j < side; ++j)
-      for (int i = 0; i < side; ++i)
-        encoder.encode(bits[static_cast<std::size_t>(j) * side + i],
-                       contexts[fine_mask_context(bits, coarse[p], side, shift, i, j)]);
+    const auto bit = [&](int i, int j) { return masks[p][static_cast<std::size_t>(j) * side + i] ? 1 : 0; };
+    std::vector<std::uint8_t> known(static_cast<std::size_t>(side) * side, 0);
+    std::vector<std::uint8_t> uniform(static_cast<std::size_t>(coarse_side) * coarse_side, 0);
+    for (int cj = 0; cj < coarse_side; ++cj) {
+      for (int ci = 0; ci < coarse_side; ++ci) {
+        const int c = coarse[p][static_cast<std::size_t>(cj) * coarse_side + ci] ? 1 : 0;
+        bool same = true;
+        for (int j = cj * block; j < (cj + 1) * block && same; ++j)
+          for (int i = ci * block; i < (ci + 1) * block && same; ++i) same = bit(i, j) == c;
+        encoder.encode(same, uniform_ctx[uniform_context(uniform, coarse_side, ci, cj, c)]);
+        uniform[static_cast<std::size_t>(cj) * coarse_side + ci] = same;
+        for (int j = cj * block; j < (cj + 1) * block; ++j) {
+          for (int i = ci * block; i < (ci + 1) * block; ++i) {
+            const int b = same ? c : bit(i, j);
+            if (!same) encoder.encode(b, fine_ctx[mask_context(known, side, i, j) | c << 4]);
+            known[static_cast<std::size_t>(j) * side + i] = static_cast<std::uint8_t>(b);
+          }
+        }
+      }
+    }
   }
   return encoder.finish();
 }
 
+/// Pack format version 1: every fine bit coded, in the context of its neighbours and the coarse bit.
+void decode_fine_masks_v1(std::span<const std::uint8_t> bytes,
+                          const std::vector<std::vector<std::uint8_t>>& coarse, int side, int shift,
+                          std::vector<std::vector<std::uint8_t>>& masks) {
+  ArithmeticDecoder decoder(bytes);
+  Context contexts[kFineContexts];
+  const int coarse_side = side >> shift;
+  masks.assign(coarse.size(), std::vector<std::uint8_t>(static_cast<std::size_t>(side) * side, 0));
+  for (std::size_t p = 0; p < coarse.size(); ++p)
+    for (int j = 0; j < side; ++j)
+      for (int i = 0; i < side; ++i) {
+        const int c = coarse[p][static_cast<std::size_t>(j >> shift) * coarse_side + (i >> shift)];
+        masks[p][static_cast<std::size_t>(j) * side + i] =
+            static_cast<std::uint8_t>(decoder.decode(contexts[mask_context(masks[p], side, i, j) | c << 4]));
+      }
+}
+
+/// Mirrors encode_fine_masks(); `coarse` holds 0/1 bytes (read_mask()).
 void decode_fine_masks(std::span<const std::uint8_t> bytes,
                        const std::vector<std::vector<std::uint8_t>>& coarse, int side, int shift,
                        std::vector<std::vector<std::uint8_t>>& masks) {
   ArithmeticDecoder decoder(bytes);
-  Context contexts[32];
+  Context uniform_ctx[kUniformContexts], fine_ctx[kFineContexts];
+  const int block = 1 << shift, coarse_side = side >> shift;
   masks.assign(coarse.size(), std::vector<std::uint8_t>(static_cast<std::size_t>(side) * side, 0));
-  for (std::size_t p = 0; p < coarse.size(); ++p)
-    for (int j = 0; j < side; ++j)
-      for (int i = 0; i < side; ++i)
-        masks[p][static_cast<std::size_t>(j) * side + i] = static_cast<std::uint8_t>(
-            decoder.decode(contexts[fine_mask_context(masks[p], coarse[p], side, shift, i, j)]));
+  std::vector<std::uint8_t> uniform(static_cast<std::size_t>(coarse_side) * coarse_side);
+  for (std::size_t p = 0; p < coarse.size(); ++p) {
+    auto& mask = masks[p];
+    std::fill(uniform.begin(), uniform.end(), std::uint8_t{0});
+    for (int cj = 0; cj < coarse_side; ++cj) {
+      for (int ci = 0; ci < coarse_side; ++ci) {
+        const int c = coarse[p][static_cast<std::size_t>(cj) * coarse_side + ci] ? 1 : 0;
+        const int same = decoder.decode(uniform_ctx[uniform_context(uniform, coarse_side, ci, cj, c)]);
+        uniform[static_cast<std::size_t>(cj) * coarse_side + ci] = static_cast<std::uint8_t>(same);
+        for (int j = cj * block; j < (cj + 1) * block; ++j) {
+          for (int i = ci * block; i < (ci + 1) * block; ++i) {
+            mask[static_cast<std::size_t>(j) * side + i] = static_cast<std::uint8_t>(
+                same ? c : decoder.decode(fine_ctx[mask_context(mask, side, i, j) | c << 4]));
+          }
+        }
+      }
+    }
+  }
 }
 
 /// The coarse mask `shift` levels above `mask`: a coarse quad is masked when at least half of its quads are.
@@ -486,8 +538,8 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
     model.hole_mask_level = model_info.hole_mask_level;
     if (s.has_fine_mask) {
       const int shift = model_info.fine_hole_mask_level - model_info.hole_mask_level;
-      decode_fine_masks(s.fine_mask, model_info.hole_mask, 1 << model_info.fine_hole_mask_level, shift,
-                        model.hole_mask);
+      (info.version == 1 ? decode_fine_masks_v1 : decode_fine_masks)(
+          s.fine_mask, model_info.hole_mask, 1 << model_info.fine_hole_mask_level, shift, model.hole_mask);
       model.hole_mask_level = model_info.fine_hole_mask_level;
     }
     model.geometry_passes = s.geometry.size();

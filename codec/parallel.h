@@ -1,15 +1,20 @@
-// A minimal fork-join loop for the codec's independent per-patch work (decoding patch streams, inverse
-// transforms): tasks 1.. on short-lived threads, task 0 on the caller's. Tasks must not throw.
+// A minimal fork-join loop for the codec's independent per-patch work (decoding patch streams, setting up
+// bands, inverse transforms): tasks 1.. on short-lived threads, task 0 on the caller's.
 #pragma once
 
 #include <algorithm>
 #include <atomic>
+#include <exception>
+#include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
 namespace geomip::codec {
 
 /// Calls f(i) for i in [0, n) on up to `max_threads` threads (0 = one per hardware thread), then joins.
+/// When threads cannot be started the caller's thread does the remaining tasks. The first exception a task
+/// throws is rethrown here after every thread has finished (the other tasks still run).
 template <typename F>
 void parallel_for(int n, int max_threads, F&& f) {
   int threads = max_threads > 0 ? max_threads : static_cast<int>(std::thread::hardware_concurrency());
@@ -19,14 +24,27 @@ void parallel_for(int n, int max_threads, F&& f) {
     return;
   }
   std::atomic<int> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
   const auto worker = [&] {
-    for (int i = next++; i < n; i = next++) f(i);
+    for (int i = next++; i < n; i = next++) {
+      try {
+        f(i);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    }
   };
   std::vector<std::thread> pool;
-  pool.reserve(static_cast<std::size_t>(threads - 1));
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  try {
+    pool.reserve(static_cast<std::size_t>(threads - 1));
+    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  } catch (const std::exception&) {  // std::system_error, std::bad_alloc: go on with the threads there are
+  }
   worker();
   for (auto& th : pool) th.join();
+  if (error) std::rethrow_exception(error);
 }
 
 }  // namespace geomip::codec

@@ -61,11 +61,16 @@ double squared_error(const std::vector<PatchCoefficients>& a, const std::vector<
   return e;
 }
 
+/// The stream layouts: one joint stream (version 1); per-patch streams from the first plane; the first two
+/// planes joint, then per patch.
+std::vector<BitplaneLayout> layouts(int level, int steps, int np) {
+  return {{level, steps, np, false, 0}, {level, steps, np, true, 0}, {level, steps, np, true, 2}};
+}
+
 TEST(BitplaneCoder, AllSegmentsAreLossless) {
-  for (bool independent : {true, false})
-    for (int level : {0, 1, 2, 3, 5, 7}) {
-      for (int steps : {0, level / 2, level}) {
-        const BitplaneLayout layout{level, steps, 2, independent};
+  for (int level : {0, 1, 2, 3, 5, 7}) {
+    for (int steps : {0, level / 2, level}) {
+      for (const BitplaneLayout& layout : layouts(level, steps, 2)) {
         const auto coefs =
             smooth_coefficients(level, steps, 2, static_cast<std::uint32_t>(level * 10 + steps));
         const auto coded = all_coded(level, 2);
@@ -79,6 +84,33 @@ TEST(BitplaneCoder, AllSegmentsAreLossless) {
         EXPECT_EQ(squared_error(out, coefs), 0) << "level " << level << " steps " << steps;
       }
     }
+  }
+}
+
+TEST(BitplaneCoder, JointBytesChoosesTheFork) {
+  const int level = 6;
+  const auto coefs = smooth_coefficients(level, level, 2, 41);
+  const auto coded = all_coded(level, 2);
+  for (std::size_t joint_bytes :
+       {std::size_t{1}, std::size_t{200}, std::size_t{1000}, std::size_t{1} << 30}) {
+    BitplaneLayout layout{level, level, 2, true, 0};
+    const auto enc = encode_bitplanes(layout, coefs, coded, joint_bytes);
+    // The fork follows the first plane at which the joint segments hold joint_bytes (or never happens).
+    std::size_t before = 0;
+    for (int t = 0; t + 1 < enc.joint_segments; ++t)
+      before += enc.segments[static_cast<std::size_t>(t)].size();
+    EXPECT_LT(before, joint_bytes);
+    if (enc.joint_segments < static_cast<int>(enc.segments.size())) {
+      EXPECT_GE(before + enc.segments[static_cast<std::size_t>(enc.joint_segments - 1)].size(), joint_bytes);
+    }
+    layout.joint_segments = enc.joint_segments;
+    std::vector<PatchCoefficients> out;
+    BitplaneDecodeResult r;
+    ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, spans(enc.segments, enc.segments.size()), {},
+                               out, r),
+              Status::kOk);
+    EXPECT_EQ(squared_error(out, coefs), 0) << joint_bytes;
+  }
 }
 
 TEST(BitplaneCoder, UncodedSamplesDecodeAsZeroAndDoNotDisturbOthers) {
@@ -129,8 +161,7 @@ TEST(BitplaneCoder, EveryPrefixDecodesExactlyTheCodedBits) {
   // true magnitude's interval width, i.e. decoded coefficients never have the wrong sign or a wrong known
   // bit.
   const int level = 4;
-  for (bool independent : {true, false}) {
-    const BitplaneLayout layout{level, level, 2, independent};
+  for (const BitplaneLayout& layout : layouts(level, level, 2)) {
     const auto coefs = smooth_coefficients(level, level, 2, 5);
     const auto coded = all_coded(level, 2);
     const auto enc = encode_bitplanes(layout, coefs, coded);
@@ -160,7 +191,7 @@ TEST(BitplaneCoder, EveryPrefixDecodesExactlyTheCodedBits) {
 // Per-patch streams decode on several threads; the result must not depend on how many.
 TEST(BitplaneCoder, ThreadCountDoesNotChangeAnyPrefix) {
   const int level = 5, np = 3;
-  const BitplaneLayout layout{level, level, np, true};
+  const BitplaneLayout layout{level, level, np, true, 3};
   const auto coefs = smooth_coefficients(level, level, np, 21);
   const auto coded = all_coded(level, np);
   const auto enc = encode_bitplanes(layout, coefs, coded);
@@ -177,6 +208,37 @@ TEST(BitplaneCoder, ThreadCountDoesNotChangeAnyPrefix) {
       ASSERT_EQ(r1.partial, r4.partial);
     }
   }
+}
+
+TEST(BitplaneCoder, APrefixOfASegmentFeedsEveryPatchAlike) {
+  // Two identical patches: identical streams, so a prefix holding 2k of a segment's stream bytes must give
+  // each patch k of them (interleaved by size), and both patches decode to the same coefficients. A
+  // patch-major layout (stream 0, then stream 1) would give patch 0 everything first.
+  const int level = 5;
+  const BitplaneLayout layout{level, level, 2, true};
+  auto coefs = smooth_coefficients(level, level, 2, 31);
+  coefs[1] = coefs[0];
+  const auto coded = all_coded(level, 2);
+  const auto enc = encode_bitplanes(layout, coefs, coded);
+  std::size_t checked = 0;
+  for (std::size_t t = 0; t < enc.segments.size(); ++t) {
+    const auto& seg = enc.segments[t];
+    std::size_t header = 0;
+    for (int v = 0; v < 2; ++v) {
+      while (seg[header] & 0x80) ++header;
+      ++header;
+    }
+    for (std::size_t len = header + 2; len < seg.size(); len += 2) {
+      std::vector<PatchCoefficients> out;
+      BitplaneDecodeResult r;
+      ASSERT_EQ(decode_bitplanes(layout, enc.top_bitplane, coded, spans(enc.segments, t),
+                                 std::span<const std::uint8_t>(seg.data(), len), out, r),
+                Status::kOk);
+      ASSERT_EQ(out[0], out[1]) << "segment " << t << ", prefix " << len;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20u);
 }
 
 // A segment whose stream sizes claim more bytes than it has is corrupt; the planes before it still decode.
@@ -206,16 +268,24 @@ TEST(BitplaneCoder, StreamSizesBeyondTheSegmentAreCorrupt) {
 
 TEST(BitplaneCoder, GarbageNeverCrashes) {
   const int level = 5;
-  for (bool independent : {true, false}) {
-    const BitplaneLayout layout{level, level, 2, independent};
+  for (const BitplaneLayout& layout : layouts(level, level, 2)) {
     const auto coded = all_coded(level, 2);
     std::mt19937 rng(77);
     for (int trial = 0; trial < 200; ++trial) {
       const int top = static_cast<int>(rng() % 50);
       std::vector<std::vector<std::uint8_t>> segs(rng() % 40);
-      for (auto& s : segs) {
+      for (std::size_t t = 0; t < segs.size(); ++t) {
+        auto& s = segs[t];
         s.resize(rng() % 200);
         for (auto& b : s) b = static_cast<std::uint8_t>(rng());
+        // Half the per-patch segments get stream sizes that fit, so the garbage reaches the patch coders.
+        if (layout.independent_patches && t >= static_cast<std::size_t>(layout.joint_segments) && rng() % 2) {
+          const std::size_t a = rng() % (s.size() + 1), b = s.size() - a;
+          const std::vector<std::uint8_t> head = {
+              static_cast<std::uint8_t>(a | 0x80), static_cast<std::uint8_t>(a >> 7),
+              static_cast<std::uint8_t>(b | 0x80), static_cast<std::uint8_t>(b >> 7)};
+          s.insert(s.begin(), head.begin(), head.end());
+        }
       }
       std::vector<std::uint8_t> tail(rng() % 50);
       for (auto& b : tail) b = static_cast<std::uint8_t>(rng());

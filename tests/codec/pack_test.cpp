@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -245,6 +246,31 @@ TEST(Pack, HoleMaskIsCoarseUntilItsChunkArrives) {
       decode_pack(pack, {.max_bytes = static_cast<std::size_t>(chunk->offset + chunk->size)});
   EXPECT_EQ(after.models[0].hole_mask_level, 5);
   EXPECT_EQ(after.models[0].hole_mask, m.hole_mask);
+}
+
+// Fine masks of every kind (empty, sparse, blobs, nearly full, isolated bits at block borders) arrive
+// exactly.
+TEST(Pack, RandomHoleMasksRoundTrip) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 12; ++trial) {
+    PackModelInput m = pillow_model(5, "holey");
+    m.hole_mask.assign(2, std::vector<std::uint8_t>(32 * 32, 0));
+    const double density = std::array{0.0, 0.01, 0.1, 0.5, 0.9, 1.0}[static_cast<std::size_t>(trial % 6)];
+    for (auto& mask : m.hole_mask) {
+      for (auto& b : mask) b = std::uniform_real_distribution<double>(0, 1)(rng) < density;
+      if (trial >= 6) {  // a blob too
+        const int x0 = static_cast<int>(rng() % 24), y0 = static_cast<int>(rng() % 24);
+        for (int j = y0; j < y0 + 7; ++j)
+          for (int i = x0; i < x0 + 5; ++i) mask[static_cast<std::size_t>(j * 32 + i)] = 1;
+      }
+    }
+    PackWriteOptions options = geometry_only();
+    options.hole_mask_after_bytes = 100;
+    const PackDecodeResult r = decode_pack(write_pack({m}, options));
+    ASSERT_EQ(r.status, Status::kOk);
+    EXPECT_EQ(r.models[0].hole_mask_level, 5);
+    EXPECT_EQ(r.models[0].hole_mask, m.hole_mask) << "trial " << trial;
+  }
 }
 
 TEST(Pack, WriterRejectsBadInput) {

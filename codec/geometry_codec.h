@@ -122,8 +122,8 @@ struct DecodedGeometry {
 /// planes that exist are still decoded). kInvalidArgument (and no patches) for a header that parse() would
 /// refuse (built by hand) or a negative drop_finest_steps. Cost: proportional to the bytes decoded; a
 /// version-2 stream decodes its patches on parallel threads (options.max_threads). Measured on the bunny
-/// (2 patches of 257², 14 bits, tests/bench/codec_bench.cpp --pack): 2 KB 1.8 ms, 16 KB 4.0 ms, the full
-/// 164 KB 16 ms on one core; 1.1, 2.7 and 9.1 ms on two.
+/// (2 patches of 257², 14 bits, tests/bench/codec_bench.cpp --pack): 2 KB 1.9 ms, 16 KB 3.6 ms, the full
+/// 164 KB 16–17.5 ms on one core; 1.4, 2.5 and 9.1–9.4 ms on two.
 Status decode_geometry(const GeometryCodecHeader& header,
                        std::span<const std::span<const std::uint8_t>> segments,
                        std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,

@@ -24,7 +24,8 @@ struct Affine {
       for (int c = 0; c < 4; ++c) m[r][c] = zero ? (r == c ? 1.0 : 0.0) : a[4 * r + c];
   }
   void point(const float* p, float* out) const {
-    for (int r = 0; r < 3; ++r) out[r] = static_cast<float>(m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]);
+    for (int r = 0; r < 3; ++r)
+      out[r] = static_cast<float>(m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]);
   }
   void vector(const float* p, float* out) const {
     for (int r = 0; r < 3; ++r) out[r] = static_cast<float>(m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2]);
@@ -44,18 +45,45 @@ struct Affine {
     c[2][2] = a[0][0] * a[1][1] - a[0][1] * a[1][0];
     const double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
     double v[3];
-    for (int r = 0; r < 3; ++r) v[r] = (c[r][0] * n[0] + c[r][1] * n[1] + c[r][2] * n[2]) * (det < 0 ? -1 : 1);
+    for (int r = 0; r < 3; ++r)
+      v[r] = (c[r][0] * n[0] + c[r][1] * n[1] + c[r][2] * n[2]) * (det < 0 ? -1 : 1);
     const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     for (int r = 0; r < 3; ++r) out[r] = static_cast<float>(l > 0 ? v[r] / l : 0.0);
   }
 };
+
+/// The pack's normalization, or — when it is the identity (packs from `geomip convert` store positions in the
+/// mesh's units and spend no manifest bytes on a frame) — the transform of this decode's bounding box to the
+/// centred unit box. (Recomputed per prefix: the box of a coarse level is within about 1 % of the full one.)
+std::array<double, 16> view_transform(const codec::DecodedModel& m) {
+  const auto& n = m.normalization;
+  const std::array<double, 16> identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  if (n != identity && n != std::array<double, 16>{}) return n;
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (const auto& g : m.geometry) {
+    for (std::size_t k = 0; k + 2 < g.values.size(); k += 3) {
+      for (int c = 0; c < 3; ++c) {
+        const double v = g.values[k + static_cast<std::size_t>(c)];
+        if (std::isfinite(v)) lo[c] = std::min(lo[c], v), hi[c] = std::max(hi[c], v);
+      }
+    }
+  }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  if (!(extent > 0) || !std::isfinite(extent)) return identity;
+  std::array<double, 16> fit = identity;
+  for (int c = 0; c < 3; ++c) {
+    fit[static_cast<std::size_t>(5 * c)] = 1.0 / extent;
+    fit[static_cast<std::size_t>(4 * c + 3)] = -0.5 * (lo[c] + hi[c]) / extent;
+  }
+  return fit;
+}
 
 void fill_common(const codec::DecodedModel& m, SceneModel& s) {
   s.name = m.name;
   s.level = m.geometry[0].level;
   s.num_patches = static_cast<int>(m.geometry.size());
   s.detail_level = m.detail_level;
-  const Affine xf(m.normalization);
+  const Affine xf(view_transform(m));
   s.normal_level = -1;
   s.normals.clear();
   if (m.normals.size() == m.geometry.size()) {
@@ -89,7 +117,7 @@ SceneModel make_scene_model(const codec::DecodedModel& model) {
   SceneModel s;
   fill_common(model, s);
   s.bands = 1;
-  const Affine xf(model.normalization);
+  const Affine xf(view_transform(model));
   for (const auto& g : model.geometry) {
     const std::size_t base = s.positions.size();
     s.positions.resize(base + g.values.size());
@@ -109,7 +137,7 @@ SceneModel make_banded_scene_model(const std::vector<codec::DecodedModel>& by_dr
   fill_common(full, s);
   const int bands = static_cast<int>(by_drop.size());
   s.bands = bands;
-  const Affine xf(full.normalization);
+  const Affine xf(view_transform(full));
   const std::size_t per = 3u * s.size() * s.size();
   s.positions.resize(per * s.num_patches * bands);
   for (int p = 0; p < s.num_patches; ++p)
@@ -155,7 +183,8 @@ bool same_layout(const SceneModel& a, const SceneModel& b) {
 
 std::vector<std::vector<float>> evaluate_morph(const SceneModel& source, const SceneModel& target, float t,
                                                MorphSchedule schedule) {
-  if (!same_layout(source, target)) throw std::invalid_argument("evaluate_morph: models of different layouts");
+  if (!same_layout(source, target))
+    throw std::invalid_argument("evaluate_morph: models of different layouts");
   const auto w = band_weights(t, source.bands, schedule);
   const std::size_t per = 3u * source.size() * source.size();
   std::vector<std::vector<float>> out(source.num_patches, std::vector<float>(per, 0.0f));
@@ -175,7 +204,8 @@ std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const 
   codec::PackDecodeResult full = codec::decode_pack(bytes, options);
   status = full.status;
   bytes_used = full.bytes_used;
-  if (full.models.empty() || full.models[0].geometry_passes == 0 || full.models[0].geometry.empty()) return {};
+  if (full.models.empty() || full.models[0].geometry_passes == 0 || full.models[0].geometry.empty())
+    return {};
   std::vector<SceneModel> out;
   const int bands = std::max(1, std::min(settings.bands, full.models[0].geometry[0].level + 1));
   if (bands == 1) {

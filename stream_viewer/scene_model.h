@@ -4,8 +4,8 @@
 #pragma once
 
 #include <array>
-#include <span>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -14,21 +14,23 @@
 namespace geomip::viewer {
 
 /// One model, ready for upload. Positions are stored as `bands` layers per patch, each a (2^level+1)² grid of
-/// xyz floats in the normalized frame (the pack's normalization already applied): with one band the layer is
-/// the geometry image itself; with B > 1 bands, layer 0 is the coarse base (the wavelet reconstruction with the
-/// finest B−1 steps dropped) and layer m ≥ 1 is the detail D added by step B−1−m+1 (so the layers sum to the
-/// full geometry, and layer B−1 is the finest band).
+/// xyz floats in the normalized frame (the pack's normalization applied; for an identity normalization, as
+/// `geomip convert` writes, the decode's bounding box fitted to the centred unit box): with one band the
+/// layer is the geometry image itself; with B > 1 bands, layer 0 is the coarse base (the wavelet
+/// reconstruction with the finest B−1 steps dropped) and layer m ≥ 1 is the detail D added by step B−1−m+1
+/// (so the layers sum to the full geometry, and layer B−1 is the finest band).
 struct SceneModel {
   std::string name;
-  int level = 0;        ///< geometry grid level n: (2^n+1)² samples per patch
+  int level = 0;  ///< geometry grid level n: (2^n+1)² samples per patch
   int num_patches = 0;
   int bands = 1;
   std::vector<float> positions;  ///< [(patch·bands + band) · size² + j·size + i] · 3 + c
   int normal_level = -1;         ///< −1: no normal map (the renderer shades with screen-space derivatives)
-  std::vector<float> normals;    ///< [patch · nsize² + j·nsize + i] · 3 + c, unit length, normalized frame
-  std::vector<std::uint8_t> holes;  ///< [patch · 4^L + j·2^L + i], L = hole_level: 1 = quad not drawn; empty = none
-  int hole_level = 0;               ///< level L ≤ level of the hole mask's grid
-  int detail_level = 0;          ///< finest level that received detail (codec::DecodedModel::detail_level)
+  std::vector<float> normals;  ///< [patch · nsize² + j·nsize + i] · 3 + c, unit length, normalized frame
+  /// [patch · 4^L + j·2^L + i], L = hole_level: 1 = quad not drawn; empty = none
+  std::vector<std::uint8_t> holes;
+  int hole_level = 0;    ///< level L ≤ level of the hole mask's grid
+  int detail_level = 0;  ///< finest level that received detail (codec::DecodedModel::detail_level)
   int size() const { return (1 << level) + 1; }
 };
 

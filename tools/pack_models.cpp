@@ -3,9 +3,6 @@
 #include "gimage/uniform_remesh.h"
 #include "param/errors.h"
 
-#include <algorithm>
-#include <cmath>
-
 namespace geomip::tools {
 
 codec::PackModelInput pack_model_input(const std::string& name, const GeometryImages& images,
@@ -18,29 +15,7 @@ codec::PackModelInput pack_model_input(const std::string& name, const GeometryIm
   for (const SideLink& link : images.adjacency)
     input.seams.push_back({link.patch, link.side, link.other_patch, link.other_side, link.reversed});
   if (mask) input.hole_mask = mask->quads;
-  input.normalization = unit_box_normalization(input.geometry);
   return input;
-}
-
-std::array<double, 16> unit_box_normalization(const std::vector<codec::Grid3>& patches) {
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (const codec::Grid3& g : patches) {
-    for (std::size_t k = 0; k + 2 < g.values.size(); k += 3) {
-      for (int c = 0; c < 3; ++c) {
-        const double v = g.values[k + static_cast<std::size_t>(c)];
-        if (std::isfinite(v)) lo[c] = std::min(lo[c], v), hi[c] = std::max(hi[c], v);
-      }
-    }
-  }
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  std::array<double, 16> m{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  if (!(extent > 0) || !std::isfinite(extent)) return m;
-  const double s = 1.0 / extent;
-  for (int c = 0; c < 3; ++c) {
-    m[static_cast<std::size_t>(5 * c)] = s;
-    m[static_cast<std::size_t>(4 * c + 3)] = -0.5 * (lo[c] + hi[c]) * s;
-  }
-  return m;
 }
 
 TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
@@ -63,10 +38,8 @@ TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
     const codec::Grid3& grid = model.geometry[p];
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
-        const float* v =
-            grid.values.data() + 3 * (static_cast<std::size_t>(j * stride) * grid_n + i * stride);
-        remesh.mesh.positions[remesh.grid_vertex[p][static_cast<std::size_t>(j) * n + i]] = {v[0], v[1],
-                                                                                             v[2]};
+        const float* v = grid.values.data() + 3 * (static_cast<std::size_t>(j * stride) * grid_n + i * stride);
+        remesh.mesh.positions[remesh.grid_vertex[p][static_cast<std::size_t>(j) * n + i]] = {v[0], v[1], v[2]};
       }
     }
   }

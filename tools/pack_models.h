@@ -6,21 +6,15 @@
 #include "gimage/resample.h"
 #include "param/mesh.h"
 
-#include <array>
 #include <string>
 #include <vector>
 
 namespace geomip::tools {
 
 /// The pack input of one model: its geometry images (and normal maps unless `normals` is false), its seams,
-/// the hole mask when the model was repaired (`mask` may be null or empty), and the normalization to the
-/// viewer's frame (unit_box_normalization() of its geometry).
+/// and the hole mask when the model was repaired (`mask` may be null or empty).
 codec::PackModelInput pack_model_input(const std::string& name, const GeometryImages& images,
                                        const HoleMaskResult* mask, bool normals);
-
-/// Row-major transform taking the patches' bounding box to the viewer's normalized frame: centred at the
-/// origin, largest extent 1 (uniform scale). Identity when the box is empty or flat in every direction.
-std::array<double, 16> unit_box_normalization(const std::vector<codec::Grid3>& patches);
 
 /// The level-`level` mesh of a decoded model (level ≤ its grid level; -1 = the grid level): the nested grid
 /// triangulated as `geomip remesh` does (gimage/uniform_remesh.h: same face list for every model of a

@@ -54,6 +54,23 @@ TEST(SceneModel, NormalizationMapsToTheUnitBox) {
     EXPECT_NEAR(std::hypot(m.normals[k], m.normals[k + 1], m.normals[k + 2]), 1.0f, 1e-4f);
 }
 
+// Packs from `geomip convert` keep the mesh's units and an identity normalization: the scene fits the
+// decoded bounding box to the centred unit box.
+TEST(SceneModel, IdentityNormalizationFitsTheUnitBox) {
+  auto raw = testing::decoded_model(4, 1);
+  raw.normalization = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  for (auto& g : raw.geometry) {
+    for (std::size_t k = 0; k < g.values.size(); ++k)
+      g.values[k] = 0.05f * g.values[k] + (k % 3 == 1 ? 7.f : -3.f);
+  }
+  const auto m = make_scene_model(raw);
+  float lo[3] = {1e9f, 1e9f, 1e9f}, hi[3] = {-1e9f, -1e9f, -1e9f};
+  for (std::size_t k = 0; k < m.positions.size(); ++k)
+    lo[k % 3] = std::min(lo[k % 3], m.positions[k]), hi[k % 3] = std::max(hi[k % 3], m.positions[k]);
+  EXPECT_NEAR(std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}), 1.0f, 1e-4f);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(lo[c] + hi[c], 0.0f, 1e-4f);
+}
+
 TEST(SceneModel, BandsSumToTheFullGeometry) {
   std::vector<codec::DecodedModel> by_drop;
   for (int d = 0; d < 3; ++d) {

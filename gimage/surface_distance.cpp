@@ -107,6 +107,8 @@ class Uniform {
 
 struct Samples {
   std::vector<Point> points;
+  /// Per point: the vertex (vertex samples) or triangle (face samples) it belongs to; -1 for edge samples.
+  std::vector<int> owner;
   std::size_t vertices = 0, edges = 0, faces = 0;
 };
 
@@ -128,7 +130,10 @@ Samples sample_surface(const TriMesh& mesh, const SurfaceDistanceOptions& option
       for (int v : t) referenced[v] = 1;
     }
     for (std::size_t v = 0; v < referenced.size(); ++v) {
-      if (referenced[v]) s.points.push_back(to_point(mesh.positions[v]));
+      if (referenced[v]) {
+        s.points.push_back(to_point(mesh.positions[v]));
+        s.owner.push_back(static_cast<int>(v));
+      }
     }
     s.vertices = s.points.size();
   }
@@ -152,6 +157,7 @@ Samples sample_surface(const TriMesh& mesh, const SurfaceDistanceOptions& option
         while (next < start + length && s.edges < options.edge_samples) {
           const double t = (next - start) / length;
           s.points.push_back(to_point((1 - t) * mesh.positions[a] + t * mesh.positions[b]));
+          s.owner.push_back(-1);
           ++s.edges;
           next += step;
         }
@@ -172,6 +178,7 @@ Samples sample_surface(const TriMesh& mesh, const SurfaceDistanceOptions& option
   for (double& x : picks) x = uniform() * total_area;
   std::sort(picks.begin(), picks.end());
   s.points.reserve(s.points.size() + n);
+  s.owner.reserve(s.owner.size() + n);
   std::size_t f = 0;
   for (double x : picks) {
     while (f + 1 < cumulative.size() && cumulative[f] <= x) ++f;
@@ -183,6 +190,7 @@ Samples sample_surface(const TriMesh& mesh, const SurfaceDistanceOptions& option
     }
     const Eigen::Vector3d& a = mesh.positions[t[0]];
     s.points.push_back(to_point(a + u * (mesh.positions[t[1]] - a) + v * (mesh.positions[t[2]] - a)));
+    s.owner.push_back(static_cast<int>(f));
   }
   s.faces = n;
   return s;
@@ -190,19 +198,23 @@ Samples sample_surface(const TriMesh& mesh, const SurfaceDistanceOptions& option
 
 struct Accumulator {
   double max = 0, sum = 0, sum_squares = 0;
+  std::size_t max_index = 0;  // sample attaining max (first one in its chunk)
 };
 
 /// Distances from every sample to `target`, reduced to max / mean / RMS. Distances at or below `noise_floor`
 /// count as 0.
+/// With `from` (the sampled mesh) given, also fills the per-vertex and per-face error maps.
 OneSidedDistance one_sided(const Samples& samples, const SearchSurface& target, double noise_floor,
-                           unsigned threads) {
+                           unsigned threads, const TriMesh* from) {
   const std::size_t n = samples.points.size();
+  std::vector<float> distances(from ? n : 0);
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<Accumulator> partial(chunks);
   std::atomic<std::size_t> next_chunk{0};
   auto work = [&] {
     for (std::size_t c = next_chunk++; c < chunks; c = next_chunk++) {
       Accumulator acc;
+      acc.max_index = c * kChunk;
       const std::size_t end = std::min(n, (c + 1) * kChunk);
       Point hint = target.tree().closest_point(samples.points[c * kChunk]);
       for (std::size_t i = c * kChunk; i < end; ++i) {
@@ -210,7 +222,11 @@ OneSidedDistance one_sided(const Samples& samples, const SearchSurface& target, 
         hint = target.tree().closest_point(p, hint);
         double d = std::sqrt(CGAL::squared_distance(p, hint));
         if (d <= noise_floor) d = 0;
-        acc.max = std::max(acc.max, d);
+        if (d > acc.max) {
+          acc.max = d;
+          acc.max_index = i;
+        }
+        if (from) distances[i] = static_cast<float>(d);
         acc.sum += d;
         acc.sum_squares += d * d;
       }
@@ -225,7 +241,10 @@ OneSidedDistance one_sided(const Samples& samples, const SearchSurface& target, 
 
   Accumulator total;
   for (const Accumulator& a : partial) {
-    total.max = std::max(total.max, a.max);
+    if (a.max > total.max) {
+      total.max = a.max;
+      total.max_index = a.max_index;
+    }
     total.sum += a.sum;
     total.sum_squares += a.sum_squares;
   }
@@ -236,6 +255,27 @@ OneSidedDistance one_sided(const Samples& samples, const SearchSurface& target, 
   r.vertex_samples = samples.vertices;
   r.edge_samples = samples.edges;
   r.face_samples = samples.faces;
+  if (n > 0) {
+    const Point& p = samples.points[total.max_index];
+    r.max_at = Eigen::Vector3d(p.x(), p.y(), p.z());
+  }
+  if (from) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    r.vertex_distance.assign(from->positions.size(), nan);
+    std::vector<double> face_sum(from->triangles.size(), 0);
+    std::vector<std::size_t> face_count(from->triangles.size(), 0);
+    for (std::size_t i = 0; i < samples.vertices; ++i) r.vertex_distance[samples.owner[i]] = distances[i];
+    for (std::size_t i = samples.vertices + samples.edges; i < n; ++i) {
+      const double d = distances[i];
+      face_sum[samples.owner[i]] += d * d;
+      ++face_count[samples.owner[i]];
+    }
+    r.face_rms.assign(from->triangles.size(), nan);
+    for (std::size_t f = 0; f < face_sum.size(); ++f) {
+      if (face_count[f] > 0)
+        r.face_rms[f] = static_cast<float>(std::sqrt(face_sum[f] / static_cast<double>(face_count[f])));
+    }
+  }
   return r;
 }
 
@@ -261,13 +301,13 @@ SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh&
   SurfaceDistance r;
   {
     const SearchSurface approx_surface(approx);
-    r.original_to_approx =
-        one_sided(sample_surface(original, options, 0), approx_surface, noise_floor, threads);
+    r.original_to_approx = one_sided(sample_surface(original, options, 0), approx_surface, noise_floor,
+                                     threads, options.error_maps ? &original : nullptr);
   }
   {
     const SearchSurface original_surface(original);
-    r.approx_to_original =
-        one_sided(sample_surface(approx, options, 1), original_surface, noise_floor, threads);
+    r.approx_to_original = one_sided(sample_surface(approx, options, 1), original_surface, noise_floor,
+                                     threads, options.error_maps ? &approx : nullptr);
   }
   r.hausdorff = std::max(r.original_to_approx.max, r.approx_to_original.max);
   r.rms = std::max(r.original_to_approx.rms, r.approx_to_original.rms);

@@ -32,6 +32,9 @@ struct SurfaceDistanceOptions {
   std::uint64_t seed = 0x5eed;
   /// Worker threads for the distance queries; 0 = std::thread::hardware_concurrency().
   unsigned threads = 0;
+  /// Also return where the error is (OneSidedDistance::vertex_distance and face_rms): Metro's error
+  /// colouring. Costs one float per sample while measuring.
+  bool error_maps = false;
 };
 
 /// One-sided distance from the samples of surface `from` to the surface `to`, in the meshes' units.
@@ -43,6 +46,14 @@ struct OneSidedDistance {
   std::size_t edge_samples = 0;
   std::size_t face_samples = 0;
   std::size_t samples() const { return vertex_samples + edge_samples + face_samples; }
+  /// The sample where `max` is attained (first such sample in sampling order), on the `from` surface.
+  Eigen::Vector3d max_at = Eigen::Vector3d::Zero();
+
+  /// Only with SurfaceDistanceOptions::error_maps, indexed like the `from` mesh:
+  /// distance of each vertex to `to` (NaN: not sampled — unreferenced, or vertex sampling off) and the RMS
+  /// distance of the face samples that fell in each triangle (NaN: no sample fell in it).
+  std::vector<float> vertex_distance;
+  std::vector<float> face_rms;
 };
 
 /// Result of `measure_surface_distance()`. Distances in the meshes' units; "_pct" in percent of

@@ -2,16 +2,20 @@
 #include "gimage/surface_distance.h"
 #include "param/errors.h"
 #include "param/mesh_io.h"
+#include "tools/atomic_file.h"
 #include "tools/commands.h"
+#include "tools/error_map.h"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace geomip::tools {
 namespace {
@@ -22,6 +26,9 @@ struct EvalArgs {
   SurfaceDistanceOptions options;
   bool no_vertices = false;
   bool json = false;
+  std::string error_map;           // APPROX coloured by its distance to ORIGINAL
+  std::string error_map_original;  // ORIGINAL coloured by its distance to APPROX
+  double error_map_scale_pct = 0;  // full red, % of the diagonal; 0 = the 99th percentile of the face RMS
 };
 
 nlohmann::json one_sided_to_json(const OneSidedDistance& d) {
@@ -31,7 +38,22 @@ nlohmann::json one_sided_to_json(const OneSidedDistance& d) {
           {"samples", d.samples()},
           {"vertex_samples", d.vertex_samples},
           {"edge_samples", d.edge_samples},
-          {"face_samples", d.face_samples}};
+          {"face_samples", d.face_samples},
+          {"max_at", {d.max_at.x(), d.max_at.y(), d.max_at.z()}}};
+}
+
+/// The 99th percentile of the finite face RMS values of the maps (0 when there are none).
+double percentile_99(const std::vector<const OneSidedDistance*>& maps) {
+  std::vector<float> values;
+  for (const OneSidedDistance* m : maps) {
+    for (float e : m->face_rms) {
+      if (std::isfinite(e)) values.push_back(e);
+    }
+  }
+  if (values.empty()) return 0;
+  const std::size_t k = std::min(values.size() - 1, values.size() * 99 / 100);
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
 }
 
 template <typename... T>
@@ -43,6 +65,11 @@ std::string format(const char* fmt, T... values) {
 
 int run_eval(EvalArgs args) {
   args.options.sample_vertices = !args.no_vertices;
+  args.options.error_maps = !args.error_map.empty() || !args.error_map_original.empty();
+  for (const std::string* path : {&args.error_map, &args.error_map_original}) {
+    if (!path->empty() && mesh_format_from_path(*path) != MeshFormat::kPly)
+      throw InvalidInput(*path + ": an error map is written as PLY (.ply)");
+  }
   const TriMesh original = read_mesh(args.original);
   const TriMesh approx = read_mesh(args.approx);
   const auto start = std::chrono::steady_clock::now();
@@ -54,6 +81,31 @@ int run_eval(EvalArgs args) {
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const bool finite_psnr = std::isfinite(d.psnr_db);
+
+  double scale = 0;  // error-map colour scale, in the meshes' units
+  if (args.options.error_maps) {
+    std::vector<const OneSidedDistance*> maps;
+    if (!args.error_map.empty()) maps.push_back(&d.approx_to_original);
+    if (!args.error_map_original.empty()) maps.push_back(&d.original_to_approx);
+    scale =
+        args.error_map_scale_pct > 0 ? args.error_map_scale_pct / 100 * d.bbox_diagonal : percentile_99(maps);
+    if (!(scale > 0)) scale = d.bbox_diagonal * 1e-6;  // coincident surfaces: everything blue
+    ErrorMapOptions map_options;
+    map_options.scale = scale;
+    map_options.diagonal = d.bbox_diagonal;
+    if (!args.error_map.empty()) {
+      map_options.comment = args.approx + " (distance to " + args.original + ")";
+      write_file_atomically(args.error_map, [&](std::ostream& out) {
+        write_error_map(approx, d.approx_to_original, map_options, out);
+      });
+    }
+    if (!args.error_map_original.empty()) {
+      map_options.comment = args.original + " (distance to " + args.approx + ")";
+      write_file_atomically(args.error_map_original, [&](std::ostream& out) {
+        write_error_map(original, d.original_to_approx, map_options, out);
+      });
+    }
+  }
 
   if (args.json) {
     nlohmann::json j;
@@ -67,14 +119,15 @@ int run_eval(EvalArgs args) {
     j["psnr_db"] = finite_psnr ? nlohmann::json(d.psnr_db) : nlohmann::json(nullptr);  // null: +infinity
     j["original_to_approx"] = one_sided_to_json(d.original_to_approx);
     j["approx_to_original"] = one_sided_to_json(d.approx_to_original);
+    if (args.options.error_maps) j["error_map_scale_pct"] = 100 * scale / d.bbox_diagonal;
     j["seed"] = args.options.seed;
     j["seconds"] = seconds;
     std::cout << j.dump(2) << "\n";
     return kExitOk;
   }
   auto row = [&](const char* name, const OneSidedDistance& s) {
-    std::cout << format("%s  %8zu samples  max %.6g  mean %.6g  rms %.6g\n", name, s.samples(), s.max, s.mean,
-                        s.rms);
+    std::cout << format("%s  %8zu samples  max %.6g  mean %.6g  rms %.6g  (max at %.6g %.6g %.6g)\n", name,
+                        s.samples(), s.max, s.mean, s.rms, s.max_at.x(), s.max_at.y(), s.max_at.z());
   };
   std::cout << "original " << args.original << " (" << original.num_triangles() << " faces), approx "
             << args.approx << " (" << approx.num_triangles() << " faces)\n"
@@ -85,6 +138,12 @@ int run_eval(EvalArgs args) {
             << format("symmetric RMS:       %.6g (%.4f%% of diagonal)\n", d.rms, d.rms_pct)
             << (finite_psnr ? format("PSNR: %.2f dB\n", d.psnr_db) : std::string("PSNR: inf dB\n"))
             << format("time: %.2f s\n", seconds);
+  if (args.options.error_maps) {
+    std::cout << format("error map colour scale: red = %.4f%% of diagonal", 100 * scale / d.bbox_diagonal);
+    if (!args.error_map.empty()) std::cout << "; " << args.error_map;
+    if (!args.error_map_original.empty()) std::cout << "; " << args.error_map_original;
+    std::cout << "\n";
+  }
   return kExitOk;
 }
 
@@ -106,6 +165,14 @@ CommandRunner add_eval_command(CLI::App& app) {
   cmd->add_flag("--no-vertices", args->no_vertices, "Do not sample the meshes' vertices");
   cmd->add_option("--seed", args->options.seed, "Seed of the random face samples (same seed, same result)");
   cmd->add_option("--threads", args->options.threads, "Worker threads (default: all cores)");
+  cmd->add_option("--error-map", args->error_map,
+                  "Write APPROX as PLY coloured by its distance to ORIGINAL (per face: RMS of its samples; "
+                  "quality = % of diagonal) for MeshLab or Blender");
+  cmd->add_option("--error-map-original", args->error_map_original,
+                  "Write ORIGINAL as PLY coloured by its distance to APPROX");
+  cmd->add_option("--error-map-scale", args->error_map_scale_pct,
+                  "Distance shown as red, in % of the diagonal (default: the 99th percentile of face RMS)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", args->json,
                 "Machine-readable output: hausdorff_pct, rms_pct, psnr_db (null = +inf), raw values, "
                 "per-direction max/mean/rms and sample counts, bbox_diagonal");

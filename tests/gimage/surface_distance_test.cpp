@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -92,6 +93,55 @@ TEST(SurfaceDistance, SphereScaledByOnePlusEpsilonIsEpsilonAway) {
     EXPECT_NEAR(d.bbox_diagonal, 2 * std::sqrt(3.0), 1e-12);  // the axis points (±1,0,0)… are vertices
     EXPECT_NEAR(d.psnr_db, 20 * std::log10(2 * std::sqrt(3.0) / eps), 0.1);  // 1% of ε ≈ 0.09 dB
   }
+}
+
+TEST(SurfaceDistance, ErrorMapsLocateTheErrorAndAgreeWithTheTotals) {
+  // The square z = 0 against the plane z = a·x (a square tilted about the y axis, beyond the first one so
+  // that every closest point is interior): the distance of (x, y, 0) is a·x/√(1+a²), growing with x.
+  const double a = 0.1;
+  const TriMesh flat = square(9);
+  TriMesh tilted = test::grid(4);
+  for (auto& p : tilted.positions) p = Eigen::Vector3d(3 * p.x() - 1, 3 * p.y() - 1, 0);
+  for (auto& p : tilted.positions) p.z() = a * p.x();
+  auto distance = [&](const Eigen::Vector3d& p) { return a * p.x() / std::sqrt(1 + a * a); };
+
+  SurfaceDistanceOptions options;
+  options.error_maps = true;
+  const SurfaceDistance d = measure_surface_distance(flat, tilted, options);
+  const OneSidedDistance& s = d.original_to_approx;
+  ASSERT_EQ(s.vertex_distance.size(), flat.num_vertices());
+  ASSERT_EQ(s.face_rms.size(), flat.num_triangles());
+  for (std::size_t v = 0; v < flat.num_vertices(); ++v)
+    EXPECT_NEAR(s.vertex_distance[v], distance(flat.positions[v]), 1e-6) << v;
+  // A face's RMS lies between the smallest and largest distance of its corners (the distance is linear on
+  // it).
+  double sum_squares = 0;
+  std::size_t with_samples = 0;
+  for (std::size_t f = 0; f < flat.num_triangles(); ++f) {
+    ASSERT_TRUE(std::isfinite(s.face_rms[f])) << f;  // 10 samples per face on average over 128 faces
+    double lo = 1e9, hi = -1e9;
+    for (int v : flat.triangles[f]) {
+      lo = std::min(lo, distance(flat.positions[v]));
+      hi = std::max(hi, distance(flat.positions[v]));
+    }
+    EXPECT_GE(s.face_rms[f], lo - 1e-6) << f;
+    EXPECT_LE(s.face_rms[f], hi + 1e-6) << f;
+    sum_squares += double(s.face_rms[f]) * s.face_rms[f];
+    ++with_samples;
+  }
+  EXPECT_GT(with_samples, 0u);
+  // The maximum sits on the side x = 1 (where the distance is largest) and has the distance there.
+  EXPECT_NEAR(s.max_at.x(), 1.0, 1e-9);
+  EXPECT_NEAR(s.max, distance(s.max_at), 1e-9);
+  EXPECT_NEAR(s.max, distance(Eigen::Vector3d(1, 0, 0)), 1e-9);
+  // Maps do not change the totals.
+  const SurfaceDistance plain = measure_surface_distance(flat, tilted);
+  expect_identical(d, plain);
+  EXPECT_TRUE(plain.original_to_approx.face_rms.empty());
+  // The other side: tilted-plane vertices beyond the unit square are farther than any face of the square.
+  const OneSidedDistance& back = d.approx_to_original;
+  ASSERT_EQ(back.vertex_distance.size(), tilted.num_vertices());
+  EXPECT_NEAR(back.max, *std::max_element(back.vertex_distance.begin(), back.vertex_distance.end()), 1e-6);
 }
 
 TEST(SurfaceDistance, PatchInsideSquareIsOneSided) {

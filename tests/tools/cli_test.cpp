@@ -390,6 +390,28 @@ TEST_F(Cli, EvalReportsMetroDistancesAndInfinitePsnrForIdenticalMeshes) {
   expect_bad_input("eval '" + square + "' '" + missing + "'", missing);
   const std::string flat = file("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
   expect_bad_input("eval '" + flat + "' '" + square + "'", flat);
+  // Error maps: PLY files other tools read back (geomip's own reader, which is OpenMesh's), with the
+  // distance as quality; the location of the maximum in JSON; a non-PLY map is refused and nothing written.
+  const std::string map = dir_ + "/map.ply", map_original = dir_ + "/map-original.ply";
+  const Outcome mapped = geomip("eval --json --samples 5000 '" + square + "' '" + lifted + "' --error-map '" +
+                                map + "' --error-map-original '" + map_original + "'");
+  ASSERT_EQ(mapped.exit_code, 0) << mapped.err;
+  const auto m = nlohmann::json::parse(mapped.out);
+  EXPECT_NEAR(m["error_map_scale_pct"].get<double>(), 25 / std::sqrt(2.0), 1e-4);  // every face at 0.25
+  EXPECT_NEAR(m["approx_to_original"]["max_at"][2].get<double>(), 0.25, 1e-12);   // a point of `lifted`
+  for (const std::string& path : {map, map_original}) {
+    const TriMesh back = read_mesh(path);
+    EXPECT_EQ(back.num_vertices(), 4u) << path;
+    EXPECT_EQ(back.num_triangles(), 2u) << path;
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(bytes.find("property float quality"), std::string::npos) << path;
+  }
+  EXPECT_NEAR(read_mesh(map).positions[0].z(), 0.25, 1e-7);
+  EXPECT_NEAR(read_mesh(map_original).positions[0].z(), 0.0, 1e-7);
+  const std::string wrong = dir_ + "/map.obj";
+  expect_bad_input("eval '" + square + "' '" + lifted + "' --error-map '" + wrong + "'", wrong);
+  EXPECT_FALSE(fs::exists(wrong));
   EXPECT_EQ(geomip("eval '" + square + "'").exit_code, 2);  // APPROX missing
   EXPECT_EQ(geomip("eval --help").exit_code, 0);
 }

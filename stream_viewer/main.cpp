@@ -34,6 +34,7 @@ struct Options {
   int bands = 5;
   int model = 0;
   bool animate = false;
+  bool no_align = false;
   int frames = 0;
   int width = 1280, height = 720;
   std::string screenshot, first_screenshot;
@@ -142,7 +143,7 @@ int run(const Options& opt) {
     Renderer renderer;
     Offscreen target(opt.width, opt.height);
     PackSource source(opt.source, FetchOptions{.limit_rate = opt.limit_rate},
-                      DecodeSettings{.bands = wavelet ? opt.bands : 1});
+                      DecodeSettings{.bands = wavelet ? opt.bands : 1, .align = !opt.no_align});
     Ui ui;
     ui.settings.width = opt.width;
     ui.settings.height = opt.height;
@@ -305,6 +306,9 @@ int main(int argc, char** argv) {
   app.add_option("--bands", opt.bands, "wavelet bands of the wavelet schedule")->check(CLI::Range(2, 8));
   app.add_option("--model", opt.model, "model index to show (morph source)")->check(CLI::NonNegativeNumber);
   app.add_flag("--animate", opt.animate, "cycle the morph through all models");
+  app.add_flag("--no-align", opt.no_align,
+               "keep each model in its own frame (default: models 1… are aligned to model 0 by the least-squares "
+               "similarity over corresponding samples)");
   app.add_option("--frames", opt.frames, "headless: render N frames after loading, then exit")
       ->check(CLI::PositiveNumber);
   app.add_option("--width", opt.width, "framebuffer width")->check(CLI::Range(16, 8192));

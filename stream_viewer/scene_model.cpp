@@ -1,5 +1,8 @@
 #include "stream_viewer/scene_model.h"
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -197,6 +200,61 @@ std::vector<std::vector<float>> evaluate_morph(const SceneModel& source, const S
   return out;
 }
 
+Similarity best_alignment(const SceneModel& model, const SceneModel& reference) {
+  if (!same_layout(model, reference))
+    throw std::invalid_argument("best_alignment: models of different layouts");
+  const std::size_t per = 3u * model.size() * model.size();
+  const std::size_t samples = per / 3 * static_cast<std::size_t>(model.num_patches);
+  Eigen::Matrix3Xd from(3, samples), to(3, samples);
+  from.setZero();
+  to.setZero();
+  for (int p = 0; p < model.num_patches; ++p)
+    for (int b = 0; b < model.bands; ++b) {
+      const std::size_t off = (static_cast<std::size_t>(p) * model.bands + b) * per;
+      for (std::size_t k = 0; k < per; ++k) {
+        const auto col = static_cast<Eigen::Index>(static_cast<std::size_t>(p) * (per / 3) + k / 3);
+        from(static_cast<Eigen::Index>(k % 3), col) += model.positions[off + k];
+        to(static_cast<Eigen::Index>(k % 3), col) += reference.positions[off + k];
+      }
+    }
+  // Non-finite samples (none in decoded packs) would poison the fit: leave such models as they are.
+  if (!from.allFinite() || !to.allFinite()) return {};
+  const Eigen::Matrix4d m = Eigen::umeyama(from, to, true);
+  if (!m.allFinite()) return {};
+  Similarity xf;
+  const Eigen::Matrix3d linear = m.topLeftCorner<3, 3>();
+  xf.scale = std::cbrt(linear.determinant());
+  if (!(xf.scale > 0)) return {};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) xf.rotation[static_cast<std::size_t>(3 * r + c)] = linear(r, c) / xf.scale;
+    xf.translation[static_cast<std::size_t>(r)] = m(r, 3);
+  }
+  return xf;
+}
+
+void apply_similarity(const Similarity& xf, SceneModel& model) {
+  const auto& r = xf.rotation;
+  const auto rotate = [&](float* v, double s) {
+    const double x = v[0], y = v[1], z = v[2];
+    for (int i = 0; i < 3; ++i)
+      v[i] = static_cast<float>(s * (r[static_cast<std::size_t>(3 * i)] * x +
+                                     r[static_cast<std::size_t>(3 * i + 1)] * y +
+                                     r[static_cast<std::size_t>(3 * i + 2)] * z));
+  };
+  const std::size_t per = 3u * model.size() * model.size();
+  for (int p = 0; p < model.num_patches; ++p)
+    for (int b = 0; b < model.bands; ++b) {
+      float* layer = &model.positions[(static_cast<std::size_t>(p) * model.bands + b) * per];
+      for (std::size_t k = 0; k < per; k += 3) {
+        rotate(layer + k, xf.scale);
+        if (b == 0)
+          for (int c = 0; c < 3; ++c)
+            layer[k + c] += static_cast<float>(xf.translation[static_cast<std::size_t>(c)]);
+      }
+    }
+  for (std::size_t k = 0; k + 2 < model.normals.size(); k += 3) rotate(&model.normals[k], 1.0);
+}
+
 std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
                                      codec::Status& status, std::size_t& bytes_used) {
   codec::PackDecodeOptions options;
@@ -208,8 +266,14 @@ std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const 
     return {};
   std::vector<SceneModel> out;
   const int bands = std::max(1, std::min(settings.bands, full.models[0].geometry[0].level + 1));
+  const auto align = [&] {
+    if (!settings.align) return;
+    for (std::size_t m = 1; m < out.size(); ++m)
+      if (same_layout(out[m], out[0])) apply_similarity(best_alignment(out[m], out[0]), out[m]);
+  };
   if (bands == 1) {
     for (const auto& m : full.models) out.push_back(make_scene_model(m));
+    align();
     return out;
   }
   std::vector<std::vector<codec::DecodedModel>> by_model(full.models.size());
@@ -222,6 +286,7 @@ std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const 
       by_model[m].push_back(std::move(r.models[m]));
   }
   for (const auto& decodes : by_model) out.push_back(make_banded_scene_model(decodes));
+  align();
   return out;
 }
 

@@ -62,10 +62,31 @@ std::vector<std::vector<float>> evaluate_morph(const SceneModel& source, const S
 /// True when the models can be morphed (same level, patch count and bands).
 bool same_layout(const SceneModel& a, const SceneModel& b);
 
+/// x ↦ scale · R · x + translation (R a rotation, row-major).
+struct Similarity {
+  double scale = 1;
+  std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  std::array<double, 3> translation{0, 0, 0};
+};
+
+/// The similarity that maps `model`'s samples closest onto the corresponding samples of `reference`, in the
+/// least-squares sense over every grid sample of every patch (Umeyama 1991, Eigen::umeyama; the full
+/// geometry, all bands summed). Consistent models correspond sample by sample, so this puts them in one pose
+/// and size before an image-space morph: models from different sources (the horse stands on y, the pig lies
+/// on z) otherwise sweep through a rotation and collapse at mid-morph. A reflection is never chosen.
+/// \throw std::invalid_argument when the layouts differ (same_layout() is false).
+Similarity best_alignment(const SceneModel& model, const SceneModel& reference);
+
+/// Applies `xf` to `model`: band 0 (or the single band) as points, detail bands as vectors (scale · R),
+/// normals rotated by R.
+void apply_similarity(const Similarity& xf, SceneModel& model);
+
 struct DecodeSettings {
   /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 decodes B times with
   /// drop_finest_steps = 0 … B−1).
   int bands = 1;
+  /// Align models 1, 2, … to model 0 (best_alignment) so that morphs between them do not rotate or shrink.
+  bool align = true;
 };
 
 /// Decodes a byte prefix of a pack into scene models. Returns an empty vector (status in `status`) when the

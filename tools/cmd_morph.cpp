@@ -26,6 +26,7 @@ struct MorphArgs {
   int bands = 5;
   int from = 0, to = 1;
   int level = -1;
+  bool no_align = false;
   bool quiet = false;
 };
 
@@ -40,6 +41,7 @@ int run_morph(const MorphArgs& args) {
   const bool wavelet = args.schedule == "wavelet";
   viewer::DecodeSettings settings;
   settings.bands = wavelet ? args.bands : 1;
+  settings.align = !args.no_align;
   codec::Status status = codec::Status::kOk;
   std::size_t used = 0;
   const std::vector<viewer::SceneModel> scenes = viewer::decode_scene(bytes, settings, status, used);
@@ -96,6 +98,9 @@ CommandRunner add_morph_command(CLI::App& app) {
   cmd->add_option("--to", args->to, "Target model index")->check(CLI::NonNegativeNumber);
   cmd->add_option("--level", args->level, "Output grid level (default: the pack's level)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--no-align", args->no_align,
+                "Keep each model in its own frame (default: models are aligned to model 0 by the least-squares "
+                "similarity over their corresponding samples, so the morph does not rotate or shrink)");
   cmd->add_flag("-q,--quiet", args->quiet, "No report");
   return [args] { return run_morph(*args); };
 }

@@ -84,7 +84,22 @@ TEST_F(MorphCommandTest, FramesShareConnectivityAndInterpolateTheModels) {
     ASSERT_EQ(linear[k].v.size(), linear[0].v.size());
   }
   EXPECT_NEAR(extent(linear[0]), 1.0, 1e-3) << "frames are in the normalized frame";
-  EXPECT_NEAR(extent(linear[4]), 1.0, 1e-3);
+  // The target is aligned to the source by a similarity: the last frame is the target in its own normalized
+  // frame (--no-align) up to one scale, a rotation and a translation — every distance scaled alike.
+  ASSERT_EQ(morph("--frames 2 --no-align -o " + (dir_ / "own").string()), 0);
+  const Obj own = read_obj(dir_ / "own" / "morph_0001.obj");
+  EXPECT_NEAR(extent(own), 1.0, 1e-3);
+  ASSERT_EQ(own.v.size(), linear[4].v.size());
+  auto dist = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+  };
+  const std::size_t n = own.v.size();
+  const double scale = dist(linear[4].v[0], linear[4].v[n / 2]) / dist(own.v[0], own.v[n / 2]);
+  for (std::size_t i = 1; i < n; i += 97) {
+    const std::size_t j = (i * 7919) % n;
+    if (dist(own.v[i], own.v[j]) < 1e-3) continue;
+    EXPECT_NEAR(dist(linear[4].v[i], linear[4].v[j]), scale * dist(own.v[i], own.v[j]), 1e-4) << i << " " << j;
+  }
   double mid_err = 0, wavelet_gap = 0, ends = 0;
   for (std::size_t i = 0; i < linear[0].v.size(); ++i)
     for (int c = 0; c < 3; ++c) {

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "tests/viewer/viewer_fixtures.h"
 
 namespace geomip::viewer {
@@ -86,11 +89,102 @@ TEST(SceneModel, BandsSumToTheFullGeometry) {
     for (std::size_t k = 0; k < per; ++k) EXPECT_NEAR(sum[p][k], full.positions[p * per + k], 1e-5f);
 }
 
+// A rotation about an oblique axis, row-major.
+std::array<double, 9> oblique_rotation(double angle) {
+  const double a[3] = {1 / std::sqrt(3.0), -1 / std::sqrt(3.0), 1 / std::sqrt(3.0)};
+  const double c = std::cos(angle), s = std::sin(angle);
+  std::array<double, 9> r{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r[3 * i + j] = (i == j ? c : 0) + (1 - c) * a[i] * a[j];
+  r[1] -= s * a[2], r[2] += s * a[1], r[3] += s * a[2], r[5] -= s * a[0], r[6] -= s * a[1], r[7] += s * a[0];
+  return r;
+}
+
+TEST(Alignment, RecoversAKnownSimilarity) {
+  for (int bands : {1, 3}) {
+    SceneModel reference;
+    if (bands == 1) {
+      reference = make_scene_model(testing::decoded_model(4, 1));
+    } else {
+      std::vector<codec::DecodedModel> by_drop;
+      for (int d = 0; d < bands; ++d) by_drop.push_back(testing::decoded_model(4, d == 0 ? 1 : 0));
+      reference = make_banded_scene_model(by_drop);
+    }
+    SceneModel moved = reference;
+    const Similarity xf{0.6, oblique_rotation(2.1), {0.3, -0.2, 0.7}};
+    apply_similarity(xf, moved);
+    const Similarity back = best_alignment(moved, reference);
+    EXPECT_NEAR(back.scale, 1 / 0.6, 1e-4) << bands;
+    SceneModel restored = moved;
+    apply_similarity(back, restored);
+    for (std::size_t k = 0; k < reference.positions.size(); ++k)
+      ASSERT_NEAR(restored.positions[k], reference.positions[k], 2e-5f) << bands << " " << k;
+    for (std::size_t k = 0; k < reference.normals.size(); ++k)
+      ASSERT_NEAR(restored.normals[k], reference.normals[k], 2e-5f) << bands << " " << k;
+    // A proper rotation: orthonormal with determinant +1 (no reflection).
+    const auto& r = back.rotation;
+    const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                       r[2] * (r[3] * r[7] - r[4] * r[6]);
+    EXPECT_NEAR(det, 1.0, 1e-9);
+  }
+  EXPECT_THROW(best_alignment(make_scene_model(testing::decoded_model(4, 1)),
+                              make_scene_model(testing::decoded_model(3, 1))),
+               std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace geomip::viewer
 
 namespace geomip::viewer {
 namespace {
+
+// Two consistent models of one shape in different poses (the second turned by 100° about an oblique axis, as
+// meshes from different sources are): decoded with alignment, the mid-morph is the shape itself; without, the
+// morph sweeps through the rotation and the midpoint shrinks.
+TEST(DecodeScene, AlignedModelsMorphWithoutCollapsing) {
+  auto a = testing::pack_input(4, 1);
+  auto b = a;
+  b.name = "turned";
+  const auto r = oblique_rotation(100 * M_PI / 180);
+  for (auto& g : b.geometry)
+    for (std::size_t k = 0; k < g.values.size(); k += 3) {
+      const float x = g.values[k], y = g.values[k + 1], z = g.values[k + 2];
+      for (int i = 0; i < 3; ++i)
+        g.values[k + i] = static_cast<float>(r[3 * i] * x + r[3 * i + 1] * y + r[3 * i + 2] * z);
+    }
+  b.normalization = testing::unit_box(b.geometry);
+  const auto bytes = codec::write_pack({a, b});
+  auto extent = [](const std::vector<float>& p) {
+    float lo[3] = {1e9f, 1e9f, 1e9f}, hi[3] = {-1e9f, -1e9f, -1e9f};
+    for (std::size_t k = 0; k < p.size(); ++k)
+      lo[k % 3] = std::min(lo[k % 3], p[k]), hi[k % 3] = std::max(hi[k % 3], p[k]);
+    return std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  };
+  for (bool align : {true, false}) {
+    codec::Status status;
+    std::size_t used = 0;
+    const auto models = decode_scene(bytes, DecodeSettings{.bands = 1, .align = align}, status, used);
+    ASSERT_EQ(models.size(), 2u);
+    const auto mid = evaluate_morph(models[0], models[1], 0.5f, MorphSchedule::kLinear);
+    std::vector<float> all;
+    float worst = 0;  // largest distance of a mid-morph sample from the same sample of model 0
+    const std::size_t per = 3u * models[0].size() * models[0].size();
+    for (int p = 0; p < models[0].num_patches; ++p) {
+      all.insert(all.end(), mid[p].begin(), mid[p].end());
+      for (std::size_t k = 0; k < per; k += 3) {
+        const float* m0 = &models[0].positions[p * per + k];
+        worst = std::max(worst, std::hypot(mid[p][k] - m0[0], mid[p][k + 1] - m0[1], mid[p][k + 2] - m0[2]));
+      }
+    }
+    if (align) {
+      EXPECT_LT(worst, 2e-3f) << "aligned: the mid-morph is model 0 up to the coding error";
+      EXPECT_NEAR(extent(all), 1.0f, 5e-3f);
+    } else {
+      EXPECT_GT(worst, 0.1f) << "unaligned: the mid-morph is far from either pose";
+      EXPECT_LT(extent(all), 0.95f) << "unaligned: the mid-morph shrinks";
+    }
+  }
+}
 
 // What the streaming viewer does with every prefix that arrives: decode_scene never throws on a prefix, and
 // gives either nothing (no geometry pass of model 0 yet) or both models at the pack's level, finite, with

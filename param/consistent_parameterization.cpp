@@ -26,6 +26,7 @@ struct PatchWork {
   std::vector<int> feature_index;  // index of each of `features` in the model's feature list
   ProgressiveMesh pm;
   std::vector<Eigen::Vector2d> uv;  // per local vertex (base vertices valid after the base embedding)
+  std::vector<double> weights;      // per local vertex: sampling weights (empty: uniform)
 };
 
 struct ModelWork {
@@ -105,7 +106,7 @@ void store_base(const BaseMesh& b, PatchWork& w) {
 // every level of the hierarchy; local moves alone leave clusters of vertices squeezed into tiny kernels,
 // e.g. L2 stretch 96 instead of 1.3 on one of fandisk's patches).
 void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine& c2f, const std::vector<char>& locked,
-                    const ParameterizationOptions& options, unsigned seed) {
+                    const ParameterizationOptions& options, unsigned seed, const std::vector<double>* weights) {
   std::vector<std::array<int, 3>> triangles;
   std::vector<char> present(positions.size(), 0);
   for (const auto& t : c2f.current_triangles()) {
@@ -120,6 +121,7 @@ void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine&
   StretchOptimizationOptions level_options = options.base_optimization;
   level_options.max_sweeps = options.level_sweeps;
   level_options.seed = options.seed + seed;
+  level_options.vertex.vertex_weights = weights;
   optimize_stretch(positions, triangles, uv, locked, level_options);
   for (std::size_t v = 0; v < uv.size(); ++v) {
     if (present[v]) c2f.uv()[v] = uv[v];
@@ -272,6 +274,13 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
       for (std::size_t b = 0; b < locked.size(); ++b) locked[b] = on_boundary[base.to_patch[b]];
       StretchOptimizationOptions base_options = options.base_optimization;
       base_options.seed = options.seed + static_cast<unsigned>(p);
+      std::vector<double> base_weights;
+      if (options.curvature_sampling) {
+        pw.weights =
+            curvature_sampling_weights(pw.local.positions, pw.local.triangles, options.sampling_weights);
+        for (int v : base.to_patch) base_weights.push_back(pw.weights[v]);
+        base_options.vertex.vertex_weights = &base_weights;
+      }
       optimize_stretch(base.positions, base.triangles, base.uv, locked, base_options);
       store_base(base, pw);
       o.seconds.base_embedding += seconds_since(t0);
@@ -356,11 +365,13 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
       auto t0 = Clock::now();
       CoarseToFine c2f(pw.local, pw.pm, pw.uv);
       std::mt19937 rng(options.seed * 7919u + static_cast<unsigned>(p));
+      const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
+      VertexOptimizationOptions local_options = options.local_optimization;
+      local_options.vertex_weights = weights;
       const VertexOptimizer optimize = [&](int v, const std::vector<int>& ring) {
         if (locked[v]) return;
         for (int round = 0; round < options.local_rounds; ++round) {
-          optimize_vertex(v, ring, pw.local.positions, c2f.current_triangles(), c2f.uv(),
-                          options.local_optimization, rng);
+          optimize_vertex(v, ring, pw.local.positions, c2f.current_triangles(), c2f.uv(), local_options, rng);
         }
       };
       // Insert vertex by vertex; whenever the level has grown by `level_growth`, optimize it globally.
@@ -376,7 +387,7 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
                  patch_start + patch_share * static_cast<double>(c2f.splits_done()) / double(c2f.num_splits()));
         }
         if (options.level_sweeps > 0 && level_vertices >= next_level * options.level_growth && !c2f.finished()) {
-          optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices));
+          optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices), weights);
           next_level = level_vertices;
         }
       }
@@ -388,6 +399,7 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
         StretchOptimizationOptions final_options = options.base_optimization;
         final_options.max_sweeps = options.final_sweeps;
         final_options.seed = options.seed + 101u * static_cast<unsigned>(p + 1);
+        final_options.vertex.vertex_weights = weights;
         optimize_stretch(pw.local.positions, r.triangles, r.uv, locked, final_options);
       }
       o.seconds.final_optimization += seconds_since(t0);
@@ -421,6 +433,7 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
           t0 = Clock::now();
           StretchOptimizationOptions fallback = options.base_optimization;
           fallback.seed = options.seed + 31u * static_cast<unsigned>(p + 1);
+          fallback.vertex.vertex_weights = weights;
           optimize_stretch(pw.local.positions, pw.local.triangles, mvc.uv, locked, fallback);
           const StretchValues s = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
           if (s.l2 < pp.stretch.l2 && count_flipped(pw.local.triangles, mvc.uv) == 0) {

@@ -10,6 +10,7 @@
 #include "param/mesh.h"
 #include "param/mesh_partition.h"
 #include "param/progressive_mesh.h"
+#include "param/sampling_weights.h"
 #include "param/stretch.h"
 #include "param/stretch_optimization.h"
 
@@ -74,6 +75,11 @@ struct ParameterizationOptions {
   /// Also compute the mean-value embedding of each full patch, the baseline the stretch figures are
   /// reported against (one sparse solve per patch).
   bool measure_mvc_baseline = true;
+  /// Signal-specialized sampling: weight every stretch optimization's L2 term by curvature_sampling_weights()
+  /// of the patch (more parameter area, hence more geometry-image samples, where the surface bends). Off =
+  /// Sander 2001's uniform geometric stretch.
+  bool curvature_sampling = true;
+  SamplingWeightOptions sampling_weights;
   /// Seed of the random search directions (results are deterministic for a given seed).
   unsigned seed = 1;
   ProgressCallback progress;

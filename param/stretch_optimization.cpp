@@ -40,6 +40,7 @@ struct RingTriangle {
   Eigen::Vector2d p1, p2;
   double len0_sq, len1_sq, len2_sq;  ///< 3D squared lengths opposite corners 0 (v), 1, 2
   double area3;
+  double weight = 1;  ///< sampling weight of the triangle in the L2 term (VertexOptimizationOptions)
 };
 
 /// Coefficients of one ring triangle along the line p + t·d:
@@ -47,7 +48,7 @@ struct RingTriangle {
 /// N is the cotangent form Σ_i L_i² (d_ij·d_ik) of 4·A2²·‖J‖_F² (L_i: 3D length opposite corner i, d_ij: uv
 /// edge vectors leaving corner i).
 struct LineTerm {
-  double n0, n1, n2, c0, c1, area3;
+  double n0, n1, n2, c0, c1, area3, weight;
 };
 
 struct Weights {
@@ -69,14 +70,14 @@ double blend_weight(const VertexOptimizationOptions& options) {
 
 Weights ring_weights(const RingTriangle* ring, std::size_t n, double w) {
   double sum_a3 = 0;
-  for (std::size_t i = 0; i < n; ++i) sum_a3 += ring[i].area3;
+  for (std::size_t i = 0; i < n; ++i) sum_a3 += ring[i].area3 * ring[i].weight;
   return {sum_a3 > 0 ? (1 - w) / sum_a3 : 0.0, w};
 }
 
 /// E(v) from per-triangle (Γ²+γ², 2·A2) values; adds one triangle to running sums.
-inline void accumulate(double trace, double twice_a2, double area3, const Weights& w, double& sum,
-                       double& max_sq) {
-  sum += area3 * trace;
+inline void accumulate(double trace, double twice_a2, double area3, double weight, const Weights& w,
+                       double& sum, double& max_sq) {
+  sum += area3 * weight * trace;
   if (w.linf > 0) {
     const double det = 2 * area3 / twice_a2;  // Γγ = A3 / A2
     const double big_sq = 0.5 * (trace + std::sqrt(std::max(0.0, trace * trace - 4 * det * det)));
@@ -93,7 +94,7 @@ double ring_energy(const Eigen::Vector2d& p, const RingTriangle* ring, std::size
     const double c = cross2(u1, u2);
     if (!(c > 0)) return kInf;
     const double num = r.len0_sq * u1.dot(u2) - r.len1_sq * u1.dot(u2 - u1) - r.len2_sq * u2.dot(u1 - u2);
-    accumulate(num / (c * c), c, r.area3, w, sum, max_sq);
+    accumulate(num / (c * c), c, r.area3, r.weight, w, sum, max_sq);
   }
   return 0.5 * w.l2 * sum + w.linf * max_sq;
 }
@@ -105,7 +106,7 @@ double line_energy(double t, const LineTerm* terms, std::size_t n, const Weights
     const LineTerm& l = terms[i];
     const double c = l.c0 + l.c1 * t;
     if (!(c > 0)) return kInf;
-    accumulate((l.n0 + t * (l.n1 + t * l.n2)) / (c * c), c, l.area3, w, sum, max_sq);
+    accumulate((l.n0 + t * (l.n1 + t * l.n2)) / (c * c), c, l.area3, l.weight, w, sum, max_sq);
   }
   return 0.5 * w.l2 * sum + w.linf * max_sq;
 }
@@ -191,6 +192,7 @@ double optimize_point(Eigen::Vector2d& p, const RingTriangle* ring, std::size_t 
       l.n1 = -r.len0_sq * d.dot(u1 + u2) + (r.len1_sq - r.len2_sq) * d.dot(u21);
       l.n2 = r.len0_sq;
       l.area3 = r.area3;
+      l.weight = r.weight;
       if (l.c1 < 0) hi = std::min(hi, -l.c0 / l.c1);
       if (l.c1 > 0) lo = std::max(lo, -l.c0 / l.c1);
       reach = std::max(reach, std::max(u1.squaredNorm(), u2.squaredNorm()));
@@ -219,7 +221,7 @@ double optimize_point(Eigen::Vector2d& p, const RingTriangle* ring, std::size_t 
 void check_vertex_options(const char* function, const VertexOptimizationOptions& o) {
   const bool ok = o.linf_weight >= 0 && o.linf_weight <= 1 && o.num_directions >= 1 &&
                   o.bracket_fraction > 0 && o.bracket_fraction < 1 && o.max_step > 0 && o.tolerance > 0 &&
-                  o.max_evaluations >= 1;
+                  o.max_evaluations >= 1 && (o.vertex_weights == nullptr || !o.vertex_weights->empty());
   if (!ok) throw InvalidInput(std::string(function) + ": invalid VertexOptimizationOptions");
 }
 
@@ -227,8 +229,13 @@ void check_vertex_options(const char* function, const VertexOptimizationOptions&
 std::vector<RingTriangle> build_ring(const char* function, int v, const std::vector<int>& ring,
                                      const std::vector<Eigen::Vector3d>& positions,
                                      const std::vector<std::array<int, 3>>& triangles,
-                                     const std::vector<Eigen::Vector2d>& uv) {
+                                     const std::vector<Eigen::Vector2d>& uv,
+                                     const std::vector<double>* vertex_weights) {
   const std::string name(function);
+  if (vertex_weights && vertex_weights->size() != positions.size()) {
+    throw InvalidInput(name + ": " + std::to_string(vertex_weights->size()) + " vertex weights for " +
+                       std::to_string(positions.size()) + " vertices");
+  }
   if (uv.size() != positions.size()) {
     throw InvalidInput(name + ": " + std::to_string(uv.size()) + " uv coordinates for " +
                        std::to_string(positions.size()) + " vertices");
@@ -255,7 +262,9 @@ std::vector<RingTriangle> build_ring(const char* function, int v, const std::vec
     }
     const int a = t[(corner + 1) % 3], b = t[(corner + 2) % 3];
     const TriangleMetric m = triangle_metric(positions[v], positions[a], positions[b]);
-    out.push_back({uv[a], uv[b], m.opposite_sq[0], m.opposite_sq[1], m.opposite_sq[2], m.area3});
+    const double weight =
+        vertex_weights ? ((*vertex_weights)[v] + (*vertex_weights)[a] + (*vertex_weights)[b]) / 3 : 1.0;
+    out.push_back({uv[a], uv[b], m.opposite_sq[0], m.opposite_sq[1], m.opposite_sq[2], m.area3, weight});
   }
   return out;
 }
@@ -266,7 +275,8 @@ double optimize_vertex(int v, const std::vector<int>& ring, const std::vector<Ei
                        const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
                        const VertexOptimizationOptions& options, std::mt19937& rng) {
   check_vertex_options("optimize_vertex", options);
-  const std::vector<RingTriangle> r = build_ring("optimize_vertex", v, ring, positions, triangles, uv);
+  const std::vector<RingTriangle> r = build_ring("optimize_vertex", v, ring, positions, triangles, uv,
+                                                    options.vertex_weights);
   if (!uv[v].allFinite())
     throw InvalidInput("optimize_vertex: uv of vertex " + std::to_string(v) + " not finite");
   std::vector<LineTerm> terms(r.size());
@@ -280,7 +290,8 @@ double local_stretch(int v, const std::vector<int>& ring, const std::vector<Eige
                      const std::vector<std::array<int, 3>>& triangles, const std::vector<Eigen::Vector2d>& uv,
                      const VertexOptimizationOptions& options) {
   check_vertex_options("local_stretch", options);
-  const std::vector<RingTriangle> r = build_ring("local_stretch", v, ring, positions, triangles, uv);
+  const std::vector<RingTriangle> r = build_ring("local_stretch", v, ring, positions, triangles, uv,
+                                                    options.vertex_weights);
   return std::sqrt(
       ring_energy(uv[v], r.data(), r.size(), ring_weights(r.data(), r.size(), blend_weight(options))));
 }
@@ -330,10 +341,18 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
       for (int i : triangles[f]) incident[fill[i]++] = static_cast<int>(f);
     }
   }
+  const std::vector<double>* vertex_weights = options.vertex.vertex_weights;
+  if (vertex_weights && vertex_weights->size() != nv) {
+    throw InvalidInput("optimize_stretch: " + std::to_string(vertex_weights->size()) + " vertex weights for " +
+                       std::to_string(nv) + " vertices");
+  }
   std::vector<TriangleMetric> metrics(triangles.size());
+  std::vector<double> face_weight(triangles.size(), 1.0);
   for (std::size_t f = 0; f < triangles.size(); ++f) {
     const auto& t = triangles[f];
     metrics[f] = triangle_metric(positions[t[0]], positions[t[1]], positions[t[2]]);
+    if (vertex_weights)
+      face_weight[f] = ((*vertex_weights)[t[0]] + (*vertex_weights)[t[1]] + (*vertex_weights)[t[2]]) / 3;
   }
 
   std::size_t max_ring = 0;
@@ -351,8 +370,10 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
       const auto& t = triangles[f];
       const int corner = t[0] == v ? 0 : t[1] == v ? 1 : 2;
       const TriangleMetric& m = metrics[f];
-      ring[n++] = {uv[t[(corner + 1) % 3]],         uv[t[(corner + 2) % 3]],         m.opposite_sq[corner],
-                   m.opposite_sq[(corner + 1) % 3], m.opposite_sq[(corner + 2) % 3], m.area3};
+      ring[n++] = {uv[t[(corner + 1) % 3]],         uv[t[(corner + 2) % 3]],
+                   m.opposite_sq[corner],           m.opposite_sq[(corner + 1) % 3],
+                   m.opposite_sq[(corner + 2) % 3], m.area3,
+                   face_weight[f]};
     }
     return n;
   };

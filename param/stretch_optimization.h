@@ -57,6 +57,12 @@ struct VertexOptimizationOptions {
   double tolerance = 1e-3;
   /// Function evaluations per line search at most (Brent's method usually needs 8–20).
   int max_evaluations = 40;
+  /// Optional sampling weights, one per vertex (indexed like `positions`; not owned, must outlive the call):
+  /// each triangle's term of the L2 energy is multiplied by the mean of its corners' weights, so the
+  /// optimizer gives weighted triangles more parameter area (a signal-specialized stretch in the spirit of
+  /// Sander et al. 2002; see curvature_sampling_weights()). Null = every weight 1 (Sander 2001). The L∞
+  /// term is not weighted.
+  const std::vector<double>* vertex_weights = nullptr;
 };
 
 /// Moves `uv[v]` to lower the local stretch objective E(v) (see the top of this file) of its incident

@@ -52,6 +52,7 @@ int run_convert(const ConvertArgs& args) {
   options.normals = !args.no_normals;
   options.quantization_bits = args.quantization_bits;
   options.hole_mask_level = args.hole_mask_level;
+  options.sampling_exponent = args.common.sampling_exponent;
   options.progress = bar.callback();
   const ConvertResult converted = convert_models(models, options);
   const std::vector<std::uint8_t>& pack = converted.pack;
@@ -99,6 +100,7 @@ CommandRunner add_convert_command(CLI::App& app) {
       "convert",
       "Mesh(es) → progressive .gip pack: repair when needed, consistent parameterization, geometry images "
       "(and normal maps) at level N, wavelet coding. Holes of a repaired mesh are kept as holes (a mask).");
+  args->common.sampling_exponent = ConvertOptions{}.sampling_exponent;  // streaming: best at low rates
   add_model_options(cmd, args->common);
   cmd->get_option("--output")->description("Output pack file (.gip)");
   cmd->add_option("--level", args->level, "Grid level N in [1, 10] (default 8: 257² samples per patch)");

@@ -45,6 +45,7 @@ int run_gimage(const GimageArgs& args) {
   std::filesystem::create_directories(args.common.output);
 
   ParameterizationOptions options;
+  apply_sampling(args.common, options);
   options.measure_mvc_baseline = false;
   ProgressBar bar("gimage", !args.common.quiet && !args.common.json);
   options.progress = bar.callback();

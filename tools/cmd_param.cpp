@@ -118,6 +118,7 @@ int run_param(const ParamArgs& args) {
   const std::vector<std::string>& paths = models.paths;
 
   ParameterizationOptions options;
+  apply_sampling(args.common, options);
   options.measure_mvc_baseline = !args.no_baseline;
   ProgressBar bar("param", !args.common.quiet && !args.common.json);
   options.progress = bar.callback();

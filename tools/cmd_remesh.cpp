@@ -51,6 +51,7 @@ int run_remesh(const RemeshArgs& args) {
   std::filesystem::create_directories(args.common.output);
 
   ParameterizationOptions options;
+  apply_sampling(args.common, options);
   options.measure_mvc_baseline = false;
   ProgressBar bar("remesh", !args.common.quiet && !args.common.json);
   options.progress = bar.callback();

@@ -24,6 +24,8 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   ConvertResult result;
   ParameterizationOptions param;
   param.measure_mvc_baseline = false;
+  param.curvature_sampling = options.sampling_exponent > 0;
+  param.sampling_weights.exponent = options.sampling_exponent;
   param.progress = [&](const char* stage, double fraction) { progress(stage, 0.8 * fraction); };
   auto t0 = std::chrono::steady_clock::now();
   const std::vector<ModelParameterization> params = parameterize_consistently(models.inputs, param);

@@ -18,6 +18,10 @@ struct ConvertOptions {
   int quantization_bits = 14; ///< position quantization over the largest bounding-box extent
   /// Level of the hole-mask grid (repaired meshes); -1 = the geometry's level.
   int hole_mask_level = -1;
+  /// Curvature sampling exponent of the parameterization (SamplingWeightOptions::exponent; 0 = off, the
+  /// default here: it costs the codec up to 0.26 dB below 16 KB on the bunny while adding 0.5 dB to the full
+  /// pack; the remeshing commands default to 1/3).
+  double sampling_exponent = 0;
   ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode"
 };
 

@@ -120,6 +120,15 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
   cmd->add_option("-o,--output", args.output, "Output directory (created if missing)")->required();
   cmd->add_flag("--json", args.json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar, no report");
+  cmd->add_option("--sampling-exponent", args.sampling_exponent,
+                  "Curvature sampling exponent g: stretch weights ((eps + |II|^2)/eps)^g give bent regions more "
+                  "samples; 0 = plain geometric stretch (default: 1/3 for param, gimage, remesh; 0 for convert)")
+      ->check(CLI::Range(0.0, 2.0));
+}
+
+void apply_sampling(const ModelArgs& args, ParameterizationOptions& options) {
+  options.curvature_sampling = args.sampling_exponent > 0;
+  options.sampling_weights.exponent = args.sampling_exponent;
 }
 
 }  // namespace geomip::tools

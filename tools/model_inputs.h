@@ -27,7 +27,12 @@ struct ModelArgs {
   std::string output;
   bool json = false;
   bool quiet = false;
+  /// Curvature sampling exponent γ (SamplingWeightOptions::exponent); 0 = uniform geometric stretch.
+  double sampling_exponent = SamplingWeightOptions{}.exponent;
 };
+
+/// Sets the parameterization's curvature sampling from `--sampling-exponent`.
+void apply_sampling(const ModelArgs& args, ParameterizationOptions& options);
 
 /// Registers ModelArgs' options on `cmd` (same names and help in every command).
 void add_model_options(CLI::App* cmd, ModelArgs& args);

@@ -1,6 +1,7 @@
 #include "param/sampling_weights.h"
 
 #include "param/errors.h"
+#include "param/stretch_optimization.h"
 
 #include <Eigen/Geometry>
 
@@ -26,7 +27,7 @@ std::vector<double> curvature_sampling_weights(const std::vector<Eigen::Vector3d
   std::vector<Eigen::Vector3d> laplace(nv, Eigen::Vector3d::Zero());
   std::vector<double> area(nv, 0), angle(nv, 0);
   std::vector<int> referenced(nv, 0);
-  // Boundary vertices: an edge used by one triangle. Counted per directed edge.
+  // Unique edges, for the one-rings of the smoothing below.
   std::vector<std::pair<int, int>> edges;
   edges.reserve(3 * triangles.size());
   for (const auto& t : triangles) {
@@ -46,14 +47,8 @@ std::vector<double> curvature_sampling_weights(const std::vector<Eigen::Vector3d
       edges.emplace_back(std::min(i, j), std::max(i, j));
     }
   }
+  const std::vector<char> boundary = boundary_vertex_mask(nv, triangles);
   std::sort(edges.begin(), edges.end());
-  std::vector<char> boundary(nv, 0);
-  for (std::size_t e = 0; e < edges.size();) {
-    std::size_t f = e;
-    while (f < edges.size() && edges[f] == edges[e]) ++f;
-    if (f - e == 1) boundary[edges[e].first] = boundary[edges[e].second] = 1;
-    e = f;
-  }
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
 
   std::vector<double> ii(nv, 0);  // |II|² = 4H² − 2K

@@ -14,7 +14,8 @@ namespace geomip::codec {
 
 /// Calls f(i) for i in [0, n) on up to `max_threads` threads (0 = one per hardware thread), then joins.
 /// When threads cannot be started the caller's thread does the remaining tasks. The first exception a task
-/// throws is rethrown here after every thread has finished (the other tasks still run).
+/// throws is rethrown here after every thread has finished; tasks already running finish, no new one starts.
+/// The project's one fork-join loop (codec's per-patch work, `geomip rd`'s jobs).
 template <typename F>
 void parallel_for(int n, int max_threads, F&& f) {
   int threads = max_threads > 0 ? max_threads : static_cast<int>(std::thread::hardware_concurrency());
@@ -33,6 +34,7 @@ void parallel_for(int n, int max_threads, F&& f) {
       } catch (...) {
         const std::lock_guard<std::mutex> lock(error_mutex);
         if (!error) error = std::current_exception();
+        next = n;  // start no further task
       }
     }
   };

@@ -1,7 +1,8 @@
 #include "gimage/adaptive_remesh.h"
 
 #include "gimage/uniform_remesh.h"
-#include "param/errors.h"
+#include "param/unit_square.h"
+#include "mesh/errors.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -74,34 +75,12 @@ std::optional<Cell> cell_across(const AdaptiveQuadtree& t, const Cell& c, int si
   }
   if (ci >= 0 && cj >= 0 && ci < cells && cj < cells) return Cell{c.patch, ci, cj};
   if (t.adjacency.empty()) return std::nullopt;
-  // Position k of the cell along patch side `side`, in the side's direction (corner side → corner side+1).
-  int k;
-  switch (side) {
-    case 0:
-      k = c.ci;
-      break;
-    case 1:
-      k = c.cj;
-      break;
-    case 2:
-      k = cells - 1 - c.ci;
-      break;
-    default:
-      k = cells - 1 - c.cj;
-      break;
-  }
+  // Position k of the cell along patch side `side`, in the side's direction (corner side → corner side+1):
+  // the cells along a side are indexed like a grid with last = cells − 1 (param/unit_square.h).
+  const int k = side_grid_position(side, c.ci, c.cj, cells - 1);
   const SideLink& link = t.adjacency[4 * c.patch + side];
-  const int k2 = link.reversed ? cells - 1 - k : k;
-  switch (link.other_side) {
-    case 0:
-      return Cell{link.other_patch, k2, 0};
-    case 1:
-      return Cell{link.other_patch, cells - 1, k2};
-    case 2:
-      return Cell{link.other_patch, cells - 1 - k2, cells - 1};
-    default:
-      return Cell{link.other_patch, 0, cells - 1 - k2};
-  }
+  const auto [oi, oj] = side_grid_index(link.other_side, link.reversed ? cells - 1 - k : k, cells - 1);
+  return Cell{link.other_patch, oi, oj};
 }
 
 int depth_at(const AdaptiveQuadtree& t, const Cell& c) {

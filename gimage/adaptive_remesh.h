@@ -14,7 +14,7 @@
 
 #include "gimage/resample.h"
 #include "param/consistent_parameterization.h"
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 #include "param/mesh_partition.h"
 
 #include <cstddef>

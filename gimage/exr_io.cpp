@@ -1,19 +1,21 @@
 #include "gimage/exr_io.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <Imath/half.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputPart.h>
 #include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfMatrixAttribute.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfMultiPartOutputFile.h>
 #include <OpenEXR/ImfPartType.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfTileDescription.h>
+#include <OpenEXR/ImfTiledInputPart.h>
 #include <OpenEXR/ImfTiledOutputPart.h>
-#include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -183,44 +185,90 @@ void write_geometry_image_exr(const std::string& path, const std::vector<Geometr
 }
 
 GeometryImageFile read_geometry_image_exr(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw IoError("read_geometry_image_exr: " + path + ": " + OIIO::geterror());
+  // OpenEXR directly (no OpenImageIO: linking it costs every geomip command ~1 s of start-up). Every size is
+  // checked before anything is allocated: a crafted header cannot make this allocate more than its claim of
+  // at most kMaxTexels texels per level.
+  constexpr long long kMaxSide = (1 << kMaxGeometryImageLevel) + 1;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw IoError("read_geometry_image_exr: " + path + ": " +
+                  (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file"));
+  }
   GeometryImageFile file;
-  for (int s = 0; in->seek_subimage(s, 0); ++s) {
-    if (s == 0) {
-      const OIIO::ImageSpec& spec = in->spec();
-      file.info.kind = spec.get_string_attribute("geomip:kind", file.info.kind);
-      file.info.source_mesh = spec.get_string_attribute("geomip:source_mesh");
-      file.info.level = spec.get_int_attribute("geomip:level", 0);
-      file.info.adjacency = adjacency_from_text(spec.get_string_attribute("geomip:adjacency"));
-      if (const OIIO::ParamValue* m = spec.find_attribute("geomip:normalization")) {
-        if (m->type() == OIIO::TypeDesc(OIIO::TypeDesc::DOUBLE, OIIO::TypeDesc::MATRIX44)) {
-          const double* d = static_cast<const double*>(m->data());
-          std::copy(d, d + 16, file.info.normalization.begin());
-        } else if (m->type() == OIIO::TypeMatrix44) {
-          const float* d = static_cast<const float*>(m->data());
-          std::copy(d, d + 16, file.info.normalization.begin());
+  try {
+    Imf::MultiPartInputFile in(path.c_str());
+    for (int s = 0; s < in.parts(); ++s) {
+      const Imf::Header& h = in.header(s);
+      if (s == 0) {
+        if (const auto* a = h.findTypedAttribute<Imf::StringAttribute>("geomip:kind")) file.info.kind = a->value();
+        if (const auto* a = h.findTypedAttribute<Imf::StringAttribute>("geomip:source_mesh"))
+          file.info.source_mesh = a->value();
+        if (const auto* a = h.findTypedAttribute<Imf::IntAttribute>("geomip:level")) file.info.level = a->value();
+        if (const auto* a = h.findTypedAttribute<Imf::StringAttribute>("geomip:adjacency"))
+          file.info.adjacency = adjacency_from_text(a->value());
+        if (const auto* a = h.findTypedAttribute<Imf::M44dAttribute>("geomip:normalization")) {
+          for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c) file.info.normalization[4 * r + c] = a->value()[r][c];
+        } else if (const auto* f = h.findTypedAttribute<Imf::M44fAttribute>("geomip:normalization")) {
+          for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c) file.info.normalization[4 * r + c] = f->value()[r][c];
         }
       }
-    }
-    file.part_names.push_back(in->spec().get_string_attribute("oiio:subimagename"));
-    std::vector<ExrMipLevel> levels;
-    for (int m = 0; in->seek_subimage(s, m); ++m) {
-      const OIIO::ImageSpec& spec = in->spec();
-      if (spec.nchannels != 3) {
+      file.part_names.push_back(h.hasName() ? h.name() : std::string());
+      int channels = 0;
+      for (auto c = h.channels().begin(); c != h.channels().end(); ++c) ++channels;
+      if (channels != 3 || !h.channels().findChannel("R") || !h.channels().findChannel("G") ||
+          !h.channels().findChannel("B")) {
         throw InvalidInput("read_geometry_image_exr: " + path + ": part " + std::to_string(s) + " has " +
-                           std::to_string(spec.nchannels) + " channels, expected 3");
+                           std::to_string(channels) + " channels, expected R, G, B");
       }
-      ExrMipLevel level;
-      level.width = spec.width;
-      level.height = spec.height;
-      level.rgb.resize(3 * static_cast<std::size_t>(spec.width) * spec.height);
-      if (!in->read_image(s, m, 0, 3, OIIO::TypeDesc::FLOAT, level.rgb.data())) {
-        throw IoError("read_geometry_image_exr: " + path + ": " + in->geterror());
+      auto read_level = [&](const Imath::Box2i& window, auto&& read) {
+        const long long w = 1LL + window.max.x - window.min.x, hgt = 1LL + window.max.y - window.min.y;
+        if (w < 1 || hgt < 1 || w > kMaxSide || hgt > kMaxSide) {
+          throw InvalidInput("read_geometry_image_exr: " + path + ": part " + std::to_string(s) + " is " +
+                             std::to_string(w) + "×" + std::to_string(hgt) + " texels, more than a level-" +
+                             std::to_string(kMaxGeometryImageLevel) + " geometry image");
+        }
+        ExrMipLevel level;
+        level.width = static_cast<int>(w);
+        level.height = static_cast<int>(hgt);
+        level.rgb.resize(3 * static_cast<std::size_t>(w) * hgt);
+        // The frame buffer is addressed in data-window coordinates: shift the base so (min.x, min.y) is texel 0.
+        char* base = reinterpret_cast<char*>(level.rgb.data()) -
+                     (static_cast<std::ptrdiff_t>(window.min.y) * w + window.min.x) * 3 * sizeof(float);
+        const std::size_t texel = 3 * sizeof(float);
+        Imf::FrameBuffer fb;
+        fb.insert("R", Imf::Slice(Imf::FLOAT, base, texel, texel * w));
+        fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), texel, texel * w));
+        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), texel, texel * w));
+        read(fb);
+        return level;
+      };
+      std::vector<ExrMipLevel> levels;
+      if (h.hasTileDescription() && (h.type() == Imf::TILEDIMAGE || !h.hasType())) {
+        Imf::TiledInputPart part(in, s);
+        const int num_levels = part.levelMode() == Imf::RIPMAP_LEVELS ? part.numXLevels() : part.numLevels();
+        for (int l = 0; l < num_levels; ++l) {
+          const Imath::Box2i window = part.dataWindowForLevel(l, l);
+          levels.push_back(read_level(window, [&](Imf::FrameBuffer& fb) {
+            part.setFrameBuffer(fb);
+            part.readTiles(0, part.numXTiles(l) - 1, 0, part.numYTiles(l) - 1, l, l);
+          }));
+        }
+      } else {
+        Imf::InputPart part(in, s);
+        const Imath::Box2i window = h.dataWindow();
+        levels.push_back(read_level(window, [&](Imf::FrameBuffer& fb) {
+          part.setFrameBuffer(fb);
+          part.readPixels(window.min.y, window.max.y);
+        }));
       }
-      levels.push_back(std::move(level));
+      file.parts.push_back(std::move(levels));
     }
-    file.parts.push_back(std::move(levels));
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw IoError("read_geometry_image_exr: " + path + ": " + e.what());
   }
   if (file.parts.empty()) throw IoError("read_geometry_image_exr: " + path + ": no image in the file");
   return file;

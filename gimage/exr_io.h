@@ -7,7 +7,7 @@
 // Channels R, G, B = x, y, z (positions, float32) or the unit normal (half, for normal maps).
 // Header attributes of every part (readable by `exrheader` and `oiiotool --info -v`):
 //   geomip:kind           string  "geometry" or "normals"
-//   geomip:source_mesh    string  the mesh the images were resampled from
+//   geomip:source_mesh    string  the file name (no directory) of the mesh the images were resampled from
 //   geomip:level          int     n, the finest grid level (part size 2^n+1)
 //   geomip:patch          int     this part's patch index (the part is also named "patch<k>")
 //   geomip:patches        int     number of patches
@@ -15,7 +15,8 @@
 //                                 reversed, space-separated: side s of patch p is glued to side t of patch q
 //   geomip:normalization  m44d    the transform applied to the positions before storing (row-major, points
 //                                 as row vectors as in Imath); identity when not normalized
-// The library hides OpenEXR and OpenImageIO: nothing of them appears here.
+// The library hides OpenEXR: nothing of it appears here. (Files are plain OpenEXR 2 multipart: oiiotool,
+// exrheader, Blender and other EXR readers open them.)
 #pragma once
 
 #include "gimage/resample.h"
@@ -61,10 +62,13 @@ struct GeometryImageFile {
   std::vector<std::string> part_names;
 };
 
-/// Reads every part and every MIP level of a file written by write_geometry_image_exr() (through
-/// OpenImageIO). Attributes that are absent keep GeometryImageFileInfo's defaults.
-/// \throw IoError when the file cannot be opened or read, InvalidInput when a part has other than 3 channels
-///   or the adjacency attribute is malformed.
+/// Reads every part and every MIP level of a file written by write_geometry_image_exr() (or any multipart
+/// EXR whose parts have channels R, G, B: tiled parts give every MIP level, scanline parts one level).
+/// Attributes that are absent keep GeometryImageFileInfo's defaults. No level larger than a
+/// level-kMaxGeometryImageLevel image is allocated.
+/// \throw IoError when the file is missing, not a regular file, not an EXR or cannot be read (OpenEXR's
+///   message included); InvalidInput when a part's channels are not R, G, B, a level is larger than that
+///   bound, or the adjacency attribute is malformed.
 GeometryImageFile read_geometry_image_exr(const std::string& path);
 
 /// The finest MIP level of every part of `file` as GeometryImages (what write_geometry_image_exr() wrote).

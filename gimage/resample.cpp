@@ -1,6 +1,8 @@
 #include "gimage/resample.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
+#include "mesh/predicates.h"
+#include "param/unit_square.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,56 +12,6 @@
 
 namespace geomip {
 namespace {
-
-// ---- exact orientation (Shewchuk's adaptive idea: a filtered fast path, an exact expansion fallback) ----
-
-inline void two_sum(double a, double b, double& x, double& y) {
-  x = a + b;
-  const double bv = x - a;
-  const double av = x - bv;
-  y = (a - av) + (b - bv);
-}
-
-// Sign of Σ a_k·b_k, exactly: each product as a two-term expansion (fma), summed by grow-expansion.
-int exact_sign_of_products(const double (&a)[6], const double (&b)[6]) {
-  double e[12];
-  int len = 0;
-  for (int k = 0; k < 6; ++k) {
-    const double p = a[k] * b[k];
-    const double err = std::fma(a[k], b[k], -p);
-    for (double term : {err, p}) {
-      // grow_expansion(e, term): components stay nonoverlapping and increasing in magnitude.
-      double q = term;
-      for (int m = 0; m < len; ++m) {
-        double hi, lo;
-        two_sum(q, e[m], hi, lo);
-        e[m] = lo;
-        q = hi;
-      }
-      e[len++] = q;
-    }
-  }
-  for (int m = len - 1; m >= 0; --m) {
-    if (e[m] > 0) return 1;
-    if (e[m] < 0) return -1;
-  }
-  return 0;
-}
-
-// Sign of the orientation of (a, b, c): +1 counter-clockwise, -1 clockwise, 0 collinear. Exact.
-int orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
-  const double left = (a.x() - c.x()) * (b.y() - c.y());
-  const double right = (a.y() - c.y()) * (b.x() - c.x());
-  const double det = left - right;
-  const double bound =
-      (3.0 + 16.0 * 1.1102230246251565e-16) * 1.1102230246251565e-16 * (std::abs(left) + std::abs(right));
-  if (det > bound) return 1;
-  if (-det > bound) return -1;
-  // ax·by − ax·cy − cx·by − ay·bx + ay·cx + cy·bx
-  const double fa[6] = {a.x(), -a.x(), -c.x(), -a.y(), a.y(), c.y()};
-  const double fb[6] = {b.y(), c.y(), b.y(), b.x(), c.x(), b.x()};
-  return exact_sign_of_products(fa, fb);
-}
 
 // Is `p` inside triangle edge a→b's closed left half-plane, ties broken by the symbolic perturbation
 // p + ε·(sx, sy·η) (ε ≫ η > 0 infinitesimal)? The same perturbation for every triangle at p makes the inside
@@ -71,20 +23,6 @@ inline bool left_of(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Ei
   // cross(b − a, (sx, sy·η)) = (bx−ax)·sy·η − (by−ay)·sx
   if (b.y() != a.y()) return (b.y() > a.y() ? -sx : sx) > 0;
   return (b.x() > a.x() ? sy : -sy) > 0;
-}
-
-// Grid index (i, j) of the k-th sample along side s (k = 0 at corner s), on a grid with 2^level intervals.
-inline std::pair<int, int> side_sample(int s, int k, int intervals) {
-  switch (s) {
-    case 0:
-      return {k, 0};
-    case 1:
-      return {intervals, k};
-    case 2:
-      return {intervals - k, intervals};
-    default:
-      return {0, intervals - k};
-  }
 }
 
 using Attribute = std::vector<Eigen::Vector3d>;  // per mesh vertex
@@ -206,7 +144,7 @@ void walk_side(const PatchParameterization& patch, const std::vector<int>& local
   const double h = std::ldexp(1.0, -image.level);
   std::size_t m = 0;  // current segment [m, m+1]
   for (int k = 0; k <= intervals; ++k) {
-    const auto [i, j] = side_sample(s, k, intervals);
+    const auto [i, j] = side_grid_index(s, k, intervals);
     float* out = image.at(i, j);
     if (k == 0) {
       store(out, attribute[side.front()], renormalize);
@@ -274,8 +212,8 @@ std::vector<GeometryImage> resample_attribute(const ModelParameterization& model
     const GeometryImage& src = images[link.other_patch];
     GeometryImage& dst = images[link.patch];
     for (int k = 0; k <= intervals; ++k) {
-      const auto [si, sj] = side_sample(link.other_side, link.reversed ? intervals - k : k, intervals);
-      const auto [di, dj] = side_sample(link.side, k, intervals);
+      const auto [si, sj] = side_grid_index(link.other_side, link.reversed ? intervals - k : k, intervals);
+      const auto [di, dj] = side_grid_index(link.side, k, intervals);
       std::copy(src.at(si, sj), src.at(si, sj) + 3, dst.at(di, dj));
     }
   }

@@ -16,7 +16,7 @@
 #pragma once
 
 #include "param/consistent_parameterization.h"
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 #include "param/mesh_partition.h"
 
 #include <Eigen/Core>

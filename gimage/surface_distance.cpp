@@ -1,7 +1,7 @@
 // Metro-style surface distance (see surface_distance.h). CGAL's AABB tree lives here only.
 #include "gimage/surface_distance.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>

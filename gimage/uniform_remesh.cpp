@@ -1,6 +1,6 @@
 #include "gimage/uniform_remesh.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <numeric>
 #include <string>

@@ -8,7 +8,7 @@
 #pragma once
 
 #include "gimage/resample.h"
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 #include "param/mesh_partition.h"
 
 #include <vector>

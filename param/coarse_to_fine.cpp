@@ -1,7 +1,9 @@
 #include "param/coarse_to_fine.h"
 
 
-#include "param/errors.h"
+#include "mesh/errors.h"
+#include "mesh/predicates.h"
+#include "param/unit_square.h"
 #include "param/mean_value_embedding.h"
 
 #include <algorithm>
@@ -18,14 +20,8 @@ constexpr double kOnSideTolerance = 1e-12;
   throw InvalidInput(std::string(function) + ": " + what);
 }
 
-double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
-
-/// Twice the signed area of (p, x, y).
-double orient(const Eigen::Vector2d& p, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-  return cross(x - p, y - p);
-}
+/// z of the 2D cross product (a value, for clipping and distances; signs that decide a flip use orient2d).
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 /// The corners of triangle t rotated so that `v` comes first: returns the opposite edge (x, y).
 std::pair<int, int> opposite_edge(const std::array<int, 3>& t, int v) {
@@ -67,8 +63,6 @@ Eigen::Vector2d polygon_centroid(const std::vector<Eigen::Vector2d>& poly) {
   return o + c / (3.0 * area2);
 }
 
-const Eigen::Vector2d kSquareCorner[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-
 }  // namespace
 
 CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm,
@@ -101,7 +95,7 @@ CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm,
       }
       star_[v].push_back(id);
     }
-    if (!(signed_uv_area2(uv_, pm.base_triangles[i]) > 0.0)) {
+    if (orient2d(uv_[pm.base_triangles[i][0]], uv_[pm.base_triangles[i][1]], uv_[pm.base_triangles[i][2]]) <= 0) {
       fail(kFn, "base triangle " + std::to_string(id) + " is flipped or degenerate in base_uv");
     }
   }
@@ -115,7 +109,7 @@ CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm,
     if (side.size() < 2) fail(kFn, "progressive mesh has a side with fewer than 2 vertices");
     const int corner = side.front();
     fixed_[corner] = 1;
-    if (!uv_[corner].allFinite() || (uv_[corner] - kSquareCorner[k]).norm() > kOnSideTolerance) {
+    if (!uv_[corner].allFinite() || (uv_[corner] - unit_square_corners()[k]).norm() > kOnSideTolerance) {
       fail(kFn, "corner " + std::to_string(k) + " is not at its place on the unit square in base_uv");
     }
     double s = 0.0;
@@ -132,7 +126,7 @@ CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm,
   for (int v : pm.base_vertices) {
     const int k = side_of_[v];
     if (k < 0) continue;
-    const Eigen::Vector2d a = kSquareCorner[k], b = kSquareCorner[(k + 1) % 4];
+    const Eigen::Vector2d a = unit_square_corners()[k], b = unit_square_corners()[(k + 1) % 4];
     if (std::abs(cross(b - a, uv_[v] - a)) > kOnSideTolerance) {
       fail(kFn, "base boundary vertex " + std::to_string(v) + " is not on its side in base_uv");
     }
@@ -148,8 +142,7 @@ double CoarseToFine::side_arclength(int side, int v) const {
 
 bool CoarseToFine::move_to_kernel_centroid(int v, const Eigen::Vector2d& anchor) {
   // Kernel of the neighbourhood polygon: the unit square clipped to the left of every edge (x, y) opposite v.
-  std::vector<Eigen::Vector2d> kernel = {kSquareCorner[0], kSquareCorner[1], kSquareCorner[2],
-                                         kSquareCorner[3]};
+  std::vector<Eigen::Vector2d> kernel(unit_square_corners().begin(), unit_square_corners().end());
   std::vector<Eigen::Vector2d> scratch;
   for (int id : star_[v]) {
     const auto [x, y] = opposite_edge(triangles_[id], v);
@@ -159,7 +152,7 @@ bool CoarseToFine::move_to_kernel_centroid(int v, const Eigen::Vector2d& anchor)
   auto all_positive = [&](const Eigen::Vector2d& p) {
     for (int id : star_[v]) {
       const auto [x, y] = opposite_edge(triangles_[id], v);
-      if (!(orient(p, uv_[x], uv_[y]) > 0.0)) return false;
+      if (orient2d(p, uv_[x], uv_[y]) <= 0) return false;
     }
     return true;
   };
@@ -227,12 +220,13 @@ bool CoarseToFine::place_on_side(int v) {
   if (side < 0) throw SolverFailure("CoarseToFine: boundary split of a vertex that is not on a side");
   // v = corner + s·dir, s ∈ [0,1]. Each triangle (v, x, y) stays counter-clockwise for s in an open interval
   // (orient is affine in s); the triangles on v's two boundary edges keep s between its boundary neighbours.
-  const Eigen::Vector2d corner = kSquareCorner[side], dir = kSquareCorner[(side + 1) % 4] - corner;
+  const Eigen::Vector2d corner = unit_square_corners()[side], dir = unit_square_corners()[(side + 1) % 4] - corner;
   const double s_chord = arclength_[v] / side_length_[side];
   double lo = 0.0, hi = 1.0;
   for (int id : star_[v]) {
     const auto [x, y] = opposite_edge(triangles_[id], v);
-    const double f0 = orient(corner, uv_[x], uv_[y]), f1 = orient(corner + dir, uv_[x], uv_[y]);
+    const double f0 = signed_double_area(corner, uv_[x], uv_[y]),
+                 f1 = signed_double_area(corner + dir, uv_[x], uv_[y]);
     const double slope = f1 - f0;
     if (slope > 0) {
       lo = std::max(lo, -f0 / slope);
@@ -246,7 +240,7 @@ bool CoarseToFine::place_on_side(int v) {
   auto try_at = [&](double s) {
     uv_[v] = corner + s * dir;
     for (int id : star_[v]) {
-      if (!(signed_uv_area2(uv_, triangles_[id]) > 0.0)) {
+      if (orient2d(uv_[triangles_[id][0]], uv_[triangles_[id][1]], uv_[triangles_[id][2]]) <= 0) {
         uv_[v] = before;
         return false;
       }
@@ -290,14 +284,14 @@ void CoarseToFine::retry_off_chord(int v) {
 
 void CoarseToFine::check_star(int v, const char* when) const {
   for (int id : star_[v]) {
-    if (!(signed_uv_area2(uv_, triangles_[id]) > 0.0)) {
+    if (orient2d(uv_[triangles_[id][0]], uv_[triangles_[id][1]], uv_[triangles_[id][2]]) <= 0) {
       throw SolverFailure("CoarseToFine: triangle " + std::to_string(id) + " flipped " + when + " (vertex " +
                           std::to_string(v) + ", split " + std::to_string(done_ + 1) + ")");
     }
   }
   const int k = side_of_[v];
   if (k >= 0) {
-    const Eigen::Vector2d a = kSquareCorner[k], b = kSquareCorner[(k + 1) % 4];
+    const Eigen::Vector2d a = unit_square_corners()[k], b = unit_square_corners()[(k + 1) % 4];
     const double along = (uv_[v] - a).dot(b - a);
     if (std::abs(cross(b - a, uv_[v] - a)) > kOnSideTolerance || !(along > 0.0 && along < 1.0)) {
       throw SolverFailure("CoarseToFine: boundary vertex " + std::to_string(v) + " left its side " + when);

@@ -2,7 +2,7 @@
 // (../shared/seed/consistent-mesh-parameterizations.txt, section 3.3.4; Sander et al. 2002 / Hormann et al.).
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 #include "param/progressive_mesh.h"
 
 #include <Eigen/Core>

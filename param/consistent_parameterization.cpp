@@ -1,7 +1,9 @@
 #include "param/consistent_parameterization.h"
 
 #include "param/coarse_to_fine.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
+#include "mesh/predicates.h"
+#include "param/unit_square.h"
 #include "param/feature_warp.h"
 
 #include <algorithm>
@@ -128,24 +130,6 @@ void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine&
   }
 }
 
-// Position along side k of the unit square, from corner k (0) to corner k+1 (1), and back.
-double along_side(const Eigen::Vector2d& uv, int side) {
-  switch (side) {
-    case 0: return uv.x();
-    case 1: return uv.y();
-    case 2: return 1.0 - uv.x();
-    default: return 1.0 - uv.y();
-  }
-}
-Eigen::Vector2d on_side(double s, int side) {
-  switch (side) {
-    case 0: return {s, 0.0};
-    case 1: return {1.0, s};
-    case 2: return {1.0 - s, 1.0};
-    default: return {0.0, 1.0 - s};
-  }
-}
-
 // Seam vertices sit at their chord-length position in both patches, so the two positions agree; where
 // coarse-to-fine could not put one there (a boundary vertex boxed in by long triangles), this moves the
 // vertex in the other patch to the same position if that flips nothing there, and copies the value bit for
@@ -165,8 +149,7 @@ std::size_t reconcile_seams(ModelParameterization& m) {
     for (int t : star[p][v]) {
       const auto& tri = m.patches[p].triangles[t];
       const auto& uv = m.patches[p].uv;
-      const Eigen::Vector2d a = uv[tri[1]] - uv[tri[0]], b = uv[tri[2]] - uv[tri[0]];
-      if (!(a.x() * b.y() - a.y() * b.x() > 0.0)) return false;
+      if (orient2d(uv[tri[0]], uv[tri[1]], uv[tri[2]]) <= 0) return false;
     }
     return true;
   };
@@ -178,17 +161,17 @@ std::size_t reconcile_seams(ModelParameterization& m) {
     const auto& side = a.sides[link.side];
     for (std::size_t j = 1; j + 1 < side.size(); ++j) {
       const int va = local[link.patch][side[j]], vb = local[link.other_patch][side[j]];
-      const double sa = along_side(a.uv[va], link.side);
-      const double sb_as_a = link.reversed ? 1.0 - along_side(b.uv[vb], link.other_side)
-                                           : along_side(b.uv[vb], link.other_side);
+      const double sa = position_on_side(a.uv[va], link.side);
+      const double sb_as_a = link.reversed ? 1.0 - position_on_side(b.uv[vb], link.other_side)
+                                           : position_on_side(b.uv[vb], link.other_side);
       if (sa == sb_as_a) continue;
       // Move b's copy to a's position; failing that, a's copy to b's.
       const Eigen::Vector2d old_b = b.uv[vb];
-      b.uv[vb] = on_side(link.reversed ? 1.0 - sa : sa, link.other_side);
+      b.uv[vb] = point_on_side(link.other_side, link.reversed ? 1.0 - sa : sa);
       if (star_valid(link.other_patch, vb)) continue;
       b.uv[vb] = old_b;
       const Eigen::Vector2d old_a = a.uv[va];
-      a.uv[va] = on_side(sb_as_a, link.side);
+      a.uv[va] = point_on_side(link.side, sb_as_a);
       if (star_valid(link.patch, va)) continue;
       a.uv[va] = old_a;
       ++mismatches;
@@ -197,11 +180,14 @@ std::size_t reconcile_seams(ModelParameterization& m) {
   return mismatches;
 }
 
-}  // namespace
+// Progress of the whole run: 3 steps per model (one for phase A, two for phase C) plus phase B.
+struct Progress {
+  const ParameterizationOptions& options;
+  double total_steps;
+  void operator()(const char* stage, double f) const { report(options, stage, f / total_steps); }
+};
 
-std::vector<ModelParameterization> parameterize_consistently(const std::vector<ParameterizationInput>& models,
-                                                             const ParameterizationOptions& options) {
-  if (models.empty()) throw InvalidInput("parameterize_consistently: no model");
+void check_feature_counts(const std::vector<ParameterizationInput>& models) {
   const std::size_t num_features = models[0].features.size();
   for (const auto& m : models) {
     if (m.features.size() != num_features) {
@@ -210,249 +196,292 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
                          " (features correspond by order: the counts must agree)");
     }
   }
+}
 
-  std::vector<ModelWork> work(models.size());
-  std::vector<ModelParameterization> out(models.size());
-  const double total_steps = 3.0 * models.size();
-
-  // Phase A, per model: partition, patches, progressive meshes, base embeddings.
-  for (std::size_t i = 0; i < models.size(); ++i) {
-    const auto& in = models[i];
-    auto& w = work[i];
-    auto& o = out[i];
-    report(options, "partition", i / total_steps);
-    auto t0 = Clock::now();
-    w.partition = partition_mesh(in.mesh, in.partition_points, in.auxiliary_points);
-    o.seconds.partition = seconds_since(t0);
-    if (i > 0 && w.partition.patches.size() != work[0].partition.patches.size()) {
-      throw InvalidInput("parameterize_consistently: model '" + in.name + "' has " +
-                         std::to_string(w.partition.patches.size()) + " patches, model '" + models[0].name +
-                         "' has " + std::to_string(work[0].partition.patches.size()) + " (different genus)");
+// vertex_feature[v] = k when vertex v of the (partitioned) mesh is feature k, else −1.
+std::vector<int> feature_of_vertex(const ParameterizationInput& in, std::size_t num_vertices) {
+  std::vector<int> vertex_feature(num_vertices, -1);
+  for (std::size_t k = 0; k < in.features.size(); ++k) {
+    const int v = in.features[k];
+    if (v < 0 || static_cast<std::size_t>(v) >= in.mesh.positions.size()) {
+      throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " of model '" + in.name +
+                         "' is vertex " + std::to_string(v) + ", out of range");
     }
+    if (vertex_feature[v] >= 0) {
+      throw InvalidInput("parameterize_consistently: features " + std::to_string(vertex_feature[v]) + " and " +
+                         std::to_string(k) + " of model '" + in.name + "' are the same vertex");
+    }
+    vertex_feature[v] = static_cast<int>(k);
+  }
+  return vertex_feature;
+}
 
-    // Features: interior vertices of a patch, in the same patch in every model.
-    std::vector<int> vertex_feature(w.partition.mesh.positions.size(), -1);
+// Phase A for one patch: its features, progressive mesh, MVC base embedding and the base's stretch
+// optimization. Sets w.feature_patch for the patch's features.
+PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size_t p,
+                        const std::vector<int>& vertex_feature, const ParameterizationOptions& options,
+                        ModelParameterization& o) {
+  PatchWork pw = extract_patch(w.partition, w.partition.patches[p]);
+  const std::vector<char> on_boundary = boundary_mask(pw);
+  for (std::size_t v = 0; v < pw.to_mesh.size(); ++v) {
+    const int k = vertex_feature[pw.to_mesh[v]];
+    if (k < 0) continue;
+    if (on_boundary[v]) {
+      throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " of model '" + in.name +
+                         "' (vertex " + std::to_string(in.features[k]) +
+                         ") lies on the partition cut; features must be inside a patch");
+    }
+    w.feature_patch[k] = static_cast<int>(p);
+    pw.features.push_back(static_cast<int>(v));
+    pw.feature_index.push_back(k);
+  }
+  auto t0 = Clock::now();
+  pw.pm = progressive_mesh(pw.local, pw.sides, pw.features, options.progressive_mesh);
+  o.seconds.progressive_mesh += seconds_since(t0);
+
+  t0 = Clock::now();
+  const std::vector<FixedUv> boundary = square_boundary_uv(pw.local.positions, pw.pm.sides);
+  pw.uv = mean_value_embedding(pw.local.positions, pw.pm.base_triangles, boundary).uv;
+  BaseMesh base = base_mesh(pw);
+  std::vector<char> locked(base.to_patch.size(), 0);
+  for (std::size_t b = 0; b < locked.size(); ++b) locked[b] = on_boundary[base.to_patch[b]];
+  StretchOptimizationOptions base_options = options.base_optimization;
+  base_options.seed = options.seed + static_cast<unsigned>(p);
+  std::vector<double> base_weights;
+  if (options.curvature_sampling) {
+    pw.weights = curvature_sampling_weights(pw.local.positions, pw.local.triangles, options.sampling_weights);
+    for (int v : base.to_patch) base_weights.push_back(pw.weights[v]);
+    base_options.vertex.vertex_weights = &base_weights;
+  }
+  optimize_stretch(base.positions, base.triangles, base.uv, locked, base_options);
+  store_base(base, pw);
+  o.seconds.base_embedding += seconds_since(t0);
+  return pw;
+}
+
+// Phase A for model i: partition, patches, progressive meshes, base embeddings. `first` is model 0's work
+// (null for model 0 itself): patch counts and feature patches must agree with it.
+ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::size_t i, const ModelWork* first,
+                        const ParameterizationOptions& options, const Progress& progress,
+                        ModelParameterization& o) {
+  const ParameterizationInput& in = models[i];
+  ModelWork w;
+  progress("partition", static_cast<double>(i));
+  const auto t0 = Clock::now();
+  w.partition = partition_mesh(in.mesh, in.partition_points, in.auxiliary_points);
+  o.seconds.partition = seconds_since(t0);
+  if (first && w.partition.patches.size() != first->partition.patches.size()) {
+    throw InvalidInput("parameterize_consistently: model '" + in.name + "' has " +
+                       std::to_string(w.partition.patches.size()) + " patches, model '" + models[0].name +
+                       "' has " + std::to_string(first->partition.patches.size()) + " (different genus)");
+  }
+  // Features: interior vertices of a patch, in the same patch in every model.
+  const std::vector<int> vertex_feature = feature_of_vertex(in, w.partition.mesh.positions.size());
+  w.feature_patch.assign(in.features.size(), -1);
+  const std::size_t num_patches = w.partition.patches.size();
+  for (std::size_t p = 0; p < num_patches; ++p) {
+    progress("progressive mesh", static_cast<double>(i) + (p + 0.5) / static_cast<double>(num_patches));
+    w.patches.push_back(prepare_patch(in, w, p, vertex_feature, options, o));
+  }
+  if (first) {
     for (std::size_t k = 0; k < in.features.size(); ++k) {
-      const int v = in.features[k];
-      if (v < 0 || static_cast<std::size_t>(v) >= in.mesh.positions.size()) {
-        throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " of model '" + in.name +
-                           "' is vertex " + std::to_string(v) + ", out of range");
-      }
-      if (vertex_feature[v] >= 0) {
-        throw InvalidInput("parameterize_consistently: features " + std::to_string(vertex_feature[v]) + " and " +
-                           std::to_string(k) + " of model '" + in.name + "' are the same vertex");
-      }
-      vertex_feature[v] = static_cast<int>(k);
-    }
-    w.feature_patch.assign(in.features.size(), -1);
-
-    for (std::size_t p = 0; p < w.partition.patches.size(); ++p) {
-      PatchWork pw = extract_patch(w.partition, w.partition.patches[p]);
-      const std::vector<char> on_boundary = boundary_mask(pw);
-      for (std::size_t v = 0; v < pw.to_mesh.size(); ++v) {
-        const int k = vertex_feature[pw.to_mesh[v]];
-        if (k < 0) continue;
-        if (on_boundary[v]) {
-          throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " of model '" + in.name +
-                             "' (vertex " + std::to_string(in.features[k]) +
-                             ") lies on the partition cut; features must be inside a patch");
-        }
-        w.feature_patch[k] = static_cast<int>(p);
-        pw.features.push_back(static_cast<int>(v));
-        pw.feature_index.push_back(k);
-      }
-      report(options, "progressive mesh", (i + (p + 0.5) / double(w.partition.patches.size())) / total_steps);
-      t0 = Clock::now();
-      pw.pm = progressive_mesh(pw.local, pw.sides, pw.features, options.progressive_mesh);
-      o.seconds.progressive_mesh += seconds_since(t0);
-
-      t0 = Clock::now();
-      const std::vector<FixedUv> boundary = square_boundary_uv(pw.local.positions, pw.pm.sides);
-      pw.uv = mean_value_embedding(pw.local.positions, pw.pm.base_triangles, boundary).uv;
-      BaseMesh base = base_mesh(pw);
-      std::vector<char> locked(base.to_patch.size(), 0);
-      for (std::size_t b = 0; b < locked.size(); ++b) locked[b] = on_boundary[base.to_patch[b]];
-      StretchOptimizationOptions base_options = options.base_optimization;
-      base_options.seed = options.seed + static_cast<unsigned>(p);
-      std::vector<double> base_weights;
-      if (options.curvature_sampling) {
-        pw.weights =
-            curvature_sampling_weights(pw.local.positions, pw.local.triangles, options.sampling_weights);
-        for (int v : base.to_patch) base_weights.push_back(pw.weights[v]);
-        base_options.vertex.vertex_weights = &base_weights;
-      }
-      optimize_stretch(base.positions, base.triangles, base.uv, locked, base_options);
-      store_base(base, pw);
-      o.seconds.base_embedding += seconds_since(t0);
-      w.patches.push_back(std::move(pw));
-    }
-    if (i > 0) {
-      for (std::size_t k = 0; k < num_features; ++k) {
-        if (w.feature_patch[k] != work[0].feature_patch[k]) {
-          throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " is in patch " +
-                             std::to_string(w.feature_patch[k]) + " of model '" + in.name + "' but in patch " +
-                             std::to_string(work[0].feature_patch[k]) + " of model '" + models[0].name +
-                             "': corresponding features must lie on corresponding sides of the partition loop");
-        }
+      if (w.feature_patch[k] != first->feature_patch[k]) {
+        throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " is in patch " +
+                           std::to_string(w.feature_patch[k]) + " of model '" + in.name + "' but in patch " +
+                           std::to_string(first->feature_patch[k]) + " of model '" + models[0].name +
+                           "': corresponding features must lie on corresponding sides of the partition loop");
       }
     }
   }
+  return w;
+}
+
+// Phase B for patch p: moves corresponding features of every model to their average (u,v) (§3.4) by warping
+// the base meshes.
+void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
+                          const std::vector<ParameterizationInput>& models,
+                          std::vector<ModelParameterization>& out) {
+  // Features of a patch are in the same order in every model (ascending local id in model 0 would not be):
+  // order each model's list by feature index.
+  std::vector<std::vector<Eigen::Vector2d>> ordered(work.size());
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    const auto& pw = work[i].patches[p];
+    std::vector<std::pair<int, Eigen::Vector2d>> by_index;
+    for (std::size_t j = 0; j < pw.features.size(); ++j) by_index.emplace_back(pw.feature_index[j], pw.uv[pw.features[j]]);
+    std::sort(by_index.begin(), by_index.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& e : by_index) ordered[i].push_back(e.second);
+  }
+  const std::vector<Eigen::Vector2d> targets = average_feature_targets(ordered);
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    auto& pw = work[i].patches[p];
+    const auto t0 = Clock::now();
+    BaseMesh base = base_mesh(pw);
+    std::vector<std::pair<int, int>> index_and_base;
+    for (std::size_t j = 0; j < pw.features.size(); ++j) {
+      index_and_base.emplace_back(pw.feature_index[j], base.to_base[pw.features[j]]);
+    }
+    std::sort(index_and_base.begin(), index_and_base.end());
+    std::vector<int> features;
+    for (const auto& e : index_and_base) features.push_back(e.second);
+    const FeatureWarpResult r = warp_features(base.triangles, base.uv, features, targets);
+    if (!r.unreached.empty()) {
+      throw SolverFailure("parameterize_consistently: the feature warp could not move " +
+                          std::to_string(r.unreached.size()) + " feature(s) of model '" + models[i].name +
+                          "' to their common position without folding");
+    }
+    // Exact targets: the warp reaches them to rounding; store the common value itself.
+    for (std::size_t j = 0; j < features.size(); ++j) base.uv[features[j]] = targets[j];
+    store_base(base, pw);
+    out[i].warp_events += r.events;
+    out[i].seconds.feature_warp += seconds_since(t0);
+  }
+}
+
+// Phase C, coarse to fine: inserts the patch's vertices one by one with local stretch optimization, and
+// optimizes each level globally whenever it has grown by `level_growth`. Progress runs over [start,
+// start + share).
+CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<char>& locked,
+                                const ParameterizationOptions& options, const Progress& progress, double start,
+                                double share) {
+  CoarseToFine c2f(pw.local, pw.pm, pw.uv);
+  std::mt19937 rng(options.seed * 7919u + static_cast<unsigned>(p));
+  const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
+  VertexOptimizationOptions local_options = options.local_optimization;
+  local_options.vertex_weights = weights;
+  const VertexOptimizer optimize = [&](int v, const std::vector<int>& ring) {
+    if (locked[v]) return;
+    for (int round = 0; round < options.local_rounds; ++round) {
+      optimize_vertex(v, ring, pw.local.positions, c2f.current_triangles(), c2f.uv(), local_options, rng);
+    }
+  };
+  std::size_t next_level = pw.pm.base_vertices.size();
+  std::size_t level_vertices = next_level;
+  while (!c2f.finished()) {
+    c2f.split_next(optimize);
+    ++level_vertices;
+    if ((c2f.splits_done() & 1023u) == 0) {
+      progress("coarse-to-fine", start + share * static_cast<double>(c2f.splits_done()) / double(c2f.num_splits()));
+    }
+    if (options.level_sweeps > 0 && level_vertices >= next_level * options.level_growth && !c2f.finished()) {
+      optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices), weights);
+      next_level = level_vertices;
+    }
+  }
+  return c2f.result();
+}
+
+// Phase C for patch p of model `name`: coarse-to-fine, final sweeps, the MVC baseline and fallback; returns
+// the patch's parameterization in mesh ids. \throw SolverFailure when a triangle ends flipped.
+PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std::string& name,
+                                         const ParameterizationOptions& options, const Progress& progress,
+                                         double start, double share, ModelParameterization& o) {
+  std::vector<char> locked = boundary_mask(pw);
+  for (int v : pw.features) locked[v] = 1;
+  const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
+
+  auto t0 = Clock::now();
+  CoarseToFineResult r = refine_patch(pw, p, locked, options, progress, start, share);
+  o.seconds.coarse_to_fine += seconds_since(t0);
+
+  t0 = Clock::now();
+  if (options.final_sweeps > 0) {
+    StretchOptimizationOptions final_options = options.base_optimization;
+    final_options.max_sweeps = options.final_sweeps;
+    final_options.seed = options.seed + 101u * static_cast<unsigned>(p + 1);
+    final_options.vertex.vertex_weights = weights;
+    optimize_stretch(pw.local.positions, r.triangles, r.uv, locked, final_options);
+  }
+  o.seconds.final_optimization += seconds_since(t0);
+
+  PatchParameterization pp;
+  pp.vertices = pw.to_mesh;
+  pp.triangles = r.triangles;
+  pp.uv = r.uv;
+  for (int k = 0; k < 4; ++k) {
+    pp.corners[k] = pw.to_mesh[pw.corners[k]];
+    for (int v : pw.pm.sides[k]) pp.sides[k].push_back(pw.to_mesh[v]);
+  }
+  pp.base_vertices = pw.pm.base_vertices.size();
+  pp.stretch = mesh_stretch(pw.local.positions, pp.triangles, pp.uv);
+  pp.flipped = count_flipped(pp.triangles, pp.uv);
+  pp.boundary_off_chord = r.boundary_off_chord;
+  if (pp.flipped != 0) {
+    throw SolverFailure("parameterize_consistently: patch " + std::to_string(p) + " of model '" + name +
+                        "' has " + std::to_string(pp.flipped) + " flipped triangles");
+  }
+  // The full patch's MVC embedding: the baseline the figures are reported against, and a fallback for a
+  // patch without features where coarse-to-fine ends worse than MVC (it happens on CAD-like patches whose
+  // long thin triangles leave vertices squeezed into tiny kernels).
+  if (options.measure_mvc_baseline || pw.features.empty()) {
+    t0 = Clock::now();
+    auto mvc = mean_value_embedding(pw.local.positions, pw.local.triangles,
+                                    square_boundary_uv(pw.local.positions, pw.pm.sides));
+    pp.mvc_stretch = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
+    o.seconds.mvc_baseline += seconds_since(t0);
+    if (pw.features.empty() && pp.mvc_stretch.l2 < pp.stretch.l2) {
+      t0 = Clock::now();
+      StretchOptimizationOptions fallback = options.base_optimization;
+      fallback.seed = options.seed + 31u * static_cast<unsigned>(p + 1);
+      fallback.vertex.vertex_weights = weights;
+      optimize_stretch(pw.local.positions, pw.local.triangles, mvc.uv, locked, fallback);
+      const StretchValues s = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
+      if (s.l2 < pp.stretch.l2 && count_flipped(pw.local.triangles, mvc.uv) == 0) {
+        pp.triangles = pw.local.triangles;
+        pp.uv = std::move(mvc.uv);
+        pp.stretch = s;
+        pp.boundary_off_chord = 0;
+        pp.mvc_fallback = true;
+      }
+      o.seconds.final_optimization += seconds_since(t0);
+    }
+  }
+  for (std::size_t j = 0; j < pw.features.size(); ++j) {
+    FeatureLocation& f = o.features[pw.feature_index[j]];
+    f.vertex = pw.to_mesh[pw.features[j]];
+    f.patch = static_cast<int>(p);
+    f.uv = pp.uv[pw.features[j]];
+  }
+  return pp;
+}
+
+}  // namespace
+
+std::vector<ModelParameterization> parameterize_consistently(const std::vector<ParameterizationInput>& models,
+                                                             const ParameterizationOptions& options) {
+  if (models.empty()) throw InvalidInput("parameterize_consistently: no model");
+  check_feature_counts(models);
+  const std::size_t num_features = models[0].features.size();
+  const double n = static_cast<double>(models.size());
+  const Progress progress{options, 3.0 * n};
+  std::vector<ModelWork> work;
+  std::vector<ModelParameterization> out(models.size());
+
+  // Phase A, per model: partition, patches, progressive meshes, base embeddings.
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    work.push_back(prepare_model(models, i, i > 0 ? &work[0] : nullptr, options, progress, out[i]));
+  }
 
   // Phase B, per patch: align corresponding features at their average (u,v) (§3.4).
-  report(options, "feature alignment", models.size() / total_steps);
+  progress("feature alignment", n);
   if (num_features > 0) {
-    const std::size_t num_patches = work[0].patches.size();
-    for (std::size_t p = 0; p < num_patches; ++p) {
-      if (work[0].patches[p].features.empty()) continue;
-      std::vector<std::vector<Eigen::Vector2d>> per_model;
-      for (const auto& w : work) {
-        std::vector<Eigen::Vector2d> f;
-        for (int v : w.patches[p].features) f.push_back(w.patches[p].uv[v]);
-        per_model.push_back(std::move(f));
-      }
-      // Features of a patch are in the same order in every model (ascending local id in model 0 would not
-      // be): reorder each model's list by feature index.
-      std::vector<std::vector<Eigen::Vector2d>> ordered(work.size());
-      for (std::size_t i = 0; i < work.size(); ++i) {
-        const auto& pw = work[i].patches[p];
-        std::vector<std::pair<int, Eigen::Vector2d>> by_index;
-        for (std::size_t j = 0; j < pw.features.size(); ++j) by_index.emplace_back(pw.feature_index[j], per_model[i][j]);
-        std::sort(by_index.begin(), by_index.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-        for (const auto& e : by_index) ordered[i].push_back(e.second);
-      }
-      const std::vector<Eigen::Vector2d> targets = average_feature_targets(ordered);
-      for (std::size_t i = 0; i < work.size(); ++i) {
-        auto& pw = work[i].patches[p];
-        const auto t0 = Clock::now();
-        BaseMesh base = base_mesh(pw);
-        std::vector<std::pair<int, int>> index_and_base;
-        for (std::size_t j = 0; j < pw.features.size(); ++j) {
-          index_and_base.emplace_back(pw.feature_index[j], base.to_base[pw.features[j]]);
-        }
-        std::sort(index_and_base.begin(), index_and_base.end());
-        std::vector<int> features;
-        for (const auto& e : index_and_base) features.push_back(e.second);
-        const FeatureWarpResult r = warp_features(base.triangles, base.uv, features, targets);
-        if (!r.unreached.empty()) {
-          throw SolverFailure("parameterize_consistently: the feature warp could not move " +
-                              std::to_string(r.unreached.size()) + " feature(s) of model '" + models[i].name +
-                              "' to their common position without folding");
-        }
-        // Exact targets: the warp reaches them to rounding; store the common value itself.
-        for (std::size_t j = 0; j < features.size(); ++j) base.uv[features[j]] = targets[j];
-        store_base(base, pw);
-        out[i].warp_events += r.events;
-        out[i].seconds.feature_warp += seconds_since(t0);
-      }
+    for (std::size_t p = 0; p < work[0].patches.size(); ++p) {
+      if (!work[0].patches[p].features.empty()) align_patch_features(work, p, models, out);
     }
   }
 
   // Phase C, per model and patch: coarse-to-fine with local stretch optimization, final sweeps.
   for (std::size_t i = 0; i < models.size(); ++i) {
-    auto& w = work[i];
-    auto& o = out[i];
-    report(options, "coarse-to-fine", (models.size() + 2.0 * i) / total_steps);
+    ModelWork& w = work[i];
+    ModelParameterization& o = out[i];
+    progress("coarse-to-fine", n + 2.0 * static_cast<double>(i));
     o.mesh = w.partition.mesh;
     o.adjacency = w.partition.adjacency;
     o.split_vertices = w.partition.split_vertices;
     o.features.assign(num_features, FeatureLocation{});
+    const double share = 2.0 / static_cast<double>(w.patches.size());
     for (std::size_t p = 0; p < w.patches.size(); ++p) {
-      PatchWork& pw = w.patches[p];
-      const std::vector<char> on_boundary = boundary_mask(pw);
-      std::vector<char> locked = on_boundary;
-      for (int v : pw.features) locked[v] = 1;
-
-      auto t0 = Clock::now();
-      CoarseToFine c2f(pw.local, pw.pm, pw.uv);
-      std::mt19937 rng(options.seed * 7919u + static_cast<unsigned>(p));
-      const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
-      VertexOptimizationOptions local_options = options.local_optimization;
-      local_options.vertex_weights = weights;
-      const VertexOptimizer optimize = [&](int v, const std::vector<int>& ring) {
-        if (locked[v]) return;
-        for (int round = 0; round < options.local_rounds; ++round) {
-          optimize_vertex(v, ring, pw.local.positions, c2f.current_triangles(), c2f.uv(), local_options, rng);
-        }
-      };
-      // Insert vertex by vertex; whenever the level has grown by `level_growth`, optimize it globally.
-      std::size_t next_level = pw.pm.base_vertices.size();
-      std::size_t level_vertices = next_level;
-      const double patch_share = 2.0 / (total_steps * static_cast<double>(w.patches.size()));
-      const double patch_start = (models.size() + 2.0 * i) / total_steps + patch_share * static_cast<double>(p);
-      while (!c2f.finished()) {
-        c2f.split_next(optimize);
-        ++level_vertices;
-        if ((c2f.splits_done() & 1023u) == 0) {
-          report(options, "coarse-to-fine",
-                 patch_start + patch_share * static_cast<double>(c2f.splits_done()) / double(c2f.num_splits()));
-        }
-        if (options.level_sweeps > 0 && level_vertices >= next_level * options.level_growth && !c2f.finished()) {
-          optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices), weights);
-          next_level = level_vertices;
-        }
-      }
-      CoarseToFineResult r = c2f.result();
-      o.seconds.coarse_to_fine += seconds_since(t0);
-
-      t0 = Clock::now();
-      if (options.final_sweeps > 0) {
-        StretchOptimizationOptions final_options = options.base_optimization;
-        final_options.max_sweeps = options.final_sweeps;
-        final_options.seed = options.seed + 101u * static_cast<unsigned>(p + 1);
-        final_options.vertex.vertex_weights = weights;
-        optimize_stretch(pw.local.positions, r.triangles, r.uv, locked, final_options);
-      }
-      o.seconds.final_optimization += seconds_since(t0);
-
-      PatchParameterization pp;
-      pp.vertices = pw.to_mesh;
-      pp.triangles = r.triangles;
-      pp.uv = r.uv;
-      for (int k = 0; k < 4; ++k) {
-        pp.corners[k] = pw.to_mesh[pw.corners[k]];
-        for (int v : pw.pm.sides[k]) pp.sides[k].push_back(pw.to_mesh[v]);
-      }
-      pp.base_vertices = pw.pm.base_vertices.size();
-      pp.stretch = mesh_stretch(pw.local.positions, pp.triangles, pp.uv);
-      pp.flipped = count_flipped(pp.triangles, pp.uv);
-      pp.boundary_off_chord = r.boundary_off_chord;
-      if (pp.flipped != 0) {
-        throw SolverFailure("parameterize_consistently: patch " + std::to_string(p) + " of model '" +
-                            models[i].name + "' has " + std::to_string(pp.flipped) + " flipped triangles");
-      }
-      // The full patch's MVC embedding: the baseline the figures are reported against, and a fallback for a
-      // patch without features where coarse-to-fine ends worse than MVC (it happens on CAD-like patches whose
-      // long thin triangles leave vertices squeezed into tiny kernels).
-      if (options.measure_mvc_baseline || pw.features.empty()) {
-        t0 = Clock::now();
-        auto mvc = mean_value_embedding(pw.local.positions, pw.local.triangles,
-                                        square_boundary_uv(pw.local.positions, pw.pm.sides));
-        pp.mvc_stretch = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
-        o.seconds.mvc_baseline += seconds_since(t0);
-        if (pw.features.empty() && pp.mvc_stretch.l2 < pp.stretch.l2) {
-          t0 = Clock::now();
-          StretchOptimizationOptions fallback = options.base_optimization;
-          fallback.seed = options.seed + 31u * static_cast<unsigned>(p + 1);
-          fallback.vertex.vertex_weights = weights;
-          optimize_stretch(pw.local.positions, pw.local.triangles, mvc.uv, locked, fallback);
-          const StretchValues s = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
-          if (s.l2 < pp.stretch.l2 && count_flipped(pw.local.triangles, mvc.uv) == 0) {
-            pp.triangles = pw.local.triangles;
-            pp.uv = std::move(mvc.uv);
-            pp.stretch = s;
-            pp.boundary_off_chord = 0;
-            pp.mvc_fallback = true;
-          }
-          o.seconds.final_optimization += seconds_since(t0);
-        }
-      }
-      for (std::size_t j = 0; j < pw.features.size(); ++j) {
-        FeatureLocation& f = o.features[pw.feature_index[j]];
-        f.vertex = pw.to_mesh[pw.features[j]];
-        f.patch = static_cast<int>(p);
-        f.uv = pp.uv[pw.features[j]];
-      }
-      o.patches.push_back(std::move(pp));
+      const double start = n + 2.0 * static_cast<double>(i) + share * static_cast<double>(p);
+      o.patches.push_back(parameterize_patch(w.patches[p], p, models[i].name, options, progress, start, share, o));
     }
     o.seam_mismatches = reconcile_seams(o);
   }

@@ -7,7 +7,7 @@
 #pragma once
 
 #include "param/mean_value_embedding.h"
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 #include "param/mesh_partition.h"
 #include "param/progressive_mesh.h"
 #include "param/sampling_weights.h"
@@ -33,10 +33,9 @@ struct ParameterizationInput {
 
 /// Defaults of ParameterizationOptions::base_optimization: threshold 10⁻⁴ and up to 200 sweeps (instead of
 /// StretchOptimizationOptions' 10⁻³ / 50). The base mesh (~100 vertices) is cheap to converge, and its layout
-/// decides how much of the square the protrusions (bunny ears) get. Together with
-/// default_local_optimization(): bunny M5..M8 +0.57 / +0.27 / +0.14 / +0.25 dB (symmetric, against the
-/// repaired bunny; README, "Tuning the parameterization"). The threshold also stops the level and final
-/// sweeps, whose counts are level_sweeps / final_sweeps.
+/// decides how much of the square the protrusions (bunny ears) get; chosen with
+/// default_local_optimization() by measured remesh PSNR (README, "Tuning the parameterization"). The threshold
+/// also stops the level and final sweeps, whose counts are level_sweeps / final_sweeps.
 inline StretchOptimizationOptions default_base_optimization() {
   StretchOptimizationOptions o;
   o.threshold = 1e-4;
@@ -46,8 +45,8 @@ inline StretchOptimizationOptions default_base_optimization() {
 
 /// Defaults of ParameterizationOptions::local_optimization: the blended energy, half L2 and half L∞
 /// (w = 0.5), instead of plain L2. Penalizing each ring's largest stretch spreads samples onto the
-/// undersampled ears. It pays only together with default_base_optimization() (alone it loses 0.2 dB at
-/// M6); the pair gains on the bunny, horse (+0.5..+1.2 dB at M5..M8) and venus (+0.05..+0.24 dB).
+/// undersampled ears. It pays only together with default_base_optimization() (README, "Tuning the
+/// parameterization", has the figures).
 inline VertexOptimizationOptions default_local_optimization() {
   VertexOptimizationOptions o;
   o.norm = StretchNorm::kBlend;

@@ -3,8 +3,9 @@
 // and CGAL's exact orientation predicate decides every sign; the kinetic part (moves, edge flips, barycentric
 // re-binding, base-mesh repair) works on a small triangle list of its own.
 #include "param/feature_warp.h"
+#include "param/unit_square.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 // CGAL's headers shadow names freely; silence that for them only.
 #pragma GCC diagnostic push
@@ -32,7 +33,7 @@ using Tri = std::array<int, 3>;
 
 constexpr int kCorners = 4;
 constexpr std::size_t kStallSteps = 500;  // a feature that gains < 0.1% of its remaining way in this many steps is stuck
-const Vec2 kCornerUv[kCorners] = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+const Vec2* const kCornerUv = unit_square_corners().data();
 
 /// Exact sign of the orientation of (a, b, c): +1 counter-clockwise, 0 collinear, -1 clockwise.
 int orientation(const Vec2& a, const Vec2& b, const Vec2& c) {

@@ -103,8 +103,8 @@ struct FeatureWarpResult {
 /// around it inside the kernels of their stars (`repaired_vertices`); every relocation is checked with exact
 /// predicates. The base mesh therefore has no flipped triangle afterwards. Points outside the warp triangles
 /// incident to a moving feature move only when repaired (they are then within a few rings of a moving one).
-/// Measured (tests, 20×20 grid, 3–6 features): targets within 0.2 of their features are all reached; targets
-/// anywhere in [0.1,0.9]² leave about a fifth of the features unreached, reported, never folded.
+/// A target may be left unreached (reported in `unreached`, never folded); how often that happens for near
+/// and far targets is in docs/measurements.md.
 ///
 /// \param triangles  #F base-mesh triangles, 0-based indices into `uv`, counter-clockwise (positive area).
 /// \param uv         #V positions in [0,1]²: corners at the square's corners, boundary vertices with a

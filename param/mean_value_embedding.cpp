@@ -1,6 +1,7 @@
 #include "param/mean_value_embedding.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
+#include "param/unit_square.h"
 
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
@@ -20,16 +21,12 @@ namespace {
   throw InvalidInput(std::string(function) + ": " + what);
 }
 
-std::uint64_t edge_key(int a, int b) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
-
 }  // namespace
 
 std::vector<FixedUv> square_boundary_uv(const std::vector<Eigen::Vector3d>& positions,
                                         const std::array<std::vector<int>, 4>& sides) {
   constexpr const char* kFn = "square_boundary_uv";
-  static const Eigen::Vector2d kCorner[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const auto& kCorner = unit_square_corners();
   const int n = static_cast<int>(positions.size());
   std::vector<FixedUv> out;
   for (int k = 0; k < 4; ++k) {
@@ -83,7 +80,7 @@ MeanValueEmbeddingResult mean_value_embedding(const std::vector<Eigen::Vector3d>
   for (const auto& t : triangles) {
     for (int i = 0; i < 3; ++i) {
       if (t[i] < 0 || t[i] >= n) fail(kFn, "triangle vertex id out of range");
-      directed.insert(edge_key(t[i], t[(i + 1) % 3]));
+      directed.insert(directed_edge_key(t[i], t[(i + 1) % 3]));
     }
     for (int v : t) {
       if (!is_fixed[v] && unknown[v] < 0) unknown[v] = m++;
@@ -92,7 +89,7 @@ MeanValueEmbeddingResult mean_value_embedding(const std::vector<Eigen::Vector3d>
   for (const auto& t : triangles) {
     for (int i = 0; i < 3; ++i) {
       const int a = t[i], b = t[(i + 1) % 3];
-      if (directed.count(edge_key(b, a)) == 0 && (!is_fixed[a] || !is_fixed[b])) {
+      if (directed.count(directed_edge_key(b, a)) == 0 && (!is_fixed[a] || !is_fixed[b])) {
         fail(kFn, "boundary vertex " + std::to_string(is_fixed[a] ? b : a) + " has no fixed uv");
       }
     }
@@ -159,21 +156,6 @@ MeanValueEmbeddingResult mean_value_embedding(const std::vector<Eigen::Vector3d>
     if (unknown[v] >= 0) result.uv[v] = x.row(unknown[v]).transpose();
   }
   return result;
-}
-
-double signed_uv_area2(const std::vector<Eigen::Vector2d>& uv, const std::array<int, 3>& t) {
-  const Eigen::Vector2d a = uv[t[1]] - uv[t[0]], b = uv[t[2]] - uv[t[0]];
-  return a.x() * b.y() - a.y() * b.x();
-}
-
-std::size_t count_flipped_triangles(const std::vector<Eigen::Vector2d>& uv,
-                                    const std::vector<std::array<int, 3>>& triangles) {
-  std::size_t flipped = 0;
-  for (const auto& t : triangles) {
-    if (t[0] < 0) continue;
-    if (!(signed_uv_area2(uv, t) > 0.0)) ++flipped;
-  }
-  return flipped;
 }
 
 }  // namespace geomip

@@ -2,7 +2,9 @@
 // initial embedding of base meshes in ../shared/seed/consistent-mesh-parameterizations.txt, section 3.3.2.
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/predicates.h"  // signed_uv_area2, count_flipped_triangles (used with the embedding)
+
+#include "mesh/mesh.h"
 
 #include <Eigen/Core>
 
@@ -59,13 +61,5 @@ MeanValueEmbeddingResult mean_value_embedding(const std::vector<Eigen::Vector3d>
                                               const std::vector<std::array<int, 3>>& triangles,
                                               const std::vector<FixedUv>& fixed,
                                               const MeanValueEmbeddingOptions& options = {});
-
-/// Twice the signed area of triangle t in the parameter domain: > 0 for counter-clockwise (not flipped).
-double signed_uv_area2(const std::vector<Eigen::Vector2d>& uv, const std::array<int, 3>& t);
-
-/// Number of triangles whose parameter area is ≤ 0 (flipped or degenerate); triangles with a negative id
-/// (absent at a level of a progressive mesh) are skipped.
-std::size_t count_flipped_triangles(const std::vector<Eigen::Vector2d>& uv,
-                                    const std::vector<std::array<int, 3>>& triangles);
 
 }  // namespace geomip

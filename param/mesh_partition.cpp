@@ -1,7 +1,8 @@
 #include "param/mesh_partition.h"
 
-#include "param/errors.h"
-#include "param/mesh_topology.h"
+#include "mesh/errors.h"
+#include "mesh/predicates.h"
+#include "mesh/mesh_topology.h"
 
 #include <algorithm>
 #include <cmath>
@@ -74,11 +75,6 @@ Connectivity build_connectivity(const TriMesh& m) {
     c.opposite[h] = found;
   }
   return c;
-}
-
-std::uint64_t edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
 }
 
 // Splits every listed edge at its midpoint; returns the number of vertices appended. Triangles keep their id
@@ -417,9 +413,7 @@ void collect_faces(PartitionResult& r) {
 // Returns false (and sets `why`) when a side has no partner.
 bool link_sides(PartitionResult& r, std::string& why) {
   std::unordered_map<std::uint64_t, std::pair<int, int>> by_start;  // (first, second vertex) → (patch, side)
-  auto key = [](int a, int b) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-  };
+  const auto key = directed_edge_key;
   for (int p = 0; p < static_cast<int>(r.patches.size()); ++p) {
     for (int s = 0; s < 4; ++s) {
       const auto& v = r.patches[p].sides[s].vertices;
@@ -540,9 +534,7 @@ PartitionResult partition_genus1(const TriMesh& mesh, const std::vector<int>& p,
 
   // Which traced edge starts with (corner, next vertex), in either direction.
   std::unordered_map<std::uint64_t, int> edge_by_start;
-  auto key = [](int u, int v) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(v);
-  };
+  const auto key = directed_edge_key;
   for (int k = 0; k < 8; ++k) {
     const auto& path = part.paths()[k];
     edge_by_start[key(path[0], path[1])] = k;

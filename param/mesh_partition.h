@@ -10,7 +10,7 @@
 // square, §3.3) consume: plain index arrays, no half-edge structure (see ../shared/STYLE.md).
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <array>
 #include <cstddef>
@@ -125,8 +125,8 @@ struct PartitionOptions {
 /// Validation (always): every triangle is in exactly one patch; each patch is a topological disk (one
 /// boundary loop, V−E+F = 1) whose boundary is exactly its 4 sides meeting at its 4 corners; every side is
 /// glued to exactly one side of another patch. After chord splitting no edge joins two cut vertices across a
-/// patch. Linear-logarithmic in the mesh size: about 0.1 s for 100k triangles (horse, venus; 0.15 s for
-/// igea's 269k), a third of it in analyze_topology().
+/// patch. Cost: O(F log F) in the number of triangles, a third of it in analyze_topology() (timings:
+/// scripts/bench).
 ///
 /// \throw InvalidInput with "partition_mesh:" and the reason when: a point index is out of range, repeated or
 ///   not referenced by a triangle; the number of points does not fit the genus; the mesh is not one closed,

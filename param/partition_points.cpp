@@ -1,8 +1,8 @@
 #include "param/partition_points.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "param/mesh_partition.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_topology.h"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>

@@ -4,7 +4,7 @@
 // correspondence between different models.
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <vector>
 
@@ -51,8 +51,7 @@ struct PartitionPointsOptions {
 ///   little stretch (a cut across the longest axis would instead make two deep caps, tubes closed at one end,
 ///   that need strong radial stretch). The median plane balances the areas; extreme points in 4 directions
 ///   90° apart spread the corners evenly along the outline, so the 4 sides have similar lengths. The guiding
-///   points matter: with the same corners but no guides, the balance drops (horse 0.95 → 0.86, armadillo
-///   0.97 → 0.54, fandisk 0.73 → 0.46). If the loop fails to partition (possible on very coarse meshes), the
+///   points keep the areas balanced (without them the balance drops: docs/measurements.md). If the loop fails to partition (possible on very coarse meshes), the
 ///   other principal planes are tried (normals e3, e2, e1, after options.cut_axis); on an outline too short
 ///   for distinct corners the corners are spread over its vertices without guides, and on a mesh of a few
 ///   triangles (a tetrahedron) the vertices extreme in ±e1, ±e2 are the last resort.

@@ -7,8 +7,9 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
 
-#include "param/errors.h"
-#include "param/mesh_topology.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_topology.h"
+#include "mesh/predicates.h"
 
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Tools/Decimater/BaseDecimaterT.hh>
@@ -36,23 +37,19 @@ using PmMesh = OpenMesh::TriMesh_ArrayKernelT<PmTraits>;
   throw InvalidInput(std::string(function) + ": " + what);
 }
 
-std::uint64_t edge_key(int a, int b) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
-
 /// next_on_boundary[v] = w for every directed boundary edge v→w (patch on the left), -1 elsewhere.
 /// \pre the triangles form a manifold disk (checked by the caller).
 std::vector<int> boundary_successors(const TriMesh& patch) {
   std::unordered_map<std::uint64_t, int> directed;
   directed.reserve(patch.triangles.size() * 3);
   for (const auto& t : patch.triangles) {
-    for (int i = 0; i < 3; ++i) directed.emplace(edge_key(t[i], t[(i + 1) % 3]), 1);
+    for (int i = 0; i < 3; ++i) directed.emplace(directed_edge_key(t[i], t[(i + 1) % 3]), 1);
   }
   std::vector<int> next(patch.positions.size(), -1);
   for (const auto& t : patch.triangles) {
     for (int i = 0; i < 3; ++i) {
       const int a = t[i], b = t[(i + 1) % 3];
-      if (directed.count(edge_key(b, a)) == 0) next[a] = b;
+      if (directed.count(directed_edge_key(b, a)) == 0) next[a] = b;
     }
   }
   return next;

@@ -2,7 +2,7 @@
 // parameterization paper (../shared/seed/consistent-mesh-parameterizations.txt, section 3.3.1).
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <array>
 #include <cstddef>

@@ -1,6 +1,6 @@
 #include "param/sampling_weights.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "param/stretch_optimization.h"
 
 #include <Eigen/Geometry>

@@ -7,7 +7,7 @@
 // triangle weight w gives n ∝ √w, hence w = |II|^(4/3); a floor ε keeps flat regions sampled.
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <vector>
 
@@ -15,9 +15,8 @@ namespace geomip {
 
 struct SamplingWeightOptions {
   /// Exponent γ of w = ((ε + |II|²) / ε)^γ; 2/3 is the optimum above for a fixed sample count, 0 gives
-  /// every weight 1. The default 1/3 is half-way: measured on bunny, venus and horse it gains 0.1–1.4 dB on
-  /// the uniform remeshes M5..M8 and leaves the codec's low rates as they were, where 2/3 gains more on
-  /// the remeshes but loses up to 0.7 dB below 16 KB (README, "Curvature sampling").
+  /// every weight 1. The default 1/3 is half-way between the remeshes' gain and the codec's low
+  /// rates, which denser sampling of curved regions costs (README, "Curvature sampling", has the figures).
   double exponent = 1.0 / 3.0;
   /// ε as a multiple of the median (over vertices) of the smoothed |II|²: the curvature below which a region
   /// counts as flat. > 0.

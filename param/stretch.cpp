@@ -1,6 +1,6 @@
 #include "param/stretch.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <Eigen/Geometry>
 
@@ -75,11 +75,7 @@ StretchValues mesh_stretch(const std::vector<Eigen::Vector3d>& positions,
 std::size_t count_flipped(const std::vector<std::array<int, 3>>& triangles,
                           const std::vector<Eigen::Vector2d>& uv) {
   check_triangles("count_flipped", triangles, uv.size());
-  std::size_t flipped = 0;
-  for (const auto& t : triangles) {
-    if (!(signed_double_area(uv[t[0]], uv[t[1]], uv[t[2]]) > 0)) ++flipped;
-  }
-  return flipped;
+  return count_flipped_triangles(uv, triangles);
 }
 
 }  // namespace geomip

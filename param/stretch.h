@@ -17,6 +17,8 @@
 // clang-format on
 #pragma once
 
+#include "mesh/predicates.h"  // signed_double_area, orient2d
+
 #include <Eigen/Core>
 
 #include <array>
@@ -61,11 +63,5 @@ StretchValues mesh_stretch(const std::vector<Eigen::Vector3d>& positions,
 /// \throw InvalidInput if an index is out of range of `uv`.
 std::size_t count_flipped(const std::vector<std::array<int, 3>>& triangles,
                           const std::vector<Eigen::Vector2d>& uv);
-
-/// Twice the signed area of the uv triangle (a, b, c): positive when counter-clockwise.
-inline double signed_double_area(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                                 const Eigen::Vector2d& c) {
-  return (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
-}
 
 }  // namespace geomip

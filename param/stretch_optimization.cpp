@@ -1,6 +1,6 @@
 #include "param/stretch_optimization.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <Eigen/Geometry>
 

@@ -22,6 +22,7 @@
 namespace {
 
 using namespace geomip::viewer;
+namespace morph = geomip::morph;
 using Clock = std::chrono::steady_clock;
 
 constexpr int kExitOk = 0, kExitFailure = 1, kExitBadInput = 2, kExitPartial = 3;
@@ -84,7 +85,7 @@ void key_callback(GLFWwindow* w, int key, int, int action, int) {
     case GLFW_KEY_LEFT: s.t = std::max(s.t - 0.05f, 0.0f); ui->animate = false; break;
     case GLFW_KEY_SPACE: ui->animate = !ui->animate; break;
     case GLFW_KEY_S:
-      s.schedule = s.schedule == MorphSchedule::kLinear ? MorphSchedule::kWavelet : MorphSchedule::kLinear;
+      s.schedule = s.schedule == morph::MorphSchedule::kLinear ? morph::MorphSchedule::kWavelet : morph::MorphSchedule::kLinear;
       break;
     default: break;
   }
@@ -143,14 +144,14 @@ int run(const Options& opt) {
     Renderer renderer;
     Offscreen target(opt.width, opt.height);
     PackSource source(opt.source, FetchOptions{.limit_rate = opt.limit_rate},
-                      DecodeSettings{.bands = wavelet ? opt.bands : 1, .align = !opt.no_align});
+                      morph::DecodeSettings{.bands = wavelet ? opt.bands : 1, .align = !opt.no_align});
     Ui ui;
     ui.settings.width = opt.width;
     ui.settings.height = opt.height;
     ui.settings.level = opt.level;
     ui.settings.source = opt.model;
     ui.settings.t = opt.morph.value_or(0.0f);
-    ui.settings.schedule = wavelet ? MorphSchedule::kWavelet : MorphSchedule::kLinear;
+    ui.settings.schedule = wavelet ? morph::MorphSchedule::kWavelet : morph::MorphSchedule::kLinear;
     ui.settings.checker = opt.checker;
     ui.settings.wireframe = opt.wireframe;
     ui.settings.camera = Camera{opt.yaw, opt.pitch, opt.distance, 35.0f};

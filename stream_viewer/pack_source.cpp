@@ -4,7 +4,7 @@
 
 namespace geomip::viewer {
 
-PackSource::PackSource(const std::string& source, FetchOptions fetch, DecodeSettings decode) : decode_(decode) {
+PackSource::PackSource(const std::string& source, FetchOptions fetch, morph::DecodeSettings decode) : decode_(decode) {
   fetcher_ = std::make_unique<Fetcher>(source, fetch, [this] { wake_.notify_all(); });
   decoder_ = std::thread([this] { decode_loop(); });
 }
@@ -81,10 +81,10 @@ void PackSource::decode_loop() {
     }
     codec::Status status = codec::Status::kOk;
     std::size_t used = 0;
-    std::vector<SceneModel> models;
+    std::vector<morph::SceneModel> models;
     std::string err;
     try {
-      models = decode_scene({fetcher_->data(), static_cast<std::size_t>(end)}, decode_, status, used);
+      models = morph::decode_scene({fetcher_->data(), static_cast<std::size_t>(end)}, decode_, status, used);
     } catch (const std::exception& e) {
       err = std::string("decode failed: ") + e.what();
     }

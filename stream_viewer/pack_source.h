@@ -15,19 +15,19 @@
 
 #include "codec/pack.h"
 #include "stream_viewer/fetcher.h"
-#include "stream_viewer/scene_model.h"
+#include "morph/scene_model.h"
 
 namespace geomip::viewer {
 
 struct SourceUpdate {
-  std::vector<SceneModel> models;
+  std::vector<morph::SceneModel> models;
   std::uint64_t bytes_used = 0;  ///< bytes of the pack those models come from (complete chunks)
   std::uint64_t total = 0;       ///< the pack's size
 };
 
 class PackSource {
  public:
-  PackSource(const std::string& source, FetchOptions fetch, DecodeSettings decode);
+  PackSource(const std::string& source, FetchOptions fetch, morph::DecodeSettings decode);
   ~PackSource();
   PackSource(const PackSource&) = delete;
   PackSource& operator=(const PackSource&) = delete;
@@ -47,7 +47,7 @@ class PackSource {
  private:
   void decode_loop();
 
-  DecodeSettings decode_;
+  morph::DecodeSettings decode_;
   std::unique_ptr<Fetcher> fetcher_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;

@@ -207,7 +207,7 @@ int Renderer::model_level(int i) const {
   return i >= 0 && i < model_count() ? impl_->models[i].level : -1;
 }
 
-void Renderer::set_models(const std::vector<SceneModel>& models) {
+void Renderer::set_models(const std::vector<morph::SceneModel>& models) {
   impl_->free_models();
   for (const auto& m : models) {
     ModelGpu g;
@@ -277,7 +277,7 @@ void Renderer::draw(const RenderSettings& s) {
   glUniform1i(im.uniform("grid_size"), size);
   glUniform1i(im.uniform("stride"), 1 << (a.level - level));
   glUniform1i(im.uniform("bands"), a.bands);
-  auto w = band_weights(t, a.bands, s.schedule);
+  auto w = morph::band_weights(t, a.bands, s.schedule);
   if (!morph) std::fill(w.target.begin(), w.target.end(), 0.0f);
   w.source.resize(kMaxBands, 0.0f);
   w.target.resize(kMaxBands, 0.0f);

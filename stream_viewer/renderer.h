@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "stream_viewer/camera.h"
-#include "stream_viewer/scene_model.h"
+#include "morph/scene_model.h"
 
 namespace geomip::viewer {
 
@@ -24,7 +24,7 @@ struct RenderSettings {
   int source = 0;          ///< model index
   int target = -1;         ///< model index to morph to; −1 = no morph
   float t = 0;             ///< morph time ∈ [0,1]
-  MorphSchedule schedule = MorphSchedule::kLinear;
+  morph::MorphSchedule schedule = morph::MorphSchedule::kLinear;
   bool checker = false;
   bool wireframe = false;
 };
@@ -40,7 +40,7 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   /// Replaces the models (uploads their textures). Throws std::invalid_argument for more than 8 bands.
-  void set_models(const std::vector<SceneModel>& models);
+  void set_models(const std::vector<morph::SceneModel>& models);
   int model_count() const;
   /// Grid level n of model `i`, or −1.
   int model_level(int i) const;

@@ -1,6 +1,6 @@
 #include "tools/atomic_file.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <unistd.h>
 

@@ -2,7 +2,7 @@
 // consistent parameterization → geometry images (+ normal maps, + hole masks of repaired meshes) → the
 // progressive .gip pack (codec/pack.h), written atomically.
 #include "codec/pack.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/convert_pipeline.h"

@@ -1,8 +1,8 @@
 // geomip decode PACK [--bytes N] [--level K] -o MESH: decodes a .gip pack (or only its first N bytes, as if
 // only they had arrived) and writes each model as a mesh.
 #include "codec/pack.h"
-#include "param/errors.h"
-#include "param/mesh_io.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/pack_models.h"

@@ -3,7 +3,7 @@
 // their patch layout when they are to be morphed (gimage run on a consistent set).
 #include "codec/pack.h"
 #include "gimage/exr_io.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/pack_models.h"

@@ -1,7 +1,7 @@
 // geomip eval ORIGINAL APPROX [--json]: Metro-style surface distance, symmetric Hausdorff/RMS and PSNR.
 #include "gimage/surface_distance.h"
-#include "param/errors.h"
-#include "param/mesh_io.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/error_map.h"

@@ -4,7 +4,7 @@
 #include "gimage/exr_io.h"
 #include "gimage/resample.h"
 #include "param/consistent_parameterization.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tools/commands.h"
 #include "tools/model_inputs.h"
 #include "tools/progress.h"
@@ -63,7 +63,8 @@ int run_gimage(const GimageArgs& args) {
     const double resample_seconds = seconds_since(t0);
     const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string();
     GeometryImageFileInfo info;
-    info.source_mesh = models.paths[i];
+    // The file name only: an absolute path would leak the converting machine's directories into the file.
+    info.source_mesh = std::filesystem::path(models.paths[i]).filename().string();
     info.adjacency = images.adjacency;
     t0 = std::chrono::steady_clock::now();
     write_geometry_image_exr(stem + ".geometry.exr", images.geometry, info);

@@ -1,6 +1,6 @@
 // geomip info MESH... [--json]: topology and size of mesh files, counted on the triangles as read.
-#include "param/mesh_io.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_topology.h"
 #include "tools/commands.h"
 #include "tools/report.h"
 

@@ -1,11 +1,11 @@
 // geomip morph PACK --frames N [--schedule linear|wavelet] [--from A --to B] [--level K] -o DIR: the morph
 // between two models of a consistent pack as N meshes with the same connectivity (paper §6; the viewer's
-// schedules, stream_viewer/scene_model.h), for users without the viewer. Positions are in the pack's
+// schedules, morph/scene_model.h), for users without the viewer. Positions are in the pack's
 // normalized frame (unit bounding box, centred), where the viewer morphs.
 #include "codec/pack.h"
-#include "param/errors.h"
-#include "param/mesh_io.h"
-#include "stream_viewer/scene_model.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_io.h"
+#include "morph/scene_model.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/pack_file.h"
@@ -39,16 +39,16 @@ int run_morph(const MorphArgs& args) {
   if (args.from >= count || args.to >= count)
     throw InvalidInput(args.pack + " holds " + std::to_string(count) + " model(s); --from/--to out of range");
   const bool wavelet = args.schedule == "wavelet";
-  viewer::DecodeSettings settings;
+  morph::DecodeSettings settings;
   settings.bands = wavelet ? args.bands : 1;
   settings.align = !args.no_align;
   codec::Status status = codec::Status::kOk;
   std::size_t used = 0;
-  const std::vector<viewer::SceneModel> scenes = viewer::decode_scene(bytes, settings, status, used);
+  const std::vector<morph::SceneModel> scenes = morph::decode_scene(bytes, settings, status, used);
   if (scenes.size() != decoded.models.size()) throw InvalidInput(args.pack + ": no geometry to morph");
   const auto& a = scenes[args.from];
   const auto& b = scenes[args.to];
-  if (!viewer::same_layout(a, b))
+  if (!morph::same_layout(a, b))
     throw InvalidInput(args.pack + ": models " + std::to_string(args.from) + " and " + std::to_string(args.to) +
                        " do not share a patch layout");
   if (args.level > a.level)
@@ -65,10 +65,10 @@ int run_morph(const MorphArgs& args) {
         frame.hole_mask[p][q] = frame.hole_mask[p][q] || other[p][q];
 
   std::filesystem::create_directories(args.output);
-  const auto schedule = wavelet ? viewer::MorphSchedule::kWavelet : viewer::MorphSchedule::kLinear;
+  const auto schedule = wavelet ? morph::MorphSchedule::kWavelet : morph::MorphSchedule::kLinear;
   for (int k = 0; k < args.frames; ++k) {
     const float t = args.frames == 1 ? 0.0f : static_cast<float>(k) / static_cast<float>(args.frames - 1);
-    const auto positions = viewer::evaluate_morph(a, b, t, schedule);
+    const auto positions = morph::evaluate_morph(a, b, t, schedule);
     for (std::size_t p = 0; p < positions.size(); ++p) frame.geometry[p].values = positions[p];
     const TriMesh mesh = decoded_mesh(frame, args.level);
     char name[32];

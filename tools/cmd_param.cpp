@@ -1,7 +1,8 @@
 // geomip param MESH... -o DIR [--points CORR.json]: consistent parameterization (paper §3), written as
 // DIR/<stem>.param.obj (per-patch texture coordinates) and DIR/<stem>.param.json (layout and figures).
 #include "param/consistent_parameterization.h"
-#include "param/errors.h"
+#include "param/unit_square.h"
+#include "mesh/errors.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/model_inputs.h"
@@ -62,13 +63,13 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
   j["split_vertices"] = m.split_vertices;
   j["partition_points"] = partition_points;
   j["auxiliary_points"] = auxiliary_points;
-  static const double kCorner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const auto& kCorner = unit_square_corners();
   nlohmann::json patches = nlohmann::json::array();
   std::size_t flipped = 0;
   for (std::size_t k = 0; k < m.patches.size(); ++k) {
     const auto& p = m.patches[k];
     nlohmann::json corners = nlohmann::json::array();
-    for (int c = 0; c < 4; ++c) corners.push_back({{"vertex", p.corners[c]}, {"u", kCorner[c][0]}, {"v", kCorner[c][1]}});
+    for (int c = 0; c < 4; ++c) corners.push_back({{"vertex", p.corners[c]}, {"u", kCorner[c].x()}, {"v", kCorner[c].y()}});
     nlohmann::json sides = nlohmann::json::array();
     for (int s = 0; s < 4; ++s) sides.push_back(p.sides[s]);
     patches.push_back({{"patch", k},

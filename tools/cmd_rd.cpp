@@ -8,13 +8,14 @@
 // The command is a list of series: each series is a method name and a list of jobs, a job codes one mesh and
 // returns its bytes, decoded mesh and decode time; evaluation, the envelope, the files and the table are the
 // same for every series. A further codec adds one `Series` to `plan_series()`.
-#include "codec/draco_baseline.h"
-#include "codec/mesh_decimation.h"
-#include "codec/meshopt_baseline.h"
-#include "codec/rd_curve.h"
+#include "baselines/draco_baseline.h"
+#include "baselines/mesh_decimation.h"
+#include "baselines/meshopt_baseline.h"
+#include "baselines/rd_curve.h"
+#include "codec/parallel.h"
 #include "gimage/surface_distance.h"
-#include "param/errors.h"
-#include "param/mesh_io.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/convert_pipeline.h"
@@ -87,34 +88,6 @@ Sweep make_sweep(bool quick) {
 
 constexpr int kDracoLevel = 10;  // draco_encoder -cl 10: speed 0, the smallest streams
 
-/// Runs f(0..n-1) on `threads` threads (the caller's included); the first exception stops the others'
-/// further work and is rethrown.
-void parallel_for(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& f) {
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto worker = [&] {
-    for (;;) {
-      const std::size_t i = next++;
-      if (i >= n) return;
-      try {
-        f(i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = n;
-        return;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  const unsigned extra = static_cast<unsigned>(std::min<std::size_t>(threads, n)) - (n > 0 ? 1 : 0);
-  for (unsigned t = 0; t < extra; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-}
-
 Job draco_job(std::string method, std::shared_ptr<const TriMesh> mesh, int bits) {
   return [method = std::move(method), mesh = std::move(mesh), bits] {
     DracoOptions options;
@@ -163,7 +136,7 @@ std::vector<std::shared_ptr<const TriMesh>> decimate_all(const std::shared_ptr<c
   std::mutex progress_mutex;
   DecimationOptions options;
   options.method = method;
-  parallel_for(faces.size(), threads, [&](std::size_t i) {
+  codec::parallel_for(static_cast<int>(faces.size()), static_cast<int>(threads), [&](int i) {
     decimated[i] = std::make_shared<const TriMesh>(decimate_mesh(*original, faces[i], options).mesh);
     std::lock_guard<std::mutex> lock(progress_mutex);
     progress.update("decimating", static_cast<double>(++done) / static_cast<double>(faces.size()));
@@ -325,7 +298,7 @@ int run_rd(const RdArgs& args) {
   distance_options.face_samples = args.samples > 0 ? args.samples : (args.quick ? 20000 : 0);
   std::atomic<std::size_t> done{0};
   std::mutex progress_mutex;
-  parallel_for(slots.size(), threads, [&](std::size_t i) {
+  codec::parallel_for(static_cast<int>(slots.size()), static_cast<int>(threads), [&](int i) {
     Coded c = plan[slots[i].series].jobs[slots[i].job]();
     SurfaceDistance d;
     try {

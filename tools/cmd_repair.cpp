@@ -1,7 +1,7 @@
 // geomip repair IN -o OUT: make a scanned mesh closed, manifold and clean, ready for parameterization.
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/progress.h"

@@ -27,8 +27,6 @@ CommandRunner add_convert_command(CLI::App& app);
 CommandRunner add_encode_command(CLI::App& app);
 CommandRunner add_decode_command(CLI::App& app);
 CommandRunner add_rd_command(CLI::App& app);
-#ifdef GEOMIP_WITH_MORPH
-CommandRunner add_morph_command(CLI::App& app);  ///< needs the viewer's scene module (GEOMIP_BUILD_VIEWER)
-#endif
+CommandRunner add_morph_command(CLI::App& app);
 
 }  // namespace geomip::tools

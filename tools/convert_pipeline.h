@@ -3,7 +3,7 @@
 #pragma once
 
 #include "codec/pack.h"
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 #include "tools/model_inputs.h"
 
 #include <cstdint>
@@ -19,8 +19,8 @@ struct ConvertOptions {
   /// Level of the hole-mask grid (repaired meshes); -1 = the geometry's level.
   int hole_mask_level = -1;
   /// Curvature sampling exponent of the parameterization (SamplingWeightOptions::exponent; 0 = off, the
-  /// default here: it costs the codec up to 0.26 dB below 16 KB on the bunny while adding 0.5 dB to the full
-  /// pack; the remeshing commands default to 1/3).
+  /// default here because it costs the codec at low rates; the remeshing commands default to 1/3; README,
+  /// "Curvature sampling").
   double sampling_exponent = 0;
   ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode"
 };

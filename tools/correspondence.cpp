@@ -1,6 +1,6 @@
 #include "tools/correspondence.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <nlohmann/json.hpp>
 

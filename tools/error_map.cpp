@@ -1,7 +1,7 @@
 // Error colouring as PLY (see error_map.h).
 #include "tools/error_map.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <algorithm>
 #include <array>

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "gimage/surface_distance.h"
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <array>
 #include <iosfwd>

@@ -1,6 +1,6 @@
 // geomip: consistent geometry images from triangle meshes. This file maps every failure to one line on
 // stderr and an exit code: 2 for bad input or usage, 1 for geomip's own failures.
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tools/commands.h"
 
 #include <CLI/CLI.hpp>
@@ -33,9 +33,7 @@ int main(int argc, char** argv) {
   add(add_encode_command(app));
   add(add_decode_command(app));
   add(add_rd_command(app));
-#ifdef GEOMIP_WITH_MORPH
   add(add_morph_command(app));
-#endif
 
   try {
     app.parse(argc, argv);

@@ -1,9 +1,9 @@
 #include "tools/model_inputs.h"
 
-#include "param/errors.h"
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
 #include "tools/correspondence.h"
 

@@ -1,6 +1,6 @@
 #include "tools/pack_file.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <cerrno>
 #include <cstring>

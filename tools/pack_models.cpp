@@ -1,7 +1,7 @@
 #include "tools/pack_models.h"
 
 #include "gimage/uniform_remesh.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 namespace geomip::tools {
 

@@ -4,7 +4,7 @@
 #include "codec/pack.h"
 #include "gimage/hole_mask.h"
 #include "gimage/resample.h"
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <string>
 #include <vector>

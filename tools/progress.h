@@ -2,7 +2,7 @@
 // and the work has already taken longer than a second. Silent otherwise (pipes, CI logs, tests).
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <chrono>
 #include <string>

@@ -1,7 +1,7 @@
 // Conversions of library results to the JSON and text that commands print.
 #pragma once
 
-#include "param/mesh_topology.h"
+#include "mesh/mesh_topology.h"
 
 #include <nlohmann/json.hpp>
 

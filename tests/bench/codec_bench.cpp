@@ -31,7 +31,7 @@
 #include "codec/pack.h"
 #include "gimage/exr_io.h"
 #include "gimage/surface_distance.h"
-#include "param/mesh_io.h"
+#include "mesh/mesh_io.h"
 #include "tests/codec/codec_fixtures.h"
 
 namespace {

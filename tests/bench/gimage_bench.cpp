@@ -5,9 +5,9 @@
 #include "gimage/resample.h"
 #include "gimage/uniform_remesh.h"
 #include "param/consistent_parameterization.h"
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
 
 #include <benchmark/benchmark.h>

@@ -1,9 +1,9 @@
 // Benchmarks of the parameterization on real meshes (../shared/meshes): wall time per stage and peak memory.
 // Run: build/tests/bench/param_bench  (or scripts/bench). Not part of ctest: timings are not tests.
 #include "param/consistent_parameterization.h"
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
 
 #include <benchmark/benchmark.h>

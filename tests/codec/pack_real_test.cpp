@@ -3,8 +3,8 @@
 // PSNR at 56.4 dB), every prefix is watertight but for the source's own holes, and quality grows with bytes.
 #include "codec/pack.h"
 #include "gimage/surface_distance.h"
-#include "param/mesh_io.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_topology.h"
 #include "tests/param/test_meshes.h"
 #include "tools/convert_pipeline.h"
 #include "tools/model_inputs.h"

@@ -3,9 +3,9 @@
 // shares one adaptive face list.
 #include "gimage/adaptive_remesh.h"
 #include "gimage/uniform_remesh.h"
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
 #include "tests/gimage/gimage_fixtures.h"
 #include "tests/gimage/remesh_checks.h"
 #include "tools/model_inputs.h"

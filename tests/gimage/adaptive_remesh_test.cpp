@@ -3,7 +3,7 @@
 // level-n mesh, fewer faces for larger ε.
 #include "gimage/adaptive_remesh.h"
 #include "gimage/uniform_remesh.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tests/gimage/gimage_fixtures.h"
 #include "tests/gimage/remesh_checks.h"
 

@@ -1,7 +1,7 @@
-// EXR geometry images: round trip through OpenImageIO, MIP level sizes (2^(n−l)+1)² with the nested grids,
+// EXR geometry images: round trip through OpenEXR, MIP level sizes (2^(n−l)+1)² with the nested grids,
 // header attributes, third-party readers, atomic writes.
 #include "gimage/exr_io.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tests/gimage/gimage_fixtures.h"
 #include "tests/param/test_meshes.h"
 

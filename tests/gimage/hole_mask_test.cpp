@@ -3,7 +3,7 @@
 
 #include "gimage/resample.h"
 #include "gimage/surface_distance.h"
-#include "param/mesh_repair.h"
+#include "mesh/mesh_repair.h"
 #include "tests/gimage/gimage_fixtures.h"
 
 #include <gtest/gtest.h>

@@ -2,8 +2,8 @@
 // (each directed edge once), the input's genus, outward (positive signed volume).
 #pragma once
 
-#include "param/mesh.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_topology.h"
 
 #include <gtest/gtest.h>
 

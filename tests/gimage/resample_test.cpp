@@ -1,7 +1,7 @@
 // Properties of resample_geometry(): exact reproduction of planar patches, every sample located exactly once,
 // bit-identical seams and corners, normals.
 #include "gimage/resample.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tests/gimage/gimage_fixtures.h"
 
 #include <gtest/gtest.h>

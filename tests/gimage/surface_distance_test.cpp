@@ -1,7 +1,7 @@
 // Properties of measure_surface_distance() on synthetic surfaces with known distances (label unit).
 #include "gimage/surface_distance.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>

@@ -1,9 +1,9 @@
 // Real meshes (../shared/meshes): point location exactly once, bit-identical seams, and uniform remeshes that
 // are watertight, oriented, outward and of the input's genus at M1..M6.
 #include "gimage/uniform_remesh.h"
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
 #include "tests/gimage/gimage_fixtures.h"
 #include "tests/gimage/remesh_checks.h"
 #include "tools/model_inputs.h"

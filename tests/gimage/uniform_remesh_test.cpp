@@ -1,7 +1,7 @@
 // Properties of uniform_remesh(): watertight, oriented, genus preserved, Euler counts, one face list for a
 // consistent set, positions from the nested grids.
 #include "gimage/uniform_remesh.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tests/gimage/gimage_fixtures.h"
 #include "tests/gimage/remesh_checks.h"
 

@@ -1,10 +1,10 @@
 #include "param/coarse_to_fine.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "param/mean_value_embedding.h"
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
 #include "param/progressive_mesh.h"
 #include "tests/param/test_meshes.h"
 
@@ -411,7 +411,7 @@ TEST(CoarseToFineReal, SpotHalves) {
   }
 }
 
-TEST(CoarseToFineReal, BunnyHalvesInACoupleOfSeconds) {
+TEST(CoarseToFineReal, BunnyHalves) {
   GEOMIP_REQUIRE_SHARED_MESH(path, "bunny.obj");
   const TriMesh bunny = repair_mesh(read_mesh(path)).mesh;  // holes filled: two disks of ~35k triangles
   // The first axis whose median plane cuts the bunny into two disks (a plane through an ear leaves a ring).
@@ -430,11 +430,8 @@ TEST(CoarseToFineReal, BunnyHalvesInACoupleOfSeconds) {
     seconds += run_real_half(
         half, std::string("bunny, axis ") + "xyz"[axis] + (lower ? " lower half" : " upper half"));
   }
-#ifdef NDEBUG
-  EXPECT_LT(seconds, 3.0);  // PM + MVC + insertion for both; generous for a loaded machine
-#else
-  std::printf("unoptimised build: %.3f s not checked against the 3 s budget\n", seconds);
-#endif
+  // Speed is a benchmark (tests/bench/param_bench), not a test: a loaded machine must not fail the suite.
+  std::printf("bunny halves: %.3f s (PM + MVC + insertion for both)\n", seconds);
 }
 
 }  // namespace

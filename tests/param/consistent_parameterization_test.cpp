@@ -1,10 +1,10 @@
 // Properties of the whole parameterization (issue #3's "done means"): valid square embeddings, seams that
 // agree, stretch below the MVC baseline, aligned features across models, clean errors.
 #include "param/consistent_parameterization.h"
-#include "param/errors.h"
-#include "param/mesh_io.h"
-#include "param/mesh_repair.h"
-#include "param/mesh_topology.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
 #include "tests/param/test_meshes.h"
 

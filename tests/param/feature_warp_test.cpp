@@ -1,7 +1,7 @@
 // Property tests of the foldover-free feature alignment warp (paper §3.4).
 #include "param/feature_warp.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>

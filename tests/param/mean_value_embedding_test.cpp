@@ -1,6 +1,6 @@
 #include "param/mean_value_embedding.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "param/progressive_mesh.h"
 #include "tests/param/test_meshes.h"
 

@@ -1,8 +1,8 @@
 // Properties of partition_mesh() and choose_partition_points() on synthetic meshes (label unit).
 #include "param/mesh_partition.h"
 
-#include "param/errors.h"
-#include "param/mesh_topology.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
 #include "tests/param/partition_checks.h"
 #include "tests/param/test_meshes.h"

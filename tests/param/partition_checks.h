@@ -2,9 +2,10 @@
 // from the triangles), shared by the unit and real-mesh tests of partition_mesh().
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 #include "param/mesh_partition.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_topology.h"
+#include "mesh/predicates.h"
 
 #include <Eigen/SparseCholesky>
 
@@ -171,9 +172,7 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
   }
 
   // Sides and the cut.
-  auto key = [](int a, int b) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-  };
+  const auto key = directed_edge_key;
   std::set<std::uint64_t> mesh_halfedges;
   for (const auto& t : m.triangles) {
     for (int k = 0; k < 3; ++k) mesh_halfedges.insert(key(t[k], t[(k + 1) % 3]));

@@ -1,7 +1,7 @@
 #include "param/progressive_mesh.h"
 
-#include "param/errors.h"
-#include "param/mesh_topology.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_topology.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 // flat and uniformly curved surfaces get uniform weights, bent regions get more, and the optimizer then gives
 // the weighted triangles more parameter area without flipping any.
 #include "param/sampling_weights.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "param/stretch.h"
 #include "param/stretch_optimization.h"
 #include "tests/param/test_meshes.h"

@@ -2,7 +2,7 @@
 // flat grid from a distorted embedding, lowers stretch monotonically on curved surfaces, never flips a
 // triangle and never moves a locked vertex.
 #include "param/stretch_optimization.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "param/stretch.h"
 #include "tests/param/test_meshes.h"
 

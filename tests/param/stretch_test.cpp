@@ -1,7 +1,7 @@
 // Properties of the geometric stretch metric (Sander et al. 2001): isometry, scaling, flips, an analytic
 // anisotropic map, normalization invariances and the lower bound 1.
 #include "param/stretch.h"
-#include "param/errors.h"
+#include "mesh/errors.h"
 #include "tests/param/test_meshes.h"
 
 #include <Eigen/Geometry>

@@ -2,7 +2,7 @@
 #pragma once
 
 #include "param/consistent_parameterization.h"
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <string>
 

@@ -1,6 +1,6 @@
 // End to end: `geomip rd --quick` writes rd.csv and rd.svg, and fails cleanly (exit 2, one line, no output
 // files) on a missing mesh.
-#include "param/mesh_io.h"
+#include "mesh/mesh_io.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>

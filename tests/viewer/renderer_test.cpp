@@ -50,7 +50,7 @@ GlContext* RendererTest::context_ = nullptr;
 
 // Band-split model whose band-limited versions are exact: drop d = every 2^d-th sample, bilinearly
 // interpolated back to the full grid (what a linear-wavelet decode with drop_finest_steps = d gives).
-SceneModel banded_model(int level, int shape, int bands) {
+morph::SceneModel banded_model(int level, int shape, int bands) {
   std::vector<codec::DecodedModel> by_drop;
   for (int d = 0; d < bands; ++d) {
     auto m = decoded_model(level, shape);
@@ -71,11 +71,11 @@ SceneModel banded_model(int level, int shape, int bands) {
     }
     by_drop.push_back(std::move(m));
   }
-  return make_banded_scene_model(by_drop);
+  return morph::make_banded_scene_model(by_drop);
 }
 
 TEST_F(RendererTest, FrameCoversTheProjectedModelAtEveryLevel) {
-  const SceneModel model = make_scene_model(decoded_model(6, 0));
+  const morph::SceneModel model = morph::make_scene_model(decoded_model(6, 0));
   renderer_->set_models({model});
   for (int level : {6, 4, 2}) {
     RenderSettings s = settings();
@@ -89,7 +89,7 @@ TEST_F(RendererTest, FrameCoversTheProjectedModelAtEveryLevel) {
 }
 
 TEST_F(RendererTest, CheckerboardAndWireframeKeepTheSilhouette) {
-  const SceneModel model = make_scene_model(decoded_model(5, 1));
+  const morph::SceneModel model = morph::make_scene_model(decoded_model(5, 1));
   renderer_->set_models({model});
   RenderSettings s = settings();
   const auto plain = render(s);
@@ -105,7 +105,7 @@ TEST_F(RendererTest, CheckerboardAndWireframeKeepTheSilhouette) {
 }
 
 TEST_F(RendererTest, HoleMaskQuadsAreNotDrawn) {
-  SceneModel model = make_scene_model(decoded_model(5, 0));
+  morph::SceneModel model = morph::make_scene_model(decoded_model(5, 0));
   model.hole_level = 3;  // a coarser mask than the grid, as packs may store it
   const int q = 1 << model.hole_level;
   model.holes.assign(static_cast<std::size_t>(2) * q * q, 0);
@@ -119,17 +119,17 @@ TEST_F(RendererTest, HoleMaskQuadsAreNotDrawn) {
   const auto image = image_coverage(render(s));
   const auto reference = cpu_coverage(model, model.level, s.camera, kW, kH);
   EXPECT_GT(iou(image, reference), 0.97);
-  SceneModel full = model;
+  morph::SceneModel full = model;
   full.holes.clear();
   EXPECT_LT(count(image), count(cpu_coverage(full, full.level, s.camera, kW, kH)) * 0.95)
       << "the background should show through the holes";
 }
 
 TEST_F(RendererTest, MorphEndPointsRenderLikeEachModelAlone) {
-  const std::vector<SceneModel> banded = {banded_model(6, 0, 4), banded_model(6, 1, 4)};
-  const std::vector<SceneModel> plain = {make_scene_model(decoded_model(6, 0)), make_scene_model(decoded_model(6, 1))};
-  for (auto schedule : {MorphSchedule::kLinear, MorphSchedule::kWavelet}) {
-    const auto& models = schedule == MorphSchedule::kLinear ? plain : banded;
+  const std::vector<morph::SceneModel> banded = {banded_model(6, 0, 4), banded_model(6, 1, 4)};
+  const std::vector<morph::SceneModel> plain = {morph::make_scene_model(decoded_model(6, 0)), morph::make_scene_model(decoded_model(6, 1))};
+  for (auto schedule : {morph::MorphSchedule::kLinear, morph::MorphSchedule::kWavelet}) {
+    const auto& models = schedule == morph::MorphSchedule::kLinear ? plain : banded;
     renderer_->set_models(models);
     RenderSettings s = settings();
     s.schedule = schedule;
@@ -148,25 +148,25 @@ TEST_F(RendererTest, MorphEndPointsRenderLikeEachModelAlone) {
     // the frame at t = 0.5 covers the CPU-evaluated morph
     s.t = 0.5f;
     const auto mid = image_coverage(render(s));
-    const auto geometry = evaluate_morph(models[0], models[1], 0.5f, schedule);
+    const auto geometry = morph::evaluate_morph(models[0], models[1], 0.5f, schedule);
     EXPECT_GT(iou(mid, cpu_coverage(models[0], models[0].level, s.camera, kW, kH, &geometry)), 0.97);
   }
 }
 
 TEST_F(RendererTest, WaveletMidpointDiffersFromLinearMidpoint) {
-  const std::vector<SceneModel> banded = {banded_model(6, 0, 4), banded_model(6, 1, 4)};
+  const std::vector<morph::SceneModel> banded = {banded_model(6, 0, 4), banded_model(6, 1, 4)};
   renderer_->set_models(banded);
   RenderSettings s = settings();
   s.target = 1;
   s.t = 0.5f;
-  s.schedule = MorphSchedule::kLinear;
+  s.schedule = morph::MorphSchedule::kLinear;
   const auto linear = render(s);
-  s.schedule = MorphSchedule::kWavelet;
+  s.schedule = morph::MorphSchedule::kWavelet;
   const auto wavelet = render(s);
   EXPECT_GT(differing(linear, wavelet, 8), 0.02) << "the schedules should give visibly different midpoints";
   // geometry: at the midpoint the wavelet schedule has neither model's finest band, the linear one half of each
-  const auto gl = evaluate_morph(banded[0], banded[1], 0.5f, MorphSchedule::kLinear);
-  const auto gw = evaluate_morph(banded[0], banded[1], 0.5f, MorphSchedule::kWavelet);
+  const auto gl = morph::evaluate_morph(banded[0], banded[1], 0.5f, morph::MorphSchedule::kLinear);
+  const auto gw = morph::evaluate_morph(banded[0], banded[1], 0.5f, morph::MorphSchedule::kWavelet);
   double diff = 0;
   for (std::size_t p = 0; p < gl.size(); ++p)
     for (std::size_t k = 0; k < gl[p].size(); ++k) diff = std::max(diff, double(std::abs(gl[p][k] - gw[p][k])));

@@ -1,5 +1,5 @@
 // Morph schedules and band-split models (CPU only).
-#include "stream_viewer/scene_model.h"
+#include "morph/scene_model.h"
 
 #include <gtest/gtest.h>
 
@@ -12,9 +12,9 @@ namespace geomip::viewer {
 namespace {
 
 TEST(BandWeights, EndPointsAreExactlySourceAndTarget) {
-  for (auto schedule : {MorphSchedule::kLinear, MorphSchedule::kWavelet})
+  for (auto schedule : {morph::MorphSchedule::kLinear, morph::MorphSchedule::kWavelet})
     for (int bands : {1, 2, 5, 8}) {
-      const auto w0 = band_weights(0, bands, schedule), w1 = band_weights(1, bands, schedule);
+      const auto w0 = morph::band_weights(0, bands, schedule), w1 = morph::band_weights(1, bands, schedule);
       for (int b = 0; b < bands; ++b) {
         EXPECT_EQ(w0.source[b], 1.0f);
         EXPECT_EQ(w0.target[b], 0.0f);
@@ -27,7 +27,7 @@ TEST(BandWeights, EndPointsAreExactlySourceAndTarget) {
 TEST(BandWeights, WaveletScheduleFadesFineSourceEarlyAndBringsFineTargetLate) {
   const int bands = 5;
   for (float t = 0; t <= 1.0f; t += 0.05f) {
-    const auto w = band_weights(t, bands, MorphSchedule::kWavelet);
+    const auto w = morph::band_weights(t, bands, morph::MorphSchedule::kWavelet);
     EXPECT_NEAR(w.source[0] + w.target[0], 1.0f, 1e-6f) << "the coarse band interpolates";
     EXPECT_NEAR(w.target[0], t, 1e-6f);
     for (int b = 1; b < bands; ++b) {
@@ -35,19 +35,19 @@ TEST(BandWeights, WaveletScheduleFadesFineSourceEarlyAndBringsFineTargetLate) {
       EXPECT_LE(w.target[b], w.target[b - 1] + 1e-6f) << "finer target bands arrive no earlier";
     }
     // monotone in t
-    const auto w2 = band_weights(t + 0.05f, bands, MorphSchedule::kWavelet);
+    const auto w2 = morph::band_weights(t + 0.05f, bands, morph::MorphSchedule::kWavelet);
     for (int b = 0; b < bands; ++b) {
       EXPECT_LE(w2.source[b], w.source[b] + 1e-6f);
       EXPECT_GE(w2.target[b], w.target[b] - 1e-6f);
     }
   }
-  const auto mid = band_weights(0.5f, bands, MorphSchedule::kWavelet);
+  const auto mid = morph::band_weights(0.5f, bands, morph::MorphSchedule::kWavelet);
   EXPECT_EQ(mid.source[bands - 1], 0.0f);
   EXPECT_EQ(mid.target[bands - 1], 0.0f);
 }
 
 TEST(SceneModel, NormalizationMapsToTheUnitBox) {
-  const auto m = make_scene_model(testing::decoded_model(4, 1));
+  const auto m = morph::make_scene_model(testing::decoded_model(4, 1));
   float lo[3] = {1e9f, 1e9f, 1e9f}, hi[3] = {-1e9f, -1e9f, -1e9f};
   for (std::size_t k = 0; k < m.positions.size(); ++k)
     lo[k % 3] = std::min(lo[k % 3], m.positions[k]), hi[k % 3] = std::max(hi[k % 3], m.positions[k]);
@@ -66,7 +66,7 @@ TEST(SceneModel, IdentityNormalizationFitsTheUnitBox) {
     for (std::size_t k = 0; k < g.values.size(); ++k)
       g.values[k] = 0.05f * g.values[k] + (k % 3 == 1 ? 7.f : -3.f);
   }
-  const auto m = make_scene_model(raw);
+  const auto m = morph::make_scene_model(raw);
   float lo[3] = {1e9f, 1e9f, 1e9f}, hi[3] = {-1e9f, -1e9f, -1e9f};
   for (std::size_t k = 0; k < m.positions.size(); ++k)
     lo[k % 3] = std::min(lo[k % 3], m.positions[k]), hi[k % 3] = std::max(hi[k % 3], m.positions[k]);
@@ -80,10 +80,10 @@ TEST(SceneModel, BandsSumToTheFullGeometry) {
     auto m = testing::decoded_model(4, d == 0 ? 1 : 0);  // any grids of one layout
     by_drop.push_back(m);
   }
-  const auto banded = make_banded_scene_model(by_drop);
-  const auto full = make_scene_model(by_drop[0]);
+  const auto banded = morph::make_banded_scene_model(by_drop);
+  const auto full = morph::make_scene_model(by_drop[0]);
   ASSERT_EQ(banded.bands, 3);
-  const auto sum = evaluate_morph(banded, banded, 0.0f, MorphSchedule::kWavelet);
+  const auto sum = morph::evaluate_morph(banded, banded, 0.0f, morph::MorphSchedule::kWavelet);
   const std::size_t per = 3u * full.size() * full.size();
   for (int p = 0; p < full.num_patches; ++p)
     for (std::size_t k = 0; k < per; ++k) EXPECT_NEAR(sum[p][k], full.positions[p * per + k], 1e-5f);
@@ -102,21 +102,21 @@ std::array<double, 9> oblique_rotation(double angle) {
 
 TEST(Alignment, RecoversAKnownSimilarity) {
   for (int bands : {1, 3}) {
-    SceneModel reference;
+    morph::SceneModel reference;
     if (bands == 1) {
-      reference = make_scene_model(testing::decoded_model(4, 1));
+      reference = morph::make_scene_model(testing::decoded_model(4, 1));
     } else {
       std::vector<codec::DecodedModel> by_drop;
       for (int d = 0; d < bands; ++d) by_drop.push_back(testing::decoded_model(4, d == 0 ? 1 : 0));
-      reference = make_banded_scene_model(by_drop);
+      reference = morph::make_banded_scene_model(by_drop);
     }
-    SceneModel moved = reference;
-    const Similarity xf{0.6, oblique_rotation(2.1), {0.3, -0.2, 0.7}};
-    apply_similarity(xf, moved);
-    const Similarity back = best_alignment(moved, reference);
+    morph::SceneModel moved = reference;
+    const morph::Similarity xf{0.6, oblique_rotation(2.1), {0.3, -0.2, 0.7}};
+    morph::apply_similarity(xf, moved);
+    const morph::Similarity back = morph::best_alignment(moved, reference);
     EXPECT_NEAR(back.scale, 1 / 0.6, 1e-4) << bands;
-    SceneModel restored = moved;
-    apply_similarity(back, restored);
+    morph::SceneModel restored = moved;
+    morph::apply_similarity(back, restored);
     for (std::size_t k = 0; k < reference.positions.size(); ++k)
       ASSERT_NEAR(restored.positions[k], reference.positions[k], 2e-5f) << bands << " " << k;
     for (std::size_t k = 0; k < reference.normals.size(); ++k)
@@ -127,8 +127,8 @@ TEST(Alignment, RecoversAKnownSimilarity) {
                        r[2] * (r[3] * r[7] - r[4] * r[6]);
     EXPECT_NEAR(det, 1.0, 1e-9);
   }
-  EXPECT_THROW(best_alignment(make_scene_model(testing::decoded_model(4, 1)),
-                              make_scene_model(testing::decoded_model(3, 1))),
+  EXPECT_THROW(morph::best_alignment(morph::make_scene_model(testing::decoded_model(4, 1)),
+                              morph::make_scene_model(testing::decoded_model(3, 1))),
                std::invalid_argument);
 }
 
@@ -163,9 +163,9 @@ TEST(DecodeScene, AlignedModelsMorphWithoutCollapsing) {
   for (bool align : {true, false}) {
     codec::Status status;
     std::size_t used = 0;
-    const auto models = decode_scene(bytes, DecodeSettings{.bands = 1, .align = align}, status, used);
+    const auto models = morph::decode_scene(bytes, morph::DecodeSettings{.bands = 1, .align = align}, status, used);
     ASSERT_EQ(models.size(), 2u);
-    const auto mid = evaluate_morph(models[0], models[1], 0.5f, MorphSchedule::kLinear);
+    const auto mid = morph::evaluate_morph(models[0], models[1], 0.5f, morph::MorphSchedule::kLinear);
     std::vector<float> all;
     float worst = 0;  // largest distance of a mid-morph sample from the same sample of model 0
     const std::size_t per = 3u * models[0].size() * models[0].size();
@@ -186,7 +186,7 @@ TEST(DecodeScene, AlignedModelsMorphWithoutCollapsing) {
   }
 }
 
-// What the streaming viewer does with every prefix that arrives: decode_scene never throws on a prefix, and
+// What the streaming viewer does with every prefix that arrives: morph::decode_scene never throws on a prefix, and
 // gives either nothing (no geometry pass of model 0 yet) or both models at the pack's level, finite, with
 // more bytes never giving fewer models.
 TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
@@ -195,9 +195,9 @@ TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
   for (std::size_t n = 0; n <= bytes.size(); n += (n < 64 ? 1 : 37)) {
     codec::Status status = codec::Status::kOk;
     std::size_t used = 0;
-    std::vector<SceneModel> models;
+    std::vector<morph::SceneModel> models;
     for (int bands : {1, 3}) {
-      ASSERT_NO_THROW(models = decode_scene({bytes.data(), n}, DecodeSettings{.bands = bands}, status, used))
+      ASSERT_NO_THROW(models = morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands}, status, used))
           << n << " bytes";
       EXPECT_LE(used, n);
       if (models.empty()) {
@@ -216,7 +216,7 @@ TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
   EXPECT_TRUE(seen_models);
   codec::Status status;
   std::size_t used = 0;
-  EXPECT_EQ(decode_scene(bytes, {}, status, used).size(), 2u);
+  EXPECT_EQ(morph::decode_scene(bytes, {}, status, used).size(), 2u);
   EXPECT_EQ(status, codec::Status::kOk);
   EXPECT_EQ(used, bytes.size());
 }

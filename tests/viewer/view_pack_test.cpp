@@ -144,11 +144,11 @@ class ViewPackTest : public ::testing::Test {
 };
 GlContext* ViewPackTest::context_ = nullptr;
 
-std::vector<SceneModel> decode_file(const fs::path& path) {
+std::vector<morph::SceneModel> decode_file(const fs::path& path) {
   const auto bytes = read_bytes(path);
   codec::Status status;
   std::size_t used = 0;
-  auto models = decode_scene(bytes, {}, status, used);
+  auto models = morph::decode_scene(bytes, {}, status, used);
   EXPECT_EQ(status, codec::Status::kOk);
   EXPECT_EQ(used, bytes.size());
   return models;
@@ -209,7 +209,7 @@ TEST_F(ViewPackTest, RepairedMeshLeavesItsHoleMaskedQuadsOut) {
   ASSERT_EQ(models.size(), 1u);
   ASSERT_FALSE(models[0].holes.empty()) << "the repaired camel head should carry a hole mask";
   EXPECT_GT(count(models[0].holes), 0u);
-  SceneModel unmasked = models[0];
+  morph::SceneModel unmasked = models[0];
   unmasked.holes.clear();
   for (float yaw : {0.6f, 2.5f, 4.0f}) {
     Camera camera;

@@ -17,7 +17,7 @@
 #include "codec/pack.h"
 #include "stream_viewer/camera.h"
 #include "stream_viewer/renderer.h"
-#include "stream_viewer/scene_model.h"
+#include "morph/scene_model.h"
 
 namespace geomip::viewer::testing {
 
@@ -139,7 +139,7 @@ class GlContext {
 };
 
 /// Coverage mask (1 = covered) of the model's triangles at grid level `level`, projected with `camera`.
-inline std::vector<std::uint8_t> cpu_coverage(const SceneModel& model, int level, const Camera& camera, int width,
+inline std::vector<std::uint8_t> cpu_coverage(const morph::SceneModel& model, int level, const Camera& camera, int width,
                                               int height, const std::vector<std::vector<float>>* positions = nullptr) {
   const auto vp = view_projection(camera, width, height);
   std::vector<std::uint8_t> mask(static_cast<std::size_t>(width) * height, 0);

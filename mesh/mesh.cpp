@@ -1,4 +1,4 @@
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <limits>
 

@@ -1,7 +1,7 @@
 // The only translation unit of geomip::param that includes CGAL's Polygon Mesh Processing (compile time).
-#include "param/mesh_repair.h"
+#include "mesh/mesh_repair.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/border.h>

@@ -13,7 +13,7 @@
 // This file is a baseline, not part of the geomip codec (it lives in the `geomip_baselines` target).
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <cstddef>
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "stream_viewer/scene_model.h"
+#include "morph/scene_model.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace geomip::viewer {
+namespace geomip::morph {
 namespace {
 
 void check_model(const codec::DecodedModel& m, const char* fn) {
@@ -290,4 +290,4 @@ std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const 
   return out;
 }
 
-}  // namespace geomip::viewer
+}  // namespace geomip::morph

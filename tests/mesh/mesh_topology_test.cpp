@@ -1,5 +1,5 @@
-#include "param/errors.h"
-#include "param/mesh_topology.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_topology.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // Topology report of an indexed triangle mesh, counted on the triangles as read (no half-edge structure).
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <optional>
 

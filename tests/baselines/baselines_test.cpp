@@ -1,11 +1,11 @@
 // Property tests of the baseline codecs (codec/draco_baseline.h, codec/meshopt_baseline.h) and of the QEM
 // decimation (codec/mesh_decimation.h) on synthetic meshes.
-#include "codec/draco_baseline.h"
-#include "codec/mesh_decimation.h"
-#include "codec/meshopt_baseline.h"
+#include "baselines/draco_baseline.h"
+#include "baselines/mesh_decimation.h"
+#include "baselines/meshopt_baseline.h"
 #include "gimage/surface_distance.h"
-#include "param/errors.h"
-#include "param/mesh_topology.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_topology.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>

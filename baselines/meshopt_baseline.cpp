@@ -1,6 +1,6 @@
-#include "codec/meshopt_baseline.h"
+#include "baselines/meshopt_baseline.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <meshoptimizer.h>
 

@@ -1,6 +1,6 @@
 // geomip's topology counts must equal the table in ../shared/meshes/README.md for every mesh there.
-#include "param/mesh_io.h"
-#include "param/mesh_topology.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_topology.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 // triangle mesh.
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 namespace geomip {
 

@@ -1,6 +1,6 @@
-#include "param/mesh_topology.h"
+#include "mesh/mesh_topology.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <algorithm>
 #include <numeric>

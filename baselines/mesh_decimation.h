@@ -11,12 +11,11 @@
 //
 // kLindstromTurk: CGAL's Surface_mesh_simplification::edge_collapse with its default policies, Lindstrom &
 // Turk, "Fast and memory efficient polygonal simplification", IEEE Visualization 1998 (volume- and
-// boundary-preserving cost, optimal vertex placement). Slower (about 1 s for the 69k-face bunny against 0.03
-// s) but much closer to the original at equal face count: on the bunny, +3 to +6 dB PSNR after Draco at
-// Q 10..12 for 1.5k..24k faces (measured with `geomip eval`'s distance). Needs an oriented 2-manifold input.
+// boundary-preserving cost, optimal vertex placement). Slower than meshoptimizer's simplifier but much closer
+// to the original at equal face count (figures: docs/measurements.md). Needs an oriented 2-manifold input.
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <cstddef>
 

@@ -11,7 +11,7 @@
 // This file is a baseline, not part of the geomip codec: it links Draco (the `geomip_baselines` target only).
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <cstddef>
 #include <cstdint>

@@ -1,7 +1,7 @@
 // Property tests of codec/rd_curve.h: the upper envelope is the Pareto front, its staircase is monotone, and
 // the CSV and SVG files are well formed.
-#include "codec/rd_curve.h"
-#include "param/errors.h"
+#include "baselines/rd_curve.h"
+#include "mesh/errors.h"
 
 #include <gtest/gtest.h>
 

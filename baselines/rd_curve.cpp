@@ -1,6 +1,6 @@
-#include "codec/rd_curve.h"
+#include "baselines/rd_curve.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 // (see mesh_topology.h).
 #pragma once
 
-#include "param/mesh.h"
+#include "mesh/mesh.h"
 
 #include <iosfwd>
 #include <string>

@@ -11,7 +11,7 @@
 
 #include "codec/pack.h"
 
-namespace geomip::viewer {
+namespace geomip::morph {
 
 /// One model, ready for upload. Positions are stored as `bands` layers per patch, each a (2^level+1)² grid of
 /// xyz floats in the normalized frame (the pack's normalization applied; for an identity normalization, as
@@ -94,4 +94,4 @@ struct DecodeSettings {
 std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
                                      codec::Status& status, std::size_t& bytes_used);
 
-}  // namespace geomip::viewer
+}  // namespace geomip::morph

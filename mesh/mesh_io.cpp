@@ -1,6 +1,6 @@
-#include "param/mesh_io.h"
+#include "mesh/mesh_io.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/exporter/BaseExporter.hh>

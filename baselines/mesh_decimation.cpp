@@ -1,6 +1,6 @@
-#include "codec/mesh_decimation.h"
+#include "baselines/mesh_decimation.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>

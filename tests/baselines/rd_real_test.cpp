@@ -1,11 +1,11 @@
 // Real-mesh checks of the Draco baseline on ../shared/meshes/bunny.obj against the figures measured in
 // issue 5 (plain Draco, cl 10): 20,527 B → 52.7 dB, 23,892 B → 65.3 dB, 35,273 B → 77.5 dB, and the shape
 // of the decimate-then-Draco envelope.
-#include "codec/draco_baseline.h"
-#include "codec/mesh_decimation.h"
-#include "codec/rd_curve.h"
+#include "baselines/draco_baseline.h"
+#include "baselines/mesh_decimation.h"
+#include "baselines/rd_curve.h"
 #include "gimage/surface_distance.h"
-#include "param/mesh_io.h"
+#include "mesh/mesh_io.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>

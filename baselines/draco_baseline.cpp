@@ -1,6 +1,6 @@
-#include "codec/draco_baseline.h"
+#include "baselines/draco_baseline.h"
 
-#include "param/errors.h"
+#include "mesh/errors.h"
 
 #include <draco/attributes/geometry_attribute.h>
 #include <draco/compression/decode.h>

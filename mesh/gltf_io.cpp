@@ -1,0 +1,310 @@
+#include "mesh/gltf_io.h"
+
+#include "mesh/errors.h"
+
+// Debian ships TinyGLTF as a shared library (libtinygltf); only its declarations are needed here. Images are
+// never decoded (geomip reads geometry), so the stb image headers are not needed either.
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <ostream>
+
+namespace geomip {
+namespace {
+
+constexpr double kFloatMax = static_cast<double>(std::numeric_limits<float>::max());
+
+template <typename T>
+void append_bytes(std::vector<unsigned char>& buffer, const T* data, std::size_t count) {
+  const auto* p = reinterpret_cast<const unsigned char*>(data);
+  buffer.insert(buffer.end(), p, p + count * sizeof(T));
+}
+
+// Appends a tightly packed buffer view + accessor of `count` elements; returns the accessor's index.
+int add_accessor(tinygltf::Model& model, std::size_t offset, std::size_t bytes, std::size_t count, int component,
+                 int type, int target) {
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = offset;
+  view.byteLength = bytes;
+  view.target = target;
+  model.bufferViews.push_back(view);
+  tinygltf::Accessor accessor;
+  accessor.bufferView = static_cast<int>(model.bufferViews.size() - 1);
+  accessor.byteOffset = 0;
+  accessor.componentType = component;
+  accessor.count = count;
+  accessor.type = type;
+  model.accessors.push_back(accessor);
+  return static_cast<int>(model.accessors.size() - 1);
+}
+
+void pad4(std::vector<unsigned char>& buffer) {
+  while (buffer.size() % 4) buffer.push_back(0);
+}
+
+// ---- reading ----
+
+using Matrix4 = Eigen::Matrix4d;
+
+Matrix4 node_matrix(const tinygltf::Node& node) {
+  Matrix4 m = Matrix4::Identity();
+  if (node.matrix.size() == 16) {
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m(r, c) = node.matrix[4 * c + r];  // column-major in glTF
+    return m;
+  }
+  Eigen::Affine3d a = Eigen::Affine3d::Identity();
+  if (node.translation.size() == 3) a.translate(Eigen::Vector3d(node.translation[0], node.translation[1], node.translation[2]));
+  if (node.rotation.size() == 4) {
+    Eigen::Quaterniond q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);  // glTF: x y z w
+    if (q.norm() > 0) a.rotate(q.normalized());
+  }
+  if (node.scale.size() == 3) a.scale(Eigen::Vector3d(node.scale[0], node.scale[1], node.scale[2]));
+  return a.matrix();
+}
+
+class Reader {
+ public:
+  Reader(const tinygltf::Model& model, const std::string& name) : model_(model), name_(name) {}
+
+  [[noreturn]] void fail(const std::string& what) const { throw InvalidInput(name_ + ": " + what); }
+
+  // The bytes of element i of accessor `a` (validated once by check_accessor()).
+  struct View {
+    const unsigned char* base = nullptr;
+    std::size_t stride = 0;
+    std::size_t count = 0;
+    int component = 0;
+  };
+
+  View check_accessor(int index, int type, const char* what) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= model_.accessors.size())
+      fail(std::string(what) + " accessor " + std::to_string(index) + " does not exist");
+    const tinygltf::Accessor& a = model_.accessors[index];
+    if (a.sparse.isSparse) fail(std::string(what) + " accessor " + std::to_string(index) + " is sparse (not supported)");
+    if (a.type != type) fail(std::string(what) + " accessor " + std::to_string(index) + " has the wrong type");
+    if (a.bufferView < 0 || static_cast<std::size_t>(a.bufferView) >= model_.bufferViews.size())
+      fail(std::string(what) + " accessor " + std::to_string(index) + " has no buffer view");
+    const tinygltf::BufferView& v = model_.bufferViews[a.bufferView];
+    if (v.buffer < 0 || static_cast<std::size_t>(v.buffer) >= model_.buffers.size())
+      fail(std::string(what) + " buffer view " + std::to_string(a.bufferView) + " has no buffer");
+    const std::size_t buffer_bytes = model_.buffers[v.buffer].data.size();
+    const int stride = a.ByteStride(v);
+    const int component_bytes = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
+    const int components = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
+    if (stride <= 0 || component_bytes <= 0 || components <= 0)
+      fail(std::string(what) + " accessor " + std::to_string(index) + " has an invalid layout");
+    const std::size_t element = static_cast<std::size_t>(component_bytes) * components;
+    // The view inside the buffer and every element inside the view (each difference checked first).
+    if (v.byteOffset > buffer_bytes || v.byteLength > buffer_bytes - v.byteOffset || a.byteOffset > v.byteLength)
+      fail(std::string(what) + " accessor " + std::to_string(index) + " reaches past its buffer");
+    const std::size_t avail = v.byteLength - a.byteOffset;
+    if (a.count > 0 && (static_cast<std::size_t>(stride) < element || element > avail ||
+                        a.count - 1 > (avail - element) / static_cast<std::size_t>(stride))) {
+      fail(std::string(what) + " accessor " + std::to_string(index) + " reaches past its buffer");
+    }
+    return {model_.buffers[v.buffer].data.data() + v.byteOffset + a.byteOffset, static_cast<std::size_t>(stride),
+            a.count, a.componentType};
+  }
+
+  std::uint32_t index_at(const View& v, std::size_t i) const {
+    const unsigned char* p = v.base + i * v.stride;
+    switch (v.component) {
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        std::uint16_t x;
+        std::memcpy(&x, p, 2);
+        return x;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        std::uint32_t x;
+        std::memcpy(&x, p, 4);
+        return x;
+      }
+      default: fail("indices are not unsigned integers");
+    }
+  }
+
+  void add_primitive(const tinygltf::Primitive& prim, const Matrix4& xf, TriMesh& out) const {
+    if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) return;  // points, lines, strips, fans: skipped
+    if (prim.extensions.count("KHR_draco_mesh_compression"))
+      fail("Draco-compressed primitives (KHR_draco_mesh_compression) are not read; decompress the file first");
+    const auto pos = prim.attributes.find("POSITION");
+    if (pos == prim.attributes.end()) fail("a triangle primitive has no POSITION");
+    const View p = check_accessor(pos->second, TINYGLTF_TYPE_VEC3, "POSITION");
+    if (p.component != TINYGLTF_COMPONENT_TYPE_FLOAT) fail("POSITION is not float");
+    const std::size_t first = out.positions.size();
+    if (p.count > static_cast<std::size_t>(std::numeric_limits<int>::max()) - first) fail("too many vertices");
+    for (std::size_t i = 0; i < p.count; ++i) {
+      float f[3];
+      std::memcpy(f, p.base + i * p.stride, sizeof f);
+      const Eigen::Vector4d h = xf * Eigen::Vector4d(f[0], f[1], f[2], 1.0);
+      const Eigen::Vector3d q = h.head<3>();
+      if (!q.allFinite() || q.cwiseAbs().maxCoeff() > kFloatMax)
+        fail("vertex " + std::to_string(i) + " has a coordinate that is not finite or beyond float range");
+      out.positions.push_back(q);
+    }
+    if (prim.indices >= 0) {
+      const View ix = check_accessor(prim.indices, TINYGLTF_TYPE_SCALAR, "index");
+      if (ix.count % 3) fail("an index count is not a multiple of 3");
+      for (std::size_t i = 0; i < ix.count; i += 3) {
+        std::array<int, 3> t{};
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t v = index_at(ix, i + k);
+          if (v >= p.count) fail("index " + std::to_string(v) + " is beyond the " + std::to_string(p.count) + " vertices");
+          t[k] = static_cast<int>(first + v);
+        }
+        out.triangles.push_back(t);
+      }
+    } else {
+      if (p.count % 3) fail("a non-indexed primitive's vertex count is not a multiple of 3");
+      for (std::size_t i = 0; i < p.count; i += 3)
+        out.triangles.push_back({static_cast<int>(first + i), static_cast<int>(first + i + 1), static_cast<int>(first + i + 2)});
+    }
+  }
+
+  void add_node(int index, const Matrix4& parent, TriMesh& out, int depth) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= model_.nodes.size()) fail("a node reference is out of range");
+    if (depth > 64) fail("the node hierarchy is deeper than 64 (a cycle?)");
+    const tinygltf::Node& node = model_.nodes[index];
+    const Matrix4 xf = parent * node_matrix(node);
+    if (node.mesh >= 0) {
+      if (static_cast<std::size_t>(node.mesh) >= model_.meshes.size()) fail("a node references a missing mesh");
+      const std::size_t first_triangle = out.triangles.size();
+      for (const auto& prim : model_.meshes[node.mesh].primitives) add_primitive(prim, xf, out);
+      if (xf.topLeftCorner<3, 3>().determinant() < 0) {  // mirrored instance: keep the triangles outward
+        for (std::size_t t = first_triangle; t < out.triangles.size(); ++t) std::swap(out.triangles[t][1], out.triangles[t][2]);
+      }
+    }
+    for (int child : node.children) add_node(child, xf, out, depth + 1);
+  }
+
+ private:
+  const tinygltf::Model& model_;
+  const std::string& name_;
+};
+
+bool skip_images(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+}  // namespace
+
+void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostream& out,
+                const GltfWriteOptions& options) {
+  if (mesh.triangles.empty() || mesh.positions.empty()) throw InvalidInput("write_gltf: empty mesh");
+  const std::size_t n = mesh.positions.size();
+  if (!attributes.normals.empty() && attributes.normals.size() != n)
+    throw InvalidInput("write_gltf: " + std::to_string(attributes.normals.size()) + " normals for " + std::to_string(n) + " vertices");
+  if (!attributes.uv.empty() && attributes.uv.size() != n)
+    throw InvalidInput("write_gltf: " + std::to_string(attributes.uv.size()) + " texture coordinates for " + std::to_string(n) + " vertices");
+
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = options.generator;
+  std::vector<unsigned char>& buffer = model.buffers.emplace_back().data;
+
+  std::vector<float> positions(3 * n);
+  std::array<double, 3> lo{kFloatMax, kFloatMax, kFloatMax}, hi{-kFloatMax, -kFloatMax, -kFloatMax};
+  for (std::size_t v = 0; v < n; ++v) {
+    for (int c = 0; c < 3; ++c) {
+      const double x = mesh.positions[v][c];
+      if (!std::isfinite(x) || std::abs(x) > kFloatMax) throw InvalidInput("write_gltf: vertex " + std::to_string(v) + " is not finite or beyond float range");
+      positions[3 * v + c] = static_cast<float>(x);
+      lo[c] = std::min(lo[c], static_cast<double>(positions[3 * v + c]));
+      hi[c] = std::max(hi[c], static_cast<double>(positions[3 * v + c]));
+    }
+  }
+  std::vector<std::uint32_t> indices;
+  indices.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    for (int v : t) {
+      if (v < 0 || static_cast<std::size_t>(v) >= n) throw InvalidInput("write_gltf: a triangle index is out of range");
+      indices.push_back(static_cast<std::uint32_t>(v));
+    }
+  }
+
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  std::size_t offset = buffer.size();
+  append_bytes(buffer, positions.data(), positions.size());
+  prim.attributes["POSITION"] = add_accessor(model, offset, buffer.size() - offset, n, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                             TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+  model.accessors.back().minValues.assign(lo.begin(), lo.end());
+  model.accessors.back().maxValues.assign(hi.begin(), hi.end());
+  if (!attributes.normals.empty()) {
+    offset = buffer.size();
+    for (const auto& nv : attributes.normals) append_bytes(buffer, nv.data(), 3);
+    prim.attributes["NORMAL"] = add_accessor(model, offset, buffer.size() - offset, n, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                             TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  if (!attributes.uv.empty()) {
+    offset = buffer.size();
+    for (const auto& t : attributes.uv) append_bytes(buffer, t.data(), 2);
+    prim.attributes["TEXCOORD_0"] = add_accessor(model, offset, buffer.size() - offset, n,
+                                                 TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2,
+                                                 TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  pad4(buffer);
+  offset = buffer.size();
+  append_bytes(buffer, indices.data(), indices.size());
+  prim.indices = add_accessor(model, offset, buffer.size() - offset, indices.size(),
+                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                              TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+
+  model.meshes.emplace_back().primitives.push_back(prim);
+  tinygltf::Node node;
+  node.mesh = 0;
+  model.nodes.push_back(node);
+  model.scenes.emplace_back().nodes.push_back(0);
+  model.defaultScene = 0;
+
+  tinygltf::TinyGLTF gltf;
+  if (!gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/!options.binary, options.binary) || !out)
+    throw IoError("write_gltf: writing the glTF stream failed");
+}
+
+TriMesh read_gltf_from_memory(std::string_view bytes, const std::string& name, const std::string& base_dir) {
+  if (bytes.size() > std::numeric_limits<unsigned int>::max()) throw InvalidInput(name + ": too large for glTF (4 GiB)");
+  tinygltf::TinyGLTF gltf;
+  gltf.SetImageLoader(&skip_images, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  bool ok = false;
+  try {
+    ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                            static_cast<unsigned int>(bytes.size()), base_dir)
+                : gltf.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()),
+                                           base_dir);
+  } catch (const std::exception& e) {
+    throw InvalidInput(name + ": not a readable glTF file (" + e.what() + ")");
+  }
+  if (!ok) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    const std::size_t nl = err.find('\n');
+    throw InvalidInput(name + ": not a readable glTF file" + (err.empty() ? std::string() : " (" + err.substr(0, nl) + ")"));
+  }
+  const Reader reader(model, name);
+  TriMesh out;
+  if (!model.scenes.empty()) {
+    const int s = model.defaultScene >= 0 && static_cast<std::size_t>(model.defaultScene) < model.scenes.size() ? model.defaultScene : 0;
+    for (int node : model.scenes[s].nodes) reader.add_node(node, Matrix4::Identity(), out, 0);
+  } else {
+    for (const auto& mesh : model.meshes) {
+      for (const auto& prim : mesh.primitives) reader.add_primitive(prim, Matrix4::Identity(), out);
+    }
+  }
+  if (out.triangles.empty()) throw InvalidInput(name + ": no triangles in the glTF file's scene");
+  return out;
+}
+
+}  // namespace geomip

@@ -1,0 +1,47 @@
+// glTF 2.0 input and output (.gltf with the buffer embedded as a data URI, or binary .glb), through TinyGLTF
+// (Debian's libtinygltf-dev): what three.js's GLTFLoader, Blender, assimp and every glTF viewer open.
+//
+// Output: one mesh, one triangle primitive: POSITION (float VEC3, with the min/max the specification
+// requires), optional NORMAL (float VEC3, unit length) and TEXCOORD_0 (float VEC2), 32-bit indices.
+// Input: every triangle primitive (mode TRIANGLES, indexed or not) of every mesh reachable from the default
+// scene (all nodes when the file has no scene), node transforms applied, merged into one TriMesh. Accessors
+// are checked against their buffers before a byte is read; sparse accessors, strips and fans are refused.
+#pragma once
+
+#include "mesh/mesh.h"
+
+#include <Eigen/Core>
+
+#include <iosfwd>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace geomip {
+
+/// Per-vertex attributes written with a mesh; an empty vector is not written.
+struct MeshAttributes {
+  std::vector<Eigen::Vector3f> normals;  ///< #V unit normals, or empty
+  std::vector<Eigen::Vector2f> uv;       ///< #V texture coordinates (TEXCOORD_0), or empty
+};
+
+struct GltfWriteOptions {
+  bool binary = true;          ///< GLB (one file) or JSON .gltf with the buffer as a base64 data URI
+  std::string generator = "geomip";
+};
+
+/// Writes `mesh` (positions as float32) with `attributes` as glTF 2.0 to `out`. Does not open or rename
+/// files: tools/ write to a temporary file and rename (atomic output).
+/// \throw InvalidInput for an empty mesh, attributes of the wrong size, an index out of range or a
+///   coordinate outside float range; IoError when the stream fails.
+void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostream& out,
+                const GltfWriteOptions& options = {});
+
+/// Parses glTF 2.0 bytes (GLB when they start with the "glTF" magic, JSON otherwise). External buffers of a
+/// JSON file are looked up in `base_dir`; `name` only labels the messages. Work and memory are linear in
+/// the bytes and the buffers they reference.
+/// \throw InvalidInput naming `name` and the problem: not glTF, no triangle primitive, an accessor outside
+///   its buffer, an index out of range, a non-finite coordinate.
+TriMesh read_gltf_from_memory(std::string_view bytes, const std::string& name, const std::string& base_dir);
+
+}  // namespace geomip

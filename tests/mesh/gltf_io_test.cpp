@@ -1,0 +1,158 @@
+// glTF 2.0 through TinyGLTF: exact float round trips (GLB and JSON), attributes written with the sizes and
+// bounds the specification requires, node transforms applied on input, and crafted files refused with a
+// message instead of a crash (accessors past their buffers, indices out of range, garbage).
+#include "mesh/errors.h"
+#include "mesh/gltf_io.h"
+#include "tests/param/test_meshes.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sstream>
+
+namespace geomip {
+namespace {
+
+std::string to_gltf(const TriMesh& mesh, const MeshAttributes& attributes, bool binary) {
+  std::ostringstream out;
+  GltfWriteOptions o;
+  o.binary = binary;
+  write_gltf(mesh, attributes, out, o);
+  return out.str();
+}
+
+TriMesh float_rounded(TriMesh m) {
+  for (auto& p : m.positions) p = p.cast<float>().cast<double>();
+  return m;
+}
+
+TEST(GltfIo, RoundTripIsExactInFloatForGlbAndJson) {
+  const TriMesh torus = float_rounded(test::torus(12, 7));
+  for (bool binary : {true, false}) {
+    const std::string bytes = to_gltf(torus, {}, binary);
+    EXPECT_EQ(bytes.rfind("glTF", 0) == 0, binary);
+    const TriMesh back = read_gltf_from_memory(bytes, "torus", "");
+    ASSERT_EQ(back.positions.size(), torus.positions.size());
+    ASSERT_EQ(back.triangles, torus.triangles);
+    for (std::size_t v = 0; v < torus.positions.size(); ++v) EXPECT_EQ(back.positions[v], torus.positions[v]) << v;
+  }
+}
+
+TEST(GltfIo, JsonCarriesAttributesAndBoundsTheSpecificationRequires) {
+  const TriMesh cube = test::cube();
+  MeshAttributes a;
+  for (const auto& p : cube.positions) {
+    a.normals.push_back(p.normalized().cast<float>());
+    a.uv.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  }
+  const auto j = nlohmann::json::parse(to_gltf(cube, a, false));
+  EXPECT_EQ(j["asset"]["version"], "2.0");
+  const auto& attributes = j["meshes"][0]["primitives"][0]["attributes"];
+  ASSERT_TRUE(attributes.contains("POSITION") && attributes.contains("NORMAL") && attributes.contains("TEXCOORD_0"));
+  const auto& pos = j["accessors"][attributes["POSITION"].get<int>()];
+  EXPECT_EQ(pos["count"], cube.positions.size());
+  ASSERT_EQ(pos["min"].size(), 3u);
+  for (int c = 0; c < 3; ++c) {
+    double lo = 1e300, hi = -1e300;
+    for (const auto& p : cube.positions) lo = std::min(lo, p[c]), hi = std::max(hi, p[c]);
+    EXPECT_DOUBLE_EQ(pos["min"][c].get<double>(), lo);
+    EXPECT_DOUBLE_EQ(pos["max"][c].get<double>(), hi);
+  }
+  EXPECT_EQ(j["accessors"][attributes["TEXCOORD_0"].get<int>()]["type"], "VEC2");
+  const auto& ix = j["accessors"][j["meshes"][0]["primitives"][0]["indices"].get<int>()];
+  EXPECT_EQ(ix["count"], 3 * cube.triangles.size());
+  // The buffer is embedded: the file stands alone.
+  EXPECT_EQ(j["buffers"][0]["uri"].get<std::string>().rfind("data:application/octet-stream;base64,", 0), 0u);
+}
+
+TEST(GltfIo, WrongAttributeSizesAndEmptyMeshesAreRefused) {
+  const TriMesh cube = test::cube();
+  std::ostringstream out;
+  MeshAttributes a;
+  a.normals.resize(cube.positions.size() - 1);
+  EXPECT_THROW(write_gltf(cube, a, out), InvalidInput);
+  EXPECT_THROW(write_gltf(TriMesh{}, {}, out), InvalidInput);
+}
+
+TEST(GltfIo, NodeTransformsAreAppliedAndMirroringKeepsTrianglesOutward) {
+  const TriMesh tet = float_rounded(test::tetrahedron());
+  auto j = nlohmann::json::parse(to_gltf(tet, {}, false));
+  j["nodes"][0]["translation"] = {10.0, 0.0, 0.0};
+  j["nodes"][0]["scale"] = {2.0, 2.0, 2.0};
+  TriMesh moved = read_gltf_from_memory(j.dump(), "moved", "");
+  ASSERT_EQ(moved.positions.size(), tet.positions.size());
+  for (std::size_t v = 0; v < tet.positions.size(); ++v) {
+    EXPECT_NEAR((moved.positions[v] - (2.0 * tet.positions[v] + Eigen::Vector3d(10, 0, 0))).norm(), 0.0, 1e-6);
+  }
+  EXPECT_EQ(moved.triangles, tet.triangles);
+  j["nodes"][0].erase("translation");
+  j["nodes"][0]["scale"] = {-1.0, 1.0, 1.0};
+  const TriMesh mirrored = read_gltf_from_memory(j.dump(), "mirrored", "");
+  // Mirrored positions with the winding swapped: every triangle's normal is the mirror of the original's.
+  for (std::size_t t = 0; t < tet.triangles.size(); ++t) {
+    const auto& a = tet.triangles[t];
+    const auto& b = mirrored.triangles[t];
+    const Eigen::Vector3d na = (tet.positions[a[1]] - tet.positions[a[0]]).cross(tet.positions[a[2]] - tet.positions[a[0]]);
+    const Eigen::Vector3d nb = (mirrored.positions[b[1]] - mirrored.positions[b[0]])
+                                   .cross(mirrored.positions[b[2]] - mirrored.positions[b[0]]);
+    // n' = M·n for M = diag(−1, 1, 1): the outward normal mirrored (without the swap it would point inward).
+    EXPECT_NEAR(nb.x(), -na.x(), 1e-9) << t;
+    EXPECT_NEAR(nb.y(), na.y(), 1e-9) << t;
+    EXPECT_NEAR(nb.z(), na.z(), 1e-9) << t;
+  }
+}
+
+void expect_refused(const std::string& bytes, const std::string& problem) {
+  try {
+    read_gltf_from_memory(bytes, "crafted.gltf", "");
+    ADD_FAILURE() << "accepted; expected '" << problem << "'";
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("crafted.gltf"), std::string::npos) << what;
+    EXPECT_NE(what.find(problem), std::string::npos) << "'" << what << "' lacks '" << problem << "'";
+  }
+}
+
+TEST(GltfIo, CraftedFilesAreRefusedWithAMessage) {
+  const TriMesh tet = test::tetrahedron();
+  const auto good = nlohmann::json::parse(to_gltf(tet, {}, false));
+  expect_refused("", "not a readable glTF");
+  expect_refused("glTF\x02\0\0\0garbage", "not a readable glTF");
+  expect_refused("{\"asset\": {\"version\": \"2.0\"}}", "no triangles");
+  auto j = good;
+  j["accessors"][0]["count"] = 1000000;  // POSITION past its buffer view
+  expect_refused(j.dump(), "reaches past its buffer");
+  j = good;
+  j["bufferViews"][0]["byteOffset"] = 1u << 30;
+  expect_refused(j.dump(), "");
+  j = good;
+  j["accessors"][0]["byteOffset"] = 4;  // the last vertex's bytes end past the view
+  expect_refused(j.dump(), "reaches past its buffer");
+  j = good;
+  const int ix = j["meshes"][0]["primitives"][0]["indices"];
+  j["accessors"][ix]["count"] = 4;
+  expect_refused(j.dump(), "multiple of 3");
+  j = good;
+  j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = ix;  // indices as positions: wrong type
+  expect_refused(j.dump(), "wrong type");
+  j = good;
+  j["nodes"][0]["children"] = {0};  // a cycle
+  expect_refused(j.dump(), "deeper than 64");
+}
+
+TEST(GltfIo, IndicesBeyondTheVertexCountAreRefused) {
+  TriMesh tet = test::tetrahedron();
+  tet.positions.pop_back();  // the last vertex is referenced but gone
+  std::ostringstream out;
+  EXPECT_THROW(write_gltf(tet, {}, out), InvalidInput);
+  // Crafted the other way: a valid file whose index buffer is rewritten to point past the vertices.
+  const TriMesh full = test::tetrahedron();
+  std::string bytes = to_gltf(full, {}, true);
+  const std::size_t n = bytes.size();
+  // The index buffer is the last 4·3·F bytes of the BIN chunk: set its last index to 0xFFFFFFFF.
+  for (int k = 1; k <= 4; ++k) bytes[n - k] = '\xff';
+  expect_refused(bytes, "beyond the");
+}
+
+}  // namespace
+}  // namespace geomip

@@ -29,6 +29,7 @@ struct Band {
   int patch = 0, k = 0, orient = 0;  // orient 0: coarse, 1: row details, 2: column details, 3: diagonal
   int cls = 0, kcls = 0, offset = 0;
   int x0 = 0, y0 = 0, dx = 1, dy = 1, w = 0, h = 0;
+  int start = -1;  // deferred band: first weighted plane coded (−1: from the top)
   int levels = 0;
   int lw[kMaxQuadLevels] = {}, lh[kMaxQuadLevels] = {};
   std::size_t lbase[kMaxQuadLevels] = {};
@@ -85,6 +86,9 @@ struct Stop {};     // the partial tail is exhausted
 struct Corrupt {};  // bytes that no encoder writes
 
 bool layout_ok(const BitplaneLayout& layout) {
+  for (int v : layout.start_plane) {
+    if (v < -1 || v > 64) return false;
+  }
   return layout.level >= 0 && layout.level <= 12 && layout.steps >= 0 && layout.steps <= layout.level &&
          layout.num_patches >= 1 && layout.joint_segments >= 0;
 }
@@ -107,7 +111,7 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
     b.orient = 0;
     b.cls = 0;
     b.kcls = 2;
-    b.offset = steps;
+    b.offset = band_offset(layout, b.k, 0);
     b.dx = b.dy = 1 << steps;
     b.w = b.h = (size - 1) / b.dx + 1;
     bands.push_back(std::move(b));
@@ -122,7 +126,8 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
         b.orient = orient;
         b.cls = orient == 3 ? 2 : 1;
         b.kcls = std::min(k - 1, 2);
-        b.offset = k - 1;
+        b.offset = band_offset(layout, k, orient);
+        b.start = layout.start_plane[static_cast<std::size_t>(k)];
         b.dx = b.dy = 2 * s;
         const bool odd_x = orient != 2, odd_y = orient != 1;
         b.x0 = odd_x ? s : 0;
@@ -209,7 +214,7 @@ class PlaneCoder {
     for (Band* bp : mine_) {
       Band& band = *bp;
       const int p = b - band.offset;
-      if (p < 0 || band.lis.empty()) continue;
+      if (p < 0 || band.lis.empty() || (band.start >= 0 && b > band.start)) continue;
       band.lis_next.clear();
       // lis is swapped only after the loop; process() appends to lis_next only.
       for (std::size_t n = 0; n < band.lis.size(); ++n) {
@@ -425,12 +430,101 @@ class PlaneCoder {
   Context ref_ctx_[3];
 };
 
+/// The encoder's quadtree of highest set bits of band `b` (max over the three channels) from `cf`.
+void compute_msb(Band& b, const PatchCoefficients& cf, int size) {
+  b.msb.assign(b.state.size(), -1);
+  for (int y = 0; y < b.h; ++y) {
+    for (int x = 0; x < b.w; ++x) {
+      if (!(b.state[b.node(0, x, y)] & kActive)) continue;
+      const std::uint32_t index = b.grid_index(x, y, size);
+      std::int64_t m = 0;
+      for (int c = 0; c < 3; ++c) m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
+      if (m >= (std::int64_t{1} << (kMaxCoefficientPlane + 1))) {
+        throw std::invalid_argument("encode_bitplanes: coefficient magnitude " + std::to_string(m) +
+                                    " too large");
+      }
+      b.msb[b.node(0, x, y)] = static_cast<std::int8_t>(std::bit_width(static_cast<std::uint64_t>(m)) - 1);
+    }
+  }
+  for (int l = 1; l < b.levels; ++l) {
+    for (int y = 0; y < b.lh[l - 1]; ++y) {
+      for (int x = 0; x < b.lw[l - 1]; ++x) {
+        auto& parent = b.msb[b.node(l, x >> 1, y >> 1)];
+        parent = std::max(parent, b.msb[b.node(l - 1, x, y)]);
+      }
+    }
+  }
+}
+
+/// The decoder's reconstruction of one coefficient known down to plain plane q (all bits ≥ q): zero when
+/// insignificant, else the middle of the remaining interval (see the header).
+inline std::int32_t known_value(std::int32_t v, int q) {
+  if (q <= 0) return v;
+  const std::int64_t m = std::abs(static_cast<std::int64_t>(v));
+  if ((m >> q) == 0) return 0;
+  const std::int64_t r = ((m >> q) << q) + (std::int64_t{1} << (q - 1));
+  return static_cast<std::int32_t>(v < 0 ? -r : r);
+}
+
+/// What decode_bitplanes() outputs after every weighted plane above `plane`, computed by the encoder from the
+/// exact coefficients.
+std::vector<PatchCoefficients> encoder_view(const std::vector<Band>& bands,
+                                            const std::vector<PatchCoefficients>& cf, int plane, int size) {
+  const std::size_t samples = static_cast<std::size_t>(size) * size;
+  std::vector<PatchCoefficients> view(cf.size());
+  for (auto& pc : view) {
+    for (auto& ch : pc) ch.assign(samples, 0);
+  }
+  for (const Band& b : bands) {
+    if (b.start >= 0 && b.start <= plane) continue;  // no plane of it coded yet
+    const int q = plane + 1 - b.offset;
+    for (int y = 0; y < b.h; ++y) {
+      for (int x = 0; x < b.w; ++x) {
+        if (!(b.state[b.node(0, x, y)] & kActive)) continue;
+        const std::uint32_t index = b.grid_index(x, y, size);
+        for (int c = 0; c < 3; ++c) view[b.patch][c][index] = known_value(cf[b.patch][c][index], q);
+      }
+    }
+  }
+  return view;
+}
+
+/// The decoder's reconstruction of the significant samples of `band` into `patch` (zero-filled before).
+void reconstruct_band(const Band& band, PatchCoefficients& patch) {
+  for (const Sample& sm : band.lsp) {
+    for (int ch = 0; ch < 3; ++ch) {
+      if (!(sm.flags & (1 << ch))) continue;
+      // The middle of the interval [mag, mag + 2^q) (see the header).
+      const std::int64_t v = static_cast<std::int64_t>(sm.mag[ch]) +
+                             (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
+      patch[ch][sm.index] = static_cast<std::int32_t>((sm.flags >> (3 + ch)) & 1 ? -v : v);
+    }
+  }
+}
+
+/// The distinct start planes of deferred steps that are ≤ top, most significant first.
+std::vector<int> hook_planes(const BitplaneLayout& layout, int top) {
+  std::vector<int> planes;
+  for (int k = 1; k <= layout.steps; ++k) {
+    const int v = layout.start_plane[static_cast<std::size_t>(k)];
+    if (v >= 0 && v <= top && std::find(planes.begin(), planes.end(), v) == planes.end()) planes.push_back(v);
+  }
+  std::sort(planes.begin(), planes.end(), std::greater<int>());
+  return planes;
+}
+
 }  // namespace
+
+int band_offset(const BitplaneLayout& layout, int k, int orient) {
+  const int w = layout.orientation_weights ? 1 : 0;
+  if (orient == 0) return layout.steps + w;
+  return k - 1 + (orient != 3 ? w : 0);
+}
 
 BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
                                   const std::vector<PatchCoefficients>& coefficients,
                                   const std::vector<std::vector<std::uint8_t>>& coded,
-                                  std::size_t joint_bytes) {
+                                  std::size_t joint_bytes, const EncodeHook& before_plane) {
   if (!layout_ok(layout)) throw std::invalid_argument("encode_bitplanes: layout out of range");
   const std::size_t size = (std::size_t{1} << layout.level) + 1, samples = size * size;
   if (coefficients.size() != static_cast<std::size_t>(layout.num_patches) ||
@@ -446,38 +540,30 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
     }
   }
   std::vector<Band> bands = make_bands(layout, coded);
+  // The coder's own copy: the hook may change the coefficients of the bands that start at its plane.
+  std::vector<PatchCoefficients> coefs = coefficients;
   int top = 0;
   for (auto& b : bands) {
-    b.msb.assign(b.state.size(), -1);
-    const auto& cf = coefficients[b.patch];
-    for (int y = 0; y < b.h; ++y) {
-      for (int x = 0; x < b.w; ++x) {
-        if (!(b.state[b.node(0, x, y)] & kActive)) continue;
-        const std::uint32_t index = b.grid_index(x, y, static_cast<int>(size));
-        std::int64_t m = 0;
-        for (int c = 0; c < 3; ++c)
-          m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
-        if (m >= (std::int64_t{1} << (kMaxCoefficientPlane + 1))) {
-          throw std::invalid_argument("encode_bitplanes: coefficient magnitude " + std::to_string(m) +
-                                      " too large");
-        }
-        b.msb[b.node(0, x, y)] = static_cast<std::int8_t>(std::bit_width(static_cast<std::uint64_t>(m)) - 1);
-      }
-    }
-    for (int l = 1; l < b.levels; ++l) {
-      for (int y = 0; y < b.lh[l - 1]; ++y) {
-        for (int x = 0; x < b.lw[l - 1]; ++x) {
-          auto& parent = b.msb[b.node(l, x >> 1, y >> 1)];
-          parent = std::max(parent, b.msb[b.node(l - 1, x, y)]);
-        }
-      }
-    }
-    top = std::max(top, b.msb[b.node(b.levels - 1, 0, 0)] + b.offset);
+    compute_msb(b, coefs[b.patch], static_cast<int>(size));
+    top = std::max(top, b.start >= 0 ? b.start : b.msb[b.node(b.levels - 1, 0, 0)] + b.offset);
   }
+  const std::vector<int> hooks = hook_planes(layout, top);
+  // Before coding `plane`: the hook for the bands that start there, and their new magnitudes.
+  const auto run_hook = [&](int plane) {
+    if (std::find(hooks.begin(), hooks.end(), plane) == hooks.end()) return;
+    if (before_plane) before_plane(plane, encoder_view(bands, coefs, plane, static_cast<int>(size)), coefs);
+    for (auto& b : bands) {
+      if (b.start != plane) continue;
+      compute_msb(b, coefs[b.patch], static_cast<int>(size));
+      const int msb = b.msb[b.node(b.levels - 1, 0, 0)];
+      if (msb >= 0 && msb + b.offset > plane)
+        throw std::logic_error("encode_bitplanes: a deferred band exceeds its start plane");
+    }
+  };
   BitplaneEncoding result;
   result.top_bitplane = top;
   // Joint planes first (all of them in version 1), then one coder per patch from the joint contexts.
-  PlaneCoder<false> joint(layout, bands, -1, &coefficients);
+  PlaneCoder<false> joint(layout, bands, -1, &coefs);
   std::size_t joint_total = 0;
   int plane = top;
   const auto stay_joint = [&] {
@@ -485,6 +571,7 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
     return joint_bytes > 0 ? joint_total < joint_bytes : result.joint_segments < layout.joint_segments;
   };
   for (; plane >= 0 && stay_joint(); --plane) {
+    run_hook(plane);
     ArithmeticEncoder enc;
     joint.set_encoder(&enc);
     joint.template code_plane<false>(plane);
@@ -499,10 +586,11 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
   std::vector<PlaneCoder<false>> coders;
   coders.reserve(static_cast<std::size_t>(np));
   for (int p = 0; p < np; ++p) {
-    coders.emplace_back(layout, bands, p, &coefficients);
+    coders.emplace_back(layout, bands, p, &coefs);
     coders.back().copy_contexts(joint);
   }
   for (; plane >= 0; --plane) {
+    run_hook(plane);
     std::vector<std::vector<std::uint8_t>> streams;
     for (auto& coder : coders) {
       ArithmeticEncoder enc;
@@ -652,7 +740,7 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,
                         std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
-                        BitplaneDecodeResult& result, int max_threads) {
+                        BitplaneDecodeResult& result, int max_threads, const DecodeHook& before_plane) {
   result = {};
   if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) ||
       top_bitplane < 0 || top_bitplane > 64) {
@@ -691,52 +779,87 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
   }
 
   std::vector<Band> bands = make_bands(layout, coded, -1, max_threads);
-  CoderOutcome joint_outcome;
-  PlaneCoder<true> joint_coder(layout, bands, -1, nullptr);
-  decode_planes(joint_coder, top_bitplane, 0, joint_parts, joint_outcome);
-  if (joint_outcome.error) std::rethrow_exception(joint_outcome.error);
-  if (joint_outcome.corrupt) status = Status::kCorrupt;
-  result.partial = joint_outcome.partial;
-  result.segments_complete = joint_outcome.planes_complete;
-  // The per-patch planes follow only a complete, clean joint part.
-  const bool fork = joint_outcome.planes_complete == joint && !joint_outcome.corrupt && !parts[0].empty();
-  std::vector<CoderOutcome> outcomes(static_cast<std::size_t>(np));
-  // Per patch, in parallel (patch 0 on this thread): its planes after the fork, then its reconstruction.
-  const auto run = [&](int c) {
-    CoderOutcome& outcome = outcomes[static_cast<std::size_t>(c)];
-    try {
-      if (fork) {
-        PlaneCoder<true> coder(layout, bands, c, nullptr);
-        coder.copy_contexts(joint_coder);
-        decode_planes(coder, top_bitplane, joint, parts[static_cast<std::size_t>(c)], outcome);
-      }
-      auto& patch = out[static_cast<std::size_t>(c)];
+  // Hooks of deferred steps: before segment top − plane. The segments are decoded in ranges between hooks
+  // (and the fork to per-patch coders); a hook runs only when every plane above it was decoded completely.
+  const std::vector<int> hooks = hook_planes(layout, top_bitplane);
+  // Segments that can be decoded: the joint ones and the per-patch ones before a segment that did not split.
+  const std::size_t decodable = joint + parts[0].size();
+  std::vector<std::size_t> cuts = {0, joint, decodable};
+  for (int h : hooks) cuts.push_back(static_cast<std::size_t>(top_bitplane - h));
+  std::sort(cuts.begin(), cuts.end());
+  cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+  const auto view = [&] {
+    std::vector<PatchCoefficients> v(static_cast<std::size_t>(np));
+    parallel_for(np, max_threads, [&](int c) {
+      auto& patch = v[static_cast<std::size_t>(c)];
       for (auto& ch : patch) ch.assign(samples, 0);
       for (const auto& band : bands) {
-        if (band.patch != c) continue;
-        for (const Sample& sm : band.lsp) {
-          for (int ch = 0; ch < 3; ++ch) {
-            if (!(sm.flags & (1 << ch))) continue;
-            // The middle of the interval [mag, mag + 2^q) (see the header).
-            const std::int64_t v = static_cast<std::int64_t>(sm.mag[ch]) +
-                                   (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
-            patch[ch][sm.index] = static_cast<std::int32_t>((sm.flags >> (3 + ch)) & 1 ? -v : v);
-          }
-        }
+        if (band.patch == c) reconstruct_band(band, patch);
       }
-    } catch (...) {
-      outcome.error = std::current_exception();  // rethrown below, on the caller's thread
-    }
+    });
+    return v;
   };
-  parallel_for(np, max_threads, run);
-  std::size_t complete = planes;
-  for (const CoderOutcome& o : outcomes) {
-    if (o.error) std::rethrow_exception(o.error);
-    if (o.corrupt) status = Status::kCorrupt;
-    complete = std::min(complete, o.planes_complete);
-    result.partial = result.partial || o.partial;
+  CoderOutcome joint_outcome;
+  PlaneCoder<true> joint_coder(layout, bands, -1, nullptr);
+  std::vector<CoderOutcome> outcomes(static_cast<std::size_t>(np));
+  std::vector<PlaneCoder<true>> coders;  // per patch, made at the fork
+  bool fork = false;
+  for (std::size_t r = 0; r + 1 < cuts.size(); ++r) {
+    const std::size_t a = cuts[r], b = cuts[r + 1];
+    if (a >= decodable) break;
+    for (int h : hooks) {
+      if (static_cast<std::size_t>(top_bitplane - h) == a && before_plane) before_plane(h, view());
+    }
+    if (a < joint) {
+      std::vector<StreamPart> slice(joint_parts.begin() + static_cast<std::ptrdiff_t>(a),
+                                    joint_parts.begin() + static_cast<std::ptrdiff_t>(b));
+      decode_planes(joint_coder, top_bitplane, a, slice, joint_outcome);
+      if (joint_outcome.error) std::rethrow_exception(joint_outcome.error);
+      if (joint_outcome.corrupt) status = Status::kCorrupt;
+      result.partial = joint_outcome.partial;
+      result.segments_complete = joint_outcome.planes_complete;
+      if (joint_outcome.planes_complete != b || joint_outcome.corrupt) break;
+      continue;
+    }
+    // The per-patch planes follow only a complete, clean joint part.
+    if (!fork) {
+      fork = true;
+      coders.reserve(static_cast<std::size_t>(np));
+      for (int c = 0; c < np; ++c) {
+        coders.emplace_back(layout, bands, c, nullptr);
+        coders.back().copy_contexts(joint_coder);
+      }
+    }
+    parallel_for(np, max_threads, [&](int c) {
+      CoderOutcome& outcome = outcomes[static_cast<std::size_t>(c)];
+      try {
+        const auto& mine = parts[static_cast<std::size_t>(c)];
+        std::vector<StreamPart> slice(mine.begin() + static_cast<std::ptrdiff_t>(a - joint),
+                                      mine.begin() + static_cast<std::ptrdiff_t>(b - joint));
+        decode_planes(coders[static_cast<std::size_t>(c)], top_bitplane, a, slice, outcome);
+      } catch (...) {
+        outcome.error = std::current_exception();  // rethrown below, on the caller's thread
+      }
+    });
+    std::size_t complete = planes;
+    bool stop = false;
+    for (const CoderOutcome& o : outcomes) {
+      if (o.error) std::rethrow_exception(o.error);
+      if (o.corrupt) status = Status::kCorrupt, stop = true;
+      complete = std::min(complete, o.planes_complete);
+      result.partial = result.partial || o.partial;
+    }
+    result.segments_complete = joint + complete;
+    if (stop || joint + complete != b) break;
   }
-  if (fork) result.segments_complete = joint + complete;
+  // The reconstruction of every patch, in parallel.
+  parallel_for(np, max_threads, [&](int c) {
+    auto& patch = out[static_cast<std::size_t>(c)];
+    for (auto& ch : patch) ch.assign(samples, 0);
+    for (const auto& band : bands) {
+      if (band.patch == c) reconstruct_band(band, patch);
+    }
+  });
   return status;
 }
 

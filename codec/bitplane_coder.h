@@ -60,6 +60,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -82,7 +83,22 @@ struct BitplaneLayout {
   /// With independent_patches: the first joint_segments segments are one joint stream (as version 1), then
   /// every patch coder continues from the joint coder's contexts (≥ 0).
   int joint_segments = 0;
+  /// Orientation weights (codec header version 3): row- and column-detail bands (and the coarse band) are
+  /// weighted one bit-plane above the diagonal ones of the same step (their synthesis norms differ by about
+  /// √2; see band_offset()). false: all orientations alike (versions 1 and 2).
+  bool orientation_weights = false;
+  /// Deferred steps (codec header version 3): start_plane[k] ≥ 0 (k = 1..steps) makes the detail bands of
+  /// step k skip every weighted plane above start_plane[k] (they are not tested at all there); −1: coded from
+  /// the top as usual. Before the first plane ≤ top that is some step's start plane, the encoder and the
+  /// decoder call their `before_plane` hooks (see encode_bitplanes()), which is where geometry_codec puts
+  /// the local frames of those steps' coefficients.
+  std::array<int, 13> start_plane = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
 };
+
+/// Weighted offset of a band: its plain bit-plane p is coded in weighted plane p + offset. Coarse band
+/// (orient 0, k = steps + 1): steps (+1 with orientation_weights); detail band of step k (orient 1 row, 2
+/// column, 3 diagonal): k − 1, +1 for rows and columns with orientation_weights.
+int band_offset(const BitplaneLayout& layout, int k, int orient);
 
 /// Largest plain bit-plane a coefficient may reach: magnitudes must stay below 2^(kMaxCoefficientPlane + 1).
 inline constexpr int kMaxCoefficientPlane = 29;
@@ -98,10 +114,18 @@ struct BitplaneEncoding {
 /// on inconsistent sizes or a coefficient magnitude ≥ 2^(kMaxCoefficientPlane+1). `joint_bytes` > 0
 /// (independent patches only): instead of layout.joint_segments, code planes jointly until they hold at
 /// least that many bytes; the count is returned in BitplaneEncoding::joint_segments.
+///
+/// Deferred steps (layout.start_plane): `before_plane(plane, view, coefficients)` is called before coding
+/// each weighted plane that is some step's start plane, with `view` the decoder's reconstruction of every
+/// coefficient at that point (what decode_bitplanes() would output given the planes above: zero for
+/// deferred bands not yet started) and the encoder's own copy of the coefficients, which the hook may change
+/// for the bands starting at this plane (their magnitudes must stay below 2^(plane − offset + 1)).
+using EncodeHook = std::function<void(int plane, const std::vector<PatchCoefficients>& view,
+                                      std::vector<PatchCoefficients>& coefficients)>;
 BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
                                   const std::vector<PatchCoefficients>& coefficients,
                                   const std::vector<std::vector<std::uint8_t>>& coded,
-                                  std::size_t joint_bytes = 0);
+                                  std::size_t joint_bytes = 0, const EncodeHook& before_plane = {});
 
 struct BitplaneDecodeResult {
   std::size_t segments_complete = 0;  ///< complete segments decoded
@@ -115,10 +139,13 @@ struct BitplaneDecodeResult {
 /// (more segments than planes, a tail after the last plane, stream sizes that do not fit their segment, a
 /// coefficient beyond kMaxCoefficientPlane); never throws on bytes, never reads outside them, and always
 /// leaves `out` holding the reconstruction of what was decoded.
+/// Deferred steps: `before_plane(plane, view)` is called, once all planes above were decoded completely, before
+/// decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got.
+using DecodeHook = std::function<void(int plane, const std::vector<PatchCoefficients>& view)>;
 Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,
                         std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
-                        BitplaneDecodeResult& result, int max_threads = 0);
+                        BitplaneDecodeResult& result, int max_threads = 0, const DecodeHook& before_plane = {});
 
 }  // namespace geomip::codec

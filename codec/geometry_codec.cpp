@@ -3,6 +3,7 @@
 #include "codec/parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -16,8 +17,10 @@
 namespace geomip::codec {
 namespace {
 
-// Version 1: one joint bit-plane stream for all patches; version 2: a stream per patch (parallel decoding).
-constexpr std::uint8_t kHeaderVersion = 2;
+// Version 1: one joint bit-plane stream for all patches; version 2: a stream per patch (parallel decoding);
+// version 3: version 2 plus local frames and orientation weights.
+constexpr std::uint8_t kHeaderVersion = 3;
+constexpr int kMaxTangentialShift = 8;
 constexpr int kMaxLevel = 12;
 constexpr int kMaxTopBitplane = 48;
 constexpr std::uint64_t kMaxTotalSamples = std::uint64_t{1} << 26;  // patches · (2^level+1)²
@@ -129,6 +132,13 @@ bool header_ok(const GeometryCodecHeader& h) {
   if (h.joint_segments < 0 || h.joint_segments > h.top_bitplane + 1 ||
       (h.version < 2 && h.joint_segments != 0))
     return false;
+  if (h.version < 3 && (h.orientation_weights || h.frame_steps != 0 || h.tangential_shift != 0)) return false;
+  if (h.frame_steps < 0 || h.frame_steps > h.steps || h.tangential_shift < 0 ||
+      h.tangential_shift > kMaxTangentialShift || h.frame_start.size() != static_cast<std::size_t>(h.frame_steps))
+    return false;
+  for (int v : h.frame_start) {
+    if (v < 0 || v > h.top_bitplane) return false;
+  }
   if (h.seams.size() > 4 * static_cast<std::size_t>(h.num_patches)) return false;
   for (const auto& s : h.seams) {
     if (!seam_ok(s, h.num_patches)) return false;
@@ -193,6 +203,213 @@ class Reader {
   std::size_t pos_ = 0;
 };
 
+// ---- Local frames (version 3) ----------------------------------------------------------------------------
+// A frame is three integer rows (normal, tangent, bitangent), each about 2^kFrameBits times a unit vector,
+// built with integer arithmetic only from the decoder's reconstruction, so encoder and decoder (native or
+// WASM) get bit-identical frames.
+constexpr int kFrameBits = 14;
+using Frame = std::array<std::int32_t, 9>;
+
+/// floor(√v), exact (integer Newton iteration).
+std::uint64_t isqrt(std::uint64_t v) {
+  if (v < 2) return v;
+  std::uint64_t x = std::uint64_t{1} << ((std::bit_width(v) + 1) / 2);  // ≥ √v
+  while (true) {
+    const std::uint64_t y = (x + v / x) / 2;
+    if (y >= x) return x;
+    x = y;
+  }
+}
+
+/// round(num / den) for den > 0, halves up (floor((2·num + den) / (2·den))).
+std::int64_t round_div(std::int64_t num, std::int64_t den) {
+  const std::int64_t a = 2 * num + den, b = 2 * den;
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+
+/// round(v / 2^s), halves up (s ≥ 0).
+std::int64_t round_shift(std::int64_t v, int s) {
+  return s == 0 ? v : (v + (std::int64_t{1} << (s - 1))) >> s;
+}
+
+/// The frame whose normal is N (any length; identity rows for N = 0).
+Frame make_frame(std::int64_t n0, std::int64_t n1, std::int64_t n2) {
+  constexpr std::int32_t one = 1 << kFrameBits;
+  while (std::max({std::abs(n0), std::abs(n1), std::abs(n2)}) >= (std::int64_t{1} << 20)) {
+    n0 >>= 1, n1 >>= 1, n2 >>= 1;
+  }
+  const std::uint64_t len = isqrt(static_cast<std::uint64_t>(n0 * n0 + n1 * n1 + n2 * n2));
+  if (len == 0) return {one, 0, 0, 0, one, 0, 0, 0, one};
+  const std::int64_t n[3] = {round_div(n0 * one, static_cast<std::int64_t>(len)),
+                             round_div(n1 * one, static_cast<std::int64_t>(len)),
+                             round_div(n2 * one, static_cast<std::int64_t>(len))};
+  // Tangent: n × e_a, a the axis of n's smallest component (first on ties): never shorter than |n|·√(2/3).
+  int a = 0;
+  for (int c = 1; c < 3; ++c) {
+    if (std::abs(n[c]) < std::abs(n[a])) a = c;
+  }
+  std::int64_t t[3] = {0, 0, 0};
+  t[(a + 1) % 3] = n[(a + 2) % 3];
+  t[(a + 2) % 3] = -n[(a + 1) % 3];
+  const std::int64_t b[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]};
+  const auto unit = [](const std::int64_t* v, std::int32_t* out) {
+    const std::uint64_t l = isqrt(static_cast<std::uint64_t>(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    for (int c = 0; c < 3; ++c)
+      out[c] = l == 0 ? 0 : static_cast<std::int32_t>(round_div(v[c] * one, static_cast<std::int64_t>(l)));
+  };
+  Frame f;
+  for (int c = 0; c < 3; ++c) f[static_cast<std::size_t>(c)] = static_cast<std::int32_t>(n[c]);
+  unit(t, f.data() + 3);
+  unit(b, f.data() + 6);
+  return f;
+}
+
+/// The local frames of one model: per patch and grid index (filled at the framed positions of the steps
+/// whose frames were computed).
+struct FrameField {
+  int level = 0, steps = 0, frame_steps = 0, tangential_shift = 0;
+  WaveletFilter filter = WaveletFilter::kCubic;
+  const Ownership* own = nullptr;
+  std::vector<int> start;                  // start plane of step k at [k − 1]
+  std::vector<std::vector<Frame>> frames;  // [patch][grid index]
+  std::vector<std::uint8_t> ready;         // [k − 1]: frames of step k computed
+
+  /// Calls f(i, j, index) for every detail position of step k.
+  template <typename F>
+  void for_step(int k, F&& f) const {
+    const int m = 1 << level, s = 1 << (k - 1), size = m + 1;
+    for (int j = 0; j <= m; j += s) {
+      const bool odd_row = (j / s) & 1;
+      for (int i = odd_row ? 0 : s; i <= m; i += odd_row ? s : 2 * s) f(i, j, j * size + i);
+    }
+  }
+
+  /// Framed coefficients (n, t1, t2) of the ready steps, at coded positions, back to xyz (steps ≥ min_k).
+  void to_xyz(std::vector<PatchCoefficients>& coefs, int min_k = 1) const {
+    for (std::size_t p = 0; p < coefs.size(); ++p) {
+      for (int k = std::max(min_k, 1); k <= frame_steps; ++k) {
+        if (!ready[static_cast<std::size_t>(k - 1)]) continue;
+        for_step(k, [&](int, int, int idx) {
+          if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
+          const Frame& f = frames[p][static_cast<std::size_t>(idx)];
+          std::int64_t w[3];
+          for (int r = 0; r < 3; ++r) w[r] = coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)];
+          w[1] *= std::int64_t{1} << tangential_shift;
+          w[2] *= std::int64_t{1} << tangential_shift;
+          for (int c = 0; c < 3; ++c) {
+            const std::int64_t v = static_cast<std::int64_t>(f[static_cast<std::size_t>(c)]) * w[0] +
+                                   static_cast<std::int64_t>(f[static_cast<std::size_t>(3 + c)]) * w[1] +
+                                   static_cast<std::int64_t>(f[static_cast<std::size_t>(6 + c)]) * w[2];
+            coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)] =
+                static_cast<std::int32_t>(static_cast<std::uint32_t>(round_shift(v, kFrameBits)));
+          }
+        });
+      }
+    }
+  }
+
+  /// The frames of the steps that start at `plane`, from `view` (the decoder's coefficients before that
+  /// plane): framed steps already started go back to xyz, seam copies are filled, and the grid at the
+  /// spacing of the finest such step is reconstructed; the normal at a detail of step k (spacing s) is the
+  /// cross product of the central differences (i ± s, j) and (i, j ± s) of that reconstruction (one-sided on
+  /// the border).
+  void compute(int plane, const std::vector<PatchCoefficients>& view) {
+    int min_k = 0;
+    for (int k = frame_steps; k >= 1; --k) {
+      if (start[static_cast<std::size_t>(k - 1)] == plane) min_k = k;
+    }
+    if (min_k == 0) return;
+    std::vector<PatchCoefficients> w = view;
+    to_xyz(w, min_k);
+    const std::size_t size = (std::size_t{1} << level) + 1, samples = size * size;
+    for (const auto& [copy, owner] : own->copies) {
+      for (int c = 0; c < 3; ++c) w[copy / samples][c][copy % samples] = w[owner / samples][c][owner % samples];
+    }
+    const int s = 1 << (min_k - 1), sub_level = level - (min_k - 1), sub_steps = steps - (min_k - 1);
+    const std::size_t sub = (std::size_t{1} << sub_level) + 1;
+    const int m = 1 << level;
+    for (std::size_t p = 0; p < w.size(); ++p) {
+      std::array<std::vector<std::int32_t>, 3> g;
+      for (int c = 0; c < 3; ++c) {
+        g[c].resize(sub * sub);
+        for (std::size_t y = 0; y < sub; ++y) {
+          for (std::size_t x = 0; x < sub; ++x) g[c][y * sub + x] = w[p][c][(y * s) * size + x * s];
+        }
+        wavelet_inverse(g[c], sub_level, sub_steps, filter);
+      }
+      const auto at = [&](int c, int i, int j) {
+        return static_cast<std::int64_t>(g[c][static_cast<std::size_t>(j / s) * sub + static_cast<std::size_t>(i / s)]);
+      };
+      for (int k = min_k; k <= frame_steps; ++k) {
+        if (start[static_cast<std::size_t>(k - 1)] != plane) continue;
+        const int d = 1 << (k - 1);
+        for_step(k, [&](int i, int j, int idx) {
+          if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
+          const int i0 = std::max(i - d, 0), i1 = std::min(i + d, m), j0 = std::max(j - d, 0), j1 = std::min(j + d, m);
+          std::int64_t a[3], b[3];
+          for (int c = 0; c < 3; ++c) {
+            a[c] = at(c, i1, j) - at(c, i0, j);
+            b[c] = at(c, i, j1) - at(c, i, j0);
+          }
+          frames[p][static_cast<std::size_t>(idx)] =
+              make_frame(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]);
+        });
+      }
+    }
+    for (int k = min_k; k <= frame_steps; ++k) {
+      if (start[static_cast<std::size_t>(k - 1)] == plane) ready[static_cast<std::size_t>(k - 1)] = 1;
+    }
+  }
+
+  /// Encoder: the xyz coefficients of the steps starting at `plane` into their frames (n, t1, t2), the
+  /// tangential ones shifted.
+  void to_frames(int plane, std::vector<PatchCoefficients>& coefs) const {
+    for (std::size_t p = 0; p < coefs.size(); ++p) {
+      for (int k = 1; k <= frame_steps; ++k) {
+        if (start[static_cast<std::size_t>(k - 1)] != plane) continue;
+        for_step(k, [&](int, int, int idx) {
+          if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
+          const Frame& f = frames[p][static_cast<std::size_t>(idx)];
+          std::int64_t d[3];
+          for (int c = 0; c < 3; ++c) d[c] = coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)];
+          for (int r = 0; r < 3; ++r) {
+            const std::int64_t v = static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r)]) * d[0] +
+                                   static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r + 1)]) * d[1] +
+                                   static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r + 2)]) * d[2];
+            coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)] = static_cast<std::int32_t>(
+                round_shift(round_shift(v, kFrameBits), r == 0 ? 0 : tangential_shift));
+          }
+        });
+      }
+    }
+  }
+};
+
+FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) {
+  FrameField ff;
+  ff.level = h.level;
+  ff.steps = h.steps;
+  ff.frame_steps = h.frame_steps;
+  ff.tangential_shift = h.tangential_shift;
+  ff.filter = h.filter;
+  ff.own = &own;
+  ff.start = h.frame_start;
+  ff.ready.assign(static_cast<std::size_t>(h.frame_steps), 0);
+  if (h.frame_steps > 0) {
+    const std::size_t size = static_cast<std::size_t>(grid_size(h.level));
+    ff.frames.assign(static_cast<std::size_t>(h.num_patches), std::vector<Frame>(size * size));
+  }
+  return ff;
+}
+
+BitplaneLayout make_layout(const GeometryCodecHeader& h) {
+  BitplaneLayout layout{h.level, h.steps, h.num_patches, h.version >= 2, h.joint_segments};
+  layout.orientation_weights = h.orientation_weights;
+  for (int k = 1; k <= h.frame_steps && k <= static_cast<int>(h.frame_start.size()); ++k)
+    layout.start_plane[static_cast<std::size_t>(k)] = h.frame_start[static_cast<std::size_t>(k - 1)];
+  return layout;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> GeometryCodecHeader::serialize() const {
@@ -206,6 +423,12 @@ std::vector<std::uint8_t> GeometryCodecHeader::serialize() const {
   put_double(out, step);
   put_varint(out, static_cast<std::uint64_t>(top_bitplane));
   if (version >= 2) put_varint(out, static_cast<std::uint64_t>(joint_segments));
+  if (version >= 3) {
+    out.push_back(orientation_weights ? 1 : 0);
+    put_varint(out, static_cast<std::uint64_t>(frame_steps));
+    put_varint(out, static_cast<std::uint64_t>(tangential_shift));
+    for (int v : frame_start) put_varint(out, static_cast<std::uint64_t>(v));
+  }
   put_varint(out, seams.size());
   for (const auto& s : seams) {
     put_varint(out, static_cast<std::uint64_t>(s.patch));
@@ -231,10 +454,22 @@ Status GeometryCodecHeader::parse(std::span<const std::uint8_t> bytes, GeometryC
   }
   int num_seams = 0;
   if (!r.f64(h.step) || !r.small_int(h.top_bitplane, kMaxTopBitplane) ||
-      (h.version >= 2 && !r.small_int(h.joint_segments, kMaxTopBitplane + 1)) ||
-      !r.small_int(num_seams, 1 << 22)) {
+      (h.version >= 2 && !r.small_int(h.joint_segments, kMaxTopBitplane + 1))) {
     return Status::kCorrupt;
   }
+  if (h.version >= 3) {
+    std::uint8_t flags;
+    if (!r.byte(flags) || flags > 1 || !r.small_int(h.frame_steps, kMaxLevel) ||
+        !r.small_int(h.tangential_shift, kMaxTangentialShift)) {
+      return Status::kCorrupt;
+    }
+    h.orientation_weights = flags == 1;
+    h.frame_start.resize(static_cast<std::size_t>(h.frame_steps));
+    for (int& v : h.frame_start) {
+      if (!r.small_int(v, kMaxTopBitplane)) return Status::kCorrupt;
+    }
+  }
+  if (!r.small_int(num_seams, 1 << 22)) return Status::kCorrupt;
   if (num_seams > 4 * h.num_patches) return Status::kCorrupt;
   h.seams.resize(static_cast<std::size_t>(num_seams));
   for (auto& s : h.seams) {
@@ -271,6 +506,10 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   }
   if (options.steps < -1 || options.steps > level) {
     throw std::invalid_argument("encode_geometry: steps must be -1 or in [0, level]");
+  }
+  if (options.frame_steps < 0 || options.frame_steps > kMaxLevel || options.tangential_shift < 0 ||
+      options.tangential_shift > kMaxTangentialShift) {
+    throw std::invalid_argument("encode_geometry: frame_steps or tangential_shift out of range");
   }
   const int np = static_cast<int>(patches.size());
   if (seams.size() > 4 * patches.size())
@@ -326,10 +565,43 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
     for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter);
   }
   h.version = kHeaderVersion;
+  h.orientation_weights = options.orientation_weights;
+  h.frame_steps = std::min(options.frame_steps, h.steps);
+  h.tangential_shift = h.frame_steps > 0 ? options.tangential_shift : 0;
+  // Start plane of the framed details of step k: one plane above the top of their xyz magnitudes (a frame
+  // rotation lengthens no component by more than √3, rounding included, so the framed magnitudes fit).
+  FrameField ff = make_frame_field(h, own);
+  {
+    BitplaneLayout probe = make_layout(h);
+    for (int k = 1; k <= h.frame_steps; ++k) {
+      int start = 0;
+      const int s = 1 << (k - 1);
+      for (int p = 0; p < np; ++p) {
+        ff.for_step(k, [&](int i, int j, int idx) {
+          if (!own.coded[static_cast<std::size_t>(p)][static_cast<std::size_t>(idx)]) return;
+          std::int64_t mx = 0;
+          for (int c = 0; c < 3; ++c) mx = std::max<std::int64_t>(mx, std::abs(static_cast<std::int64_t>(coefs[p][c][idx])));
+          if (mx == 0) return;
+          const bool odd_x = (i / s) & 1, odd_y = (j / s) & 1;
+          const int orient = odd_x && odd_y ? 3 : (odd_x ? 1 : 2);
+          start = std::max(start, static_cast<int>(std::bit_width(static_cast<std::uint64_t>(mx))) +
+                                      band_offset(probe, k, orient));
+        });
+      }
+      h.frame_start.push_back(start);
+    }
+  }
+  ff.start = h.frame_start;
   // joint_bytes 0 means per patch from the first plane: a joint_segments of 0 (encode_bitplanes reads 0 as
   // "no automatic choice").
-  BitplaneEncoding enc =
-      encode_bitplanes({level, h.steps, np, true, 0}, coefs, own.coded, options.joint_bytes);
+  BitplaneLayout layout = make_layout(h);
+  layout.joint_segments = 0;
+  const EncodeHook hook = [&](int plane, const std::vector<PatchCoefficients>& view,
+                              std::vector<PatchCoefficients>& cf) {
+    ff.compute(plane, view);
+    ff.to_frames(plane, cf);
+  };
+  BitplaneEncoding enc = encode_bitplanes(layout, coefs, own.coded, options.joint_bytes, hook);
   h.top_bitplane = enc.top_bitplane;
   h.joint_segments = enc.joint_segments;
   result.segments = std::move(enc.segments);
@@ -347,12 +619,14 @@ Status decode_geometry(const GeometryCodecHeader& header,
   const Ownership own = seam_ownership(level, np, header.seams);
   std::vector<PatchCoefficients> coefs;
   BitplaneDecodeResult r;
-  const Status status =
-      decode_bitplanes({level, steps, np, header.version >= 2, header.joint_segments}, header.top_bitplane,
-                       own.coded, segments, partial_tail, coefs, r, options.max_threads);
+  FrameField ff = make_frame_field(header, own);
+  const DecodeHook hook = [&](int plane, const std::vector<PatchCoefficients>& view) { ff.compute(plane, view); };
+  const Status status = decode_bitplanes(make_layout(header), header.top_bitplane, own.coded, segments,
+                                         partial_tail, coefs, r, options.max_threads, hook);
   out.segments_complete = r.segments_complete;
   out.partial = r.partial;
   if (coefs.size() != static_cast<std::size_t>(np)) return status == Status::kOk ? Status::kCorrupt : status;
+  ff.to_xyz(coefs);
   for (const auto& [copy, owner] : own.copies) {
     for (int c = 0; c < 3; ++c)
       coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];

@@ -62,14 +62,29 @@ struct GeometryCodecOptions {
   /// after that by one coder per patch, decoded in parallel (see bitplane_coder.h). 0: per patch from the
   /// first plane.
   std::size_t joint_bytes = 2048;
+  /// Local frames (codec header version 3; docs/codec-v3.md): the detail coefficients of the finest
+  /// `frame_steps` wavelet steps are coded as (normal, tangent, bitangent) components in an integer frame
+  /// built from the decoder's own reconstruction of the coarser surface (the normal of the surface the
+  /// coarser levels predict at that sample), identical on both sides (integer arithmetic only). 0: xyz
+  /// coefficients throughout (then full decoding is lossless up to the quantization); with frames it is
+  /// near-lossless (the frame rotation rounds: about one quantization step per coordinate, plus the
+  /// tangential shift below).
+  int frame_steps = 3;
+  /// Tangential components of framed coefficients are quantized 2^tangential_shift times coarser than the
+  /// normal one (they move samples along the surface and barely change the surface distance); in [0, 8].
+  int tangential_shift = 1;
+  /// Weight row and column detail bands one bit-plane above diagonal ones (their synthesis norms differ by
+  /// about √2; codec header version 3).
+  bool orientation_weights = true;
 };
 
 /// The small fixed parameters the decoder needs besides the segments (stored in the pack manifest).
 /// serialize()/parse() give a compact byte form; parse() never trusts bytes.
 struct GeometryCodecHeader {
   /// Stream layout: 1 = one joint stream for all patches (packs of format version 1), 2 = one stream per
-  /// patch in every segment, decoded in parallel (written by this encoder).
-  int version = 2;
+  /// patch in every segment, decoded in parallel, 3 = version 2 plus local frames and orientation weights
+  /// (written by this encoder).
+  int version = 3;
   int level = 0;        ///< grid level n of every patch
   int num_patches = 0;  ///< patches per model
   int steps = 0;        ///< wavelet steps actually applied
@@ -79,6 +94,12 @@ struct GeometryCodecHeader {
   int top_bitplane = 0;  ///< most significant (weighted) bit-plane coded; one segment per plane down to 0
   /// Version 2: the first joint_segments segments are one joint stream, the others per patch (≤ planes).
   int joint_segments = 0;
+  /// Version 3: see GeometryCodecOptions. frame_start[k − 1] (k = 1..frame_steps) is the weighted bit-plane
+  /// at which the framed details of step k start (≤ top_bitplane).
+  bool orientation_weights = false;
+  int frame_steps = 0;
+  int tangential_shift = 0;
+  std::vector<int> frame_start;
   std::vector<PatchSeam> seams;
 
   std::vector<std::uint8_t> serialize() const;

@@ -271,7 +271,7 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
         !r.bytes(header, 1 << 20) || GeometryCodecHeader::parse(header, model.geometry) != Status::kOk ||
         !r.u8(has_normals) || has_normals > 1)
       return Status::kCorrupt;
-    // Pack version 1 holds joint streams (codec header version 1), version 2 per-patch ones (version 2).
+    // Pack version v holds codec headers of version v (1: joint streams, 2: per-patch ones, 3: local frames).
     if (model.geometry.version != out.version) return Status::kCorrupt;
     if (model.geometry.level > kMaxPackLevel || passes_of(model.geometry) < 1 ||
         passes_of(model.geometry) > static_cast<int>(kMaxPasses))

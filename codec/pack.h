@@ -30,9 +30,10 @@
 namespace geomip::codec {
 
 inline constexpr std::size_t kPackHeaderSize = 20;
-/// Format version written. Version 2 (this one): bit-plane segments hold one stream per patch (codec header
-/// version 2), decoded in parallel. Version 1: one joint stream per segment; still read.
-inline constexpr std::uint16_t kPackVersion = 2;
+/// Format version written. Version 3 (this one): codec header version 3 (local frames, orientation weights;
+/// docs/codec-v3.md). Version 2: bit-plane segments hold one stream per patch (codec header version 2),
+/// decoded in parallel. Version 1: one joint stream per segment. Versions 1 and 2 are still read.
+inline constexpr std::uint16_t kPackVersion = 3;
 inline constexpr std::uint16_t kOldestPackVersion = 1;
 
 enum class ChunkKind : std::uint8_t {
@@ -98,7 +99,9 @@ struct PackModelInput {
 
 struct PackWriteOptions {
   GeometryCodecOptions geometry;  ///< defaults: 14 bits, cubic interpolating wavelet
-  GeometryCodecOptions normal_codec{.quantization_bits = 10, .filter = WaveletFilter::kCubic, .steps = -1};
+  /// Normal maps: no local frames (they are unit vectors, not displacements on a surface).
+  GeometryCodecOptions normal_codec{.quantization_bits = 10, .filter = WaveletFilter::kCubic, .steps = -1,
+                                    .frame_steps = 0, .tangential_shift = 0, .orientation_weights = false};
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.
   int normals_delay = 4;

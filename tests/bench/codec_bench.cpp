@@ -5,13 +5,13 @@
 //
 // Rate–distortion report instead of benchmarks:
 //   codec_bench --rd FILE.geometry.exr|synthetic [--filter linear|cubic|both] [--steps N] [--bits B] [--mesh
-//   M | --surface on]
+//   M | --surface on] [--frames K] [--tshift T] [--orient 0|1]
 // reads a geometry image written by `geomip gimage`, encodes it and prints, for byte budgets (prefixes of the
 // concatenated segments), the grid RMS error (per-sample Euclidean distance) and the grid PSNR
 // 20·log10(bbox diagonal / RMS), plus the full decode time; with --mesh, also the surface PSNR (Metro-style
 // symmetric RMS distance to mesh M, gimage/surface_distance.h) of the decoded grids; with --surface on, the
 // same against the uncompressed grids (the codec's own error, tangential displacement not counted).
-// CODEC_DUMP=PATH in the environment also writes the encoded stream (u32 header size, header, u32 segment
+// CODEC_BUDGETS=2000,4700,... in the environment measures only those byte budgets. CODEC_DUMP=PATH in the environment also writes the encoded stream (u32 header size, header, u32 segment
 // count, then u32 size + bytes per segment; little-endian) for decoder experiments outside this program.
 #include <benchmark/benchmark.h>
 
@@ -135,6 +135,7 @@ geomip::TriMesh grid_mesh(const std::vector<Grid3>& patches) {
 }
 
 const geomip::TriMesh* g_reference = nullptr;  // --mesh: surface PSNR against this mesh
+GeometryCodecOptions g_v3;  // --frames K --tshift T --orient 0|1: the version-3 tools (defaults: the codec's)
 
 double surface_psnr(const std::vector<Grid3>& patches) {
   geomip::SurfaceDistanceOptions o;
@@ -147,7 +148,7 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
   if (filters != "cubic") list.push_back(WaveletFilter::kLinear);
   if (filters != "linear") list.push_back(WaveletFilter::kCubic);
   for (auto filter : list) {
-    GeometryCodecOptions o;
+    GeometryCodecOptions o = g_v3;
     o.filter = filter;
     o.steps = steps;
     o.quantization_bits = bits;
@@ -176,8 +177,16 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
         filter == WaveletFilter::kCubic ? "cubic" : "linear", enc.header.level, m.patches.size(),
         enc.segments.size(), total, enc.header.serialize().size(),
         std::chrono::duration<double, std::milli>(t1 - t0).count());
-    std::vector<std::size_t> budgets = {256,   512,   1024,  2048,   4096,   8192,
-                                        16384, 32768, 65536, 131072, 262144, total};
+    std::vector<std::size_t> budgets = {256,   512,   1024,  2000,  2048,  4096,   4700,   8192,  8800,
+                                        16000, 16384, 32000, 32768, 65536, 131072, 262144, total};
+    if (const char* list = std::getenv("CODEC_BUDGETS")) {  // e.g. "2000,4700,8800": only these
+      budgets.clear();
+      for (const char* c = list; *c;) {
+        char* end;
+        budgets.push_back(std::strtoull(c, &end, 10));
+        c = *end ? end + 1 : end;
+      }
+    }
     for (std::size_t budget : budgets) {
       if (budget > total) continue;
       std::size_t left = budget, k = 0;
@@ -260,6 +269,9 @@ int main(int argc, char** argv) {
       if (std::strcmp(argv[i], "--filter") == 0) filters = argv[i + 1];
       if (std::strcmp(argv[i], "--steps") == 0) steps = std::atoi(argv[i + 1]);
       if (std::strcmp(argv[i], "--bits") == 0) bits = std::atoi(argv[i + 1]);
+      if (std::strcmp(argv[i], "--frames") == 0) g_v3.frame_steps = std::atoi(argv[i + 1]);
+      if (std::strcmp(argv[i], "--tshift") == 0) g_v3.tangential_shift = std::atoi(argv[i + 1]);
+      if (std::strcmp(argv[i], "--orient") == 0) g_v3.orientation_weights = std::atoi(argv[i + 1]) != 0;
       if (std::strcmp(argv[i], "--mesh") == 0) {
         reference = geomip::read_mesh(argv[i + 1]);
         g_reference = &reference;

@@ -76,6 +76,7 @@ TEST(GeometryCodec, AllSegmentsReconstructWithinHalfAStep) {
         GeometryCodecOptions options;
         options.filter = filter;
         options.steps = steps;
+        options.frame_steps = 0;  // lossless up to the quantization only in xyz (frames round)
         const auto enc = encode_geometry(patches, seams, options);
         DecodedGeometry dec;
         const auto segs = first_segments(enc, enc.segments.size());
@@ -93,10 +94,20 @@ TEST(GeometryCodec, AllSegmentsReconstructWithinHalfAStep) {
   }
 }
 
+// With the version-2 ordering (xyz, all orientations alike), more segments never increase the error. The
+// version-3 tools can raise it a little: orientation weights reorder bits across bands (measured on this
+// fixture: +1.6 % once in mid-stream, xyz or framed), frames round their rotation and drop the tangential
+// components' lowest bits (+2 % and +4 % in the last two segments).
 TEST(GeometryCodec, ErrorNeverIncreasesWithMoreSegments) {
+  for (int config = 0; config < 3; ++config) {
+  const int frames = config == 2 ? 3 : 0;
   std::vector<PatchSeam> seams;
   const auto patches = two_patch_surface(6, seams);
-  const auto enc = encode_geometry(patches, seams);
+  GeometryCodecOptions o;
+  o.frame_steps = frames;
+  o.orientation_weights = config > 0;
+  const auto enc = encode_geometry(patches, seams, o);
+  const double tolerance = config == 0 ? 1e-9 : 0.05;
   double previous = std::numeric_limits<double>::infinity();
   int previous_level = 0;
   for (std::size_t k = 0; k <= enc.segments.size(); ++k) {
@@ -104,18 +115,23 @@ TEST(GeometryCodec, ErrorNeverIncreasesWithMoreSegments) {
     const auto segs = first_segments(enc, k);
     ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec), Status::kOk);
     const double e = rms_error(dec.patches, patches);
-    EXPECT_LE(e, previous * (1 + 1e-9)) << k << " segments";
+    EXPECT_LE(e, previous * (1 + tolerance)) << k << " segments, frames " << frames;
     EXPECT_GE(dec.detail_level, previous_level);
     previous = e;
     previous_level = dec.detail_level;
     expect_watertight(dec.patches, seams);
   }
+  }
 }
 
 TEST(GeometryCodec, EveryBytePrefixDecodesWatertight) {
+  for (int frames : {0, 3}) {
   std::vector<PatchSeam> seams;
   const auto patches = two_patch_surface(4, seams);
-  const auto enc = encode_geometry(patches, seams, {12, WaveletFilter::kCubic, -1});
+  GeometryCodecOptions options{12, WaveletFilter::kCubic, -1};
+  options.frame_steps = frames;
+  options.tangential_shift = frames > 0 ? 2 : 0;
+  const auto enc = encode_geometry(patches, seams, options);
   std::size_t total = 0;
   for (const auto& s : enc.segments) total += s.size();
   std::size_t tested = 0;
@@ -131,12 +147,15 @@ TEST(GeometryCodec, EveryBytePrefixDecodesWatertight) {
     }
   }
   EXPECT_GE(tested, total);
+  }
 }
 
 TEST(GeometryCodec, DroppingFinestStepsStaysWatertightAndLowersDetailLevel) {
   std::vector<PatchSeam> seams;
   const auto patches = two_patch_surface(5, seams);
-  const auto enc = encode_geometry(patches, seams);
+  GeometryCodecOptions o;
+  o.frame_steps = 0;  // exact coarse samples need exact (xyz) coefficients
+  const auto enc = encode_geometry(patches, seams, o);
   const auto segs = first_segments(enc, enc.segments.size());
   for (int drop = 0; drop <= 6; ++drop) {
     DecodedGeometry dec;
@@ -195,7 +214,22 @@ TEST(GeometryCodec, HeaderParseRejectsInconsistentValues) {
   EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.origin[1] = std::numeric_limits<double>::infinity(); }));
   EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.top_bitplane = 200; }));
   EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.seams.resize(9, h.seams[0]); }));
+  // Version 3 fields: frames of more steps than there are, a start plane above the top, a shift beyond 8,
+  // a start plane list that does not match, and version-3 tools in an older header.
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.frame_steps = h.steps + 1, h.frame_start.assign(h.steps + 1, 0); }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.frame_steps = 1, h.frame_start = {h.top_bitplane + 1}; }));
+  EXPECT_TRUE(bad([](GeometryCodecHeader& h) { h.frame_steps = 1, h.frame_start = {0}, h.tangential_shift = 9; }));
+  EXPECT_FALSE(bad([](GeometryCodecHeader& h) { h.frame_steps = 1, h.frame_start = {h.top_bitplane}; }));
   EXPECT_FALSE(bad([](GeometryCodecHeader&) {}));
+  // A hand-built version-2 header with version-3 tools: the decoder refuses it.
+  for (int tool = 0; tool < 2; ++tool) {
+    GeometryCodecHeader h = enc.header;
+    h.version = 2;
+    if (tool == 0) h.frame_steps = 1, h.frame_start = {0};
+    if (tool == 1) h.orientation_weights = true;
+    DecodedGeometry dec;
+    EXPECT_EQ(decode_geometry(h, {}, {}, dec), Status::kInvalidArgument);
+  }
 }
 
 TEST(GeometryCodec, GarbageHeadersAndSegmentsNeverCrash) {
@@ -335,16 +369,36 @@ TEST(GeometryCodec, GoldenStreamIsStable) {
       }
     }
   }
-  GeometryCodecOptions o;
-  o.quantization_bits = 6;  // extent 64: step 1
-  const auto enc = encode_geometry(patches, {}, o);
-  ASSERT_EQ(enc.header.step, 1.0);
-  EXPECT_EQ(stream_hash(enc), 0x8759571d20b3ad97ull) << std::hex << "0x" << stream_hash(enc);
-  std::vector<std::span<const std::uint8_t>> segs(enc.segments.begin(), enc.segments.end());
-  DecodedGeometry dec;
-  ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec), Status::kOk);
-  EXPECT_EQ(dec.patches[0].values, patches[0].values);
-  EXPECT_EQ(dec.patches[1].values, patches[1].values);
+  // xyz coding (no frames, no orientation weights: the version-2 bit stream in a version-3 header), then the
+  // version-3 tools (3 framed steps, tangential shift 1, orientation weights), whose decoded values are pinned too (the frames' integer arithmetic must give
+  // the same bits everywhere, WASM included).
+  for (bool v3_tools : {false, true}) {
+    GeometryCodecOptions o;
+    o.quantization_bits = 6;  // extent 64: step 1
+    o.frame_steps = v3_tools ? 3 : 0;
+    o.tangential_shift = v3_tools ? 1 : 0;
+    o.orientation_weights = v3_tools;
+    const auto enc = encode_geometry(patches, {}, o);
+    ASSERT_EQ(enc.header.step, 1.0);
+    EXPECT_EQ(stream_hash(enc), v3_tools ? 0x8297ee457489bad9ull : 0x382710ca3802b988ull) << std::hex << "0x" << stream_hash(enc);
+    std::vector<std::span<const std::uint8_t>> segs(enc.segments.begin(), enc.segments.end());
+    DecodedGeometry dec;
+    ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec), Status::kOk);
+    if (!v3_tools) {
+      EXPECT_EQ(dec.patches[0].values, patches[0].values);
+      EXPECT_EQ(dec.patches[1].values, patches[1].values);
+    } else {
+      std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the decoded floats' bits
+      for (const auto& g : dec.patches) {
+        for (float f : g.values) {
+          std::uint32_t bits;
+          std::memcpy(&bits, &f, 4);
+          for (int b = 0; b < 4; ++b) h = (h ^ ((bits >> (8 * b)) & 0xFF)) * 1099511628211ull;
+        }
+      }
+      EXPECT_EQ(h, 0x8cf4e5dd7b017e01ull) << std::hex << "decoded 0x" << h;
+    }
+  }
 }
 
 }  // namespace
@@ -376,6 +430,138 @@ TEST(GeometryCodec, ReportsPartialTailsAndRejectsSegmentsBeyondTheLastPlane) {
   bad.steps = bad.level + 1;
   EXPECT_EQ(decode_geometry(bad, segs, {}, dec), Status::kInvalidArgument);
   EXPECT_EQ(decode_geometry(enc.header, segs, {}, dec, {-1}), Status::kInvalidArgument);
+}
+
+// ---- Version 3: local frames and orientation weights -------------------------------------------------------
+
+/// A flat square (z = 0, x and y spanning [0, 1]) with pseudo-random detail of amplitude `a` at the samples of
+/// the finest step (i or j odd) along the normal (z) or along the surface (x): one patch of level 5, no seams.
+std::vector<Grid3> noisy_plane(double a, bool normal_detail) {
+  const int level = 5, n = (1 << level) + 1;
+  std::vector<Grid3> g(1);
+  g[0].level = level;
+  g[0].values.resize(3 * n * n);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      float* v = g[0].values.data() + 3 * (j * n + i);
+      const double r0 = u(rng), r1 = u(rng);
+      const bool fine = (i | j) & 1, border = i == 0 || j == 0 || i == n - 1 || j == n - 1;
+      const double d = fine ? a * r0 : 0.0;
+      v[0] = static_cast<float>(i / double(n - 1) + (normal_detail || border ? 0 : d));
+      v[1] = static_cast<float>(j / double(n - 1) + 0 * r1);
+      v[2] = static_cast<float>(normal_detail ? d : 0.0);
+    }
+  }
+  return g;
+}
+
+std::size_t total_bytes(const EncodedGeometry& enc) {
+  std::size_t t = 0;
+  for (const auto& s : enc.segments) t += s.size();
+  return t;
+}
+
+GeometryCodecOptions framed(int frame_steps, int shift) {
+  GeometryCodecOptions o;
+  o.quantization_bits = 12;
+  o.frame_steps = frame_steps;
+  o.tangential_shift = shift;
+  return o;
+}
+
+// Frames are built by the decoder from its own reconstruction: if they differed from the encoder's in a
+// single sample, that sample would be off by the size of its coefficient. Full decoding stays within a few
+// quantization steps (the rotation rounds; the tangential components lose their lowest `shift` bits), and
+// every prefix is watertight.
+TEST(GeometryCodec, FramedStreamsDecodeNearLosslessly) {
+  for (int level : {2, 5, 7}) {
+    for (int frames : {1, 3, level}) {
+      for (int shift : {0, 2}) {
+        std::vector<PatchSeam> seams;
+        const auto patches = two_patch_surface(level, seams, 0.1);
+        auto o = framed(frames, shift);
+        o.quantization_bits = 14;
+        const auto enc = encode_geometry(patches, seams, o);
+        ASSERT_EQ(enc.header.frame_steps, std::min(frames, level));
+        DecodedGeometry dec;
+        ASSERT_EQ(decode_geometry(enc.header, first_segments(enc, enc.segments.size()), {}, dec), Status::kOk);
+        const double step = enc.header.step;
+        EXPECT_LE(rms_error(dec.patches, patches), (1 << shift) * step) << level << " " << frames << " " << shift;
+        EXPECT_LE(max_error(dec.patches, patches), 8 * (1 << shift) * step) << level << " " << frames << " " << shift;
+        expect_watertight(dec.patches, seams);
+        // Decoding is deterministic: a second decode on one thread gives the same bits.
+        DecodedGeometry again;
+        GeometryDecodeOptions one;
+        one.max_threads = 1;
+        ASSERT_EQ(decode_geometry(enc.header, first_segments(enc, enc.segments.size()), {}, again, one), Status::kOk);
+        for (std::size_t p = 0; p < 2; ++p) EXPECT_EQ(again.patches[p].values, dec.patches[p].values);
+      }
+    }
+  }
+}
+
+// On a plane the frames are the axes: detail along the surface costs fewer bytes than the same detail along
+// the normal once tangential components are coded coarser, while without frames both cost about the same.
+TEST(GeometryCodec, TangentialDetailCostsLessThanNormalDetailWithFrames) {
+  const auto normal = noisy_plane(0.01, true), tangential = noisy_plane(0.01, false);
+  const std::size_t n_xyz = total_bytes(encode_geometry(normal, {}, framed(0, 0)));
+  const std::size_t t_xyz = total_bytes(encode_geometry(tangential, {}, framed(0, 0)));
+  const std::size_t n_framed = total_bytes(encode_geometry(normal, {}, framed(5, 2)));
+  const std::size_t t_framed = total_bytes(encode_geometry(tangential, {}, framed(5, 2)));
+  EXPECT_LT(t_framed, 0.85 * n_framed);
+  EXPECT_LT(t_framed, 0.85 * t_xyz);
+  EXPECT_LT(n_framed, 1.1 * n_xyz);
+}
+
+// At any byte budget, the error along the normal (z on the plane) of a frame-coded surface with detail in
+// all directions is below that of xyz coding: the normal components arrive first.
+TEST(GeometryCodec, FramesSpendBytesOnTheNormalFirst) {
+  auto both = noisy_plane(0.01, false);
+  {
+    const auto z = noisy_plane(0.01, true);
+    for (std::size_t i = 2; i < both[0].values.size(); i += 3) both[0].values[i] = 0.5f * z[0].values[i];
+  }
+  const auto xyz = encode_geometry(both, {}, framed(0, 0));
+  const auto fr = encode_geometry(both, {}, framed(5, 2));
+  const auto z_rms = [&](const EncodedGeometry& enc, std::size_t budget) {
+    std::vector<std::span<const std::uint8_t>> segs;
+    std::size_t k = 0;
+    while (k < enc.segments.size() && enc.segments[k].size() <= budget) {
+      budget -= enc.segments[k].size();
+      segs.emplace_back(enc.segments[k++]);
+    }
+    std::span<const std::uint8_t> tail;
+    if (k < enc.segments.size()) tail = std::span<const std::uint8_t>(enc.segments[k].data(), budget);
+    DecodedGeometry dec;
+    EXPECT_EQ(decode_geometry(enc.header, segs, tail, dec), Status::kOk);
+    double e = 0;
+    for (std::size_t i = 2; i < both[0].values.size(); i += 3) {
+      const double d = static_cast<double>(dec.patches[0].values[i]) - both[0].values[i];
+      e += d * d;
+    }
+    return std::sqrt(e / static_cast<double>(both[0].values.size() / 3));
+  };
+  const std::size_t total = total_bytes(xyz);
+  for (std::size_t budget : {total / 4, total / 3, total / 2}) {
+    EXPECT_LT(z_rms(fr, budget), 0.8 * z_rms(xyz, budget)) << budget << " of " << total;
+  }
+}
+
+// Orientation weights change only the order of the bits: the full stream still decodes within half a step.
+TEST(GeometryCodec, OrientationWeightsStayLossless) {
+  std::vector<PatchSeam> seams;
+  const auto patches = two_patch_surface(5, seams);
+  GeometryCodecOptions o;
+  o.frame_steps = 0;
+  o.orientation_weights = true;
+  const auto enc = encode_geometry(patches, seams, o);
+  EXPECT_TRUE(enc.header.orientation_weights);
+  DecodedGeometry dec;
+  ASSERT_EQ(decode_geometry(enc.header, first_segments(enc, enc.segments.size()), {}, dec), Status::kOk);
+  EXPECT_LE(max_error(dec.patches, patches), enc.header.step * 0.5 + 1e-6);
+  expect_watertight(dec.patches, seams);
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // Writes a golden pack of pack_test's GoldenPackDecodes: two pillows (level 5, scales 1 and 2) with normal
 // maps. Run by hand once per pack format version, to a new file (old ones stay: old packs must keep
 // decoding):
-//   ./build/tests/make_golden_pack tests/data/golden-pillow-v2.gip   (format version 2)
-// (tests/data/golden-pillow.gip was written by format version 1.)
+//   ./build/tests/make_golden_pack tests/data/golden-pillow-v3.gip   (format version 3)
+// (tests/data/golden-pillow.gip was written by format version 1, golden-pillow-v2.gip by version 2.)
 #include "codec/pack.h"
 #include "tests/codec/pillow.h"
 

@@ -75,8 +75,10 @@ TEST(Pack, RoundTripWithinQuantization) {
   for (std::size_t m = 0; m < 2; ++m) {
     EXPECT_EQ(r.models[m].name, models[m].name);
     const double extent = m == 0 ? 2.0 : 4.0;
-    // 14 bits (the default) over the largest extent: rounding to the step, plus float rounding of the output.
-    EXPECT_LE(max_error(r.models[m].geometry, models[m].geometry), extent / 16384.0 * 0.5 + 1e-6);
+    // 14 bits (the default) over the largest extent: rounding to the step, plus float rounding of the output;
+    // local frames (version 3) round their rotation and code tangential components one plane coarser: a few
+    // steps at most.
+    EXPECT_LE(max_error(r.models[m].geometry, models[m].geometry), extent / 16384.0 * 8 + 1e-6);
     EXPECT_EQ(seam_mismatches(r.models[m].geometry, r.models[m].seams), 0u);
   }
 }
@@ -120,12 +122,14 @@ TEST(Pack, EveryPrefixDecodesToACoarserModelOrTruncated) {
       for (const Grid3& g : m.geometry)
         EXPECT_TRUE(std::all_of(g.values.begin(), g.values.end(), [](float v) { return std::isfinite(v); }));
     }
-    // At chunk boundaries (whole passes), more bytes never make the model worse.
+    // At chunk boundaries (whole passes), more bytes never make the model worse — up to 5 %: with local frames
+    // (version 3) a pass that refines normal components can move a sample by the frame rotation's rounding
+    // (measured on this fixture: +3 % once, 0.0677 → 0.0698, and +1.6 % at the last pass).
     const bool boundary = std::any_of(info.chunks.begin(), info.chunks.end(),
                                       [&](const ChunkInfo& c) { return c.offset + c.size == n; });
     if (boundary) {
       const double e = rms_error(r.models[0].geometry, models[0].geometry);
-      EXPECT_LE(e, previous_error * (1 + 1e-9)) << "prefix " << n;
+      EXPECT_LE(e, previous_error * 1.05) << "prefix " << n;
       previous_error = e;
     }
   }
@@ -284,7 +288,8 @@ TEST(Pack, WriterRejectsBadInput) {
 }
 
 // The committed golden packs (tests/data/golden-pillow.gip written by format version 1, golden-pillow-v2.gip
-// by version 2) must keep decoding to the pillow they were made from: decoders of old streams do not silently
+// by version 2, golden-pillow-v3.gip by version 3) must keep decoding to the pillow they were made from:
+// decoders of old streams do not silently
 // change.
 class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
 
@@ -305,7 +310,9 @@ TEST_P(GoldenPack, Decodes) {
                                                 pillow_model(5, "b", 2.0, true)};
   for (std::size_t m = 0; m < 2; ++m) {
     EXPECT_EQ(r.models[m].name, expected[m].name);
-    EXPECT_LE(max_error(r.models[m].geometry, expected[m].geometry), (m == 0 ? 2.0 : 4.0) / 16384.0);
+    // Version 3 codes local frames: near-lossless (rotation rounding, tangential components one plane coarser).
+    EXPECT_LE(max_error(r.models[m].geometry, expected[m].geometry),
+              (version >= 3 ? 8.0 : 1.0) * (m == 0 ? 2.0 : 4.0) / 16384.0);
     ASSERT_EQ(r.models[m].normals.size(), 2u);
     EXPECT_LE(max_error(r.models[m].normals, expected[m].normals), 4.0 / 1024);
   }
@@ -319,7 +326,8 @@ TEST_P(GoldenPack, Decodes) {
 
 INSTANTIATE_TEST_SUITE_P(Versions, GoldenPack,
                          ::testing::Values(std::pair<const char*, int>{"golden-pillow.gip", 1},
-                                           std::pair<const char*, int>{"golden-pillow-v2.gip", 2}));
+                                           std::pair<const char*, int>{"golden-pillow-v2.gip", 2},
+                                           std::pair<const char*, int>{"golden-pillow-v3.gip", 3}));
 
 }  // namespace
 }  // namespace geomip::codec

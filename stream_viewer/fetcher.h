@@ -1,20 +1,31 @@
 // Background fetch of a .gip pack from a local file or an http:// URL, coarse → fine: the fixed header, then
 // the manifest, then the chunks in file order with HTTP range requests (libcurl). The bytes arrive in one
 // buffer; the received prefix is published with an atomic counter, so readers on other threads may read
-// data()[0 … received()) without a lock while the fetch goes on. Errors never throw: they end the fetch and
-// are reported by error().
+// data()[0 … received()) without a lock while the fetch goes on.
+//
+// Trusts nothing it reads: the manifest is checked against the source's real size (file size, Content-Length,
+// Content-Range total) before anything is allocated (fetch_plan.h), the buffer is never larger than that size
+// nor kMaxPackBytes, and bodies longer than asked for are cut. Errors and exceptions never leave the fetch
+// thread: they end the fetch and are reported by error(). Cancelling (the destructor) takes effect within
+// ~50 ms, also during --limit-rate pauses and on a stalled connection. HTTP redirects are followed (at most
+// kMaxRedirects, http/https only); a server that ignores Range is read with the one GET it answered.
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
+#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "stream_viewer/fetch_plan.h"
+
 namespace geomip::viewer {
+
+inline constexpr long kMaxRedirects = 5;
 
 struct FetchOptions {
   std::uint64_t limit_rate = 0;      ///< bytes per second (CURLOPT_MAX_RECV_SPEED_LARGE; files: sleeps); 0 = none
@@ -25,16 +36,18 @@ class Fetcher {
  public:
   /// Starts the fetch thread. `on_progress` is called on that thread whenever bytes arrive or it ends.
   Fetcher(std::string source, FetchOptions options, std::function<void()> on_progress);
-  ~Fetcher();  ///< cancels and joins
+  ~Fetcher();  ///< cancels and joins (within ~50 ms)
   Fetcher(const Fetcher&) = delete;
   Fetcher& operator=(const Fetcher&) = delete;
 
   /// Bytes of the pack received so far (a prefix of the file).
   std::uint64_t received() const { return received_.load(std::memory_order_acquire); }
-  /// The pack's size once the manifest is known, else 0.
+  /// The pack's size as its manifest lays it out, once the manifest is known and accepted, else 0.
   std::uint64_t total() const { return total_.load(std::memory_order_acquire); }
+  /// Header + manifest once total() > 0 (then immutable), else nullptr.
+  const codec::PackInfo* info() const { return total() > 0 ? &plan_.info : nullptr; }
   /// Valid for [0, received()).
-  const std::uint8_t* data() const { return buffer_.data(); }
+  const std::uint8_t* data() const { return buffer_.get(); }
   bool finished() const { return finished_.load(std::memory_order_acquire); }
   /// Empty while fetching and after success.
   std::string error() const;
@@ -45,16 +58,19 @@ class Fetcher {
   void run();
   void fetch_file();
   void fetch_http();
-  /// One plain GET for servers that ignore Range (answer 200 with the whole file); `handle` is the CURL*.
-  void fetch_http_whole(void* handle, char* curl_error);
   void fail(std::string message);
-  /// Grows the buffer to `size` (only before readers may see data beyond received()).
+  bool cancelled() const { return cancel_.load(std::memory_order_acquire); }
+  /// Sleeps until `until` in slices of at most 20 ms; false if cancelled meanwhile.
+  bool sleep_until(std::chrono::steady_clock::time_point until) const;
+  /// Reserves plan.buffer bytes (not zero-filled), copies `head` in and publishes the manifest.
+  void start_buffer(FetchPlan plan, const std::vector<std::uint8_t>& head);
   void publish(std::uint64_t received);
 
   std::string source_;
   FetchOptions options_;
   std::function<void()> on_progress_;
-  std::vector<std::uint8_t> buffer_;  ///< sized to the whole pack once the manifest is known
+  FetchPlan plan_;                          ///< written once before total_ is published
+  std::unique_ptr<std::uint8_t[]> buffer_;  ///< plan_.buffer bytes once the manifest is known
   std::atomic<std::uint64_t> received_{0}, total_{0};
   std::atomic<bool> finished_{false}, cancel_{false};
   mutable std::mutex error_mutex_;

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -115,6 +116,21 @@ void scroll(GLFWwindow* w, double, double dy) {
                                             0.3f, 20.0f);
 }
 
+/// Options that can only be checked once the manifest is known: "" or one line for exit code 2.
+std::string check_options_against_pack(const Options& opt, const geomip::codec::PackInfo& info) {
+  const int models = static_cast<int>(info.models.size());
+  if (opt.model >= models)
+    return "--model " + std::to_string(opt.model) + " is out of range: the pack has " + std::to_string(models) +
+           (models == 1 ? " model (index 0)" : " models (indices 0-" + std::to_string(models - 1) + ")");
+  const int finest = info.models[static_cast<std::size_t>(opt.model)].geometry.level;
+  if (opt.level > finest)
+    return "--level " + std::to_string(opt.level) + " is out of range: model " + std::to_string(opt.model) +
+           "'s finest grid level is " + std::to_string(finest);
+  if (opt.morph && models < 2)
+    return "--morph needs at least 2 models; the pack has 1";
+  return {};
+}
+
 std::string kb(std::uint64_t bytes) { return std::to_string((bytes + 512) / 1024) + " KB"; }
 
 int run(const Options& opt) {
@@ -140,6 +156,7 @@ int run(const Options& opt) {
   glfwSwapInterval(headless ? 0 : 1);
 
   int exit_code = kExitOk;
+  bool usage_error = false;  // an option the pack cannot satisfy (--model, --level): exit 2, one line
   {
     Renderer renderer;
     Offscreen target(opt.width, opt.height);
@@ -167,7 +184,8 @@ int run(const Options& opt) {
     auto last_title = start;
     auto last_frame = start;
     double frame_ms = 0;
-    bool have_models = false, first_written = false, reported_error = false;
+    bool have_models = false, first_written = false, checked_options = false;
+    std::string timed_out;  // set when headless --timeout ends the wait
     std::uint64_t shown_bytes = 0, total = 0;
     int detail = 0;
     int frames_after_load = 0;
@@ -176,6 +194,16 @@ int run(const Options& opt) {
 
     while (!glfwWindowShouldClose(window)) {
       glfwPollEvents();
+      if (!checked_options) {
+        if (const geomip::codec::PackInfo* info = source.info()) {
+          checked_options = true;
+          if (std::string e = check_options_against_pack(opt, *info); !e.empty()) {
+            std::cerr << "geomip-view: " << e << "\n";
+            usage_error = true;
+            break;
+          }
+        }
+      }
       if (auto u = source.take_update()) {
         renderer.set_models(u->models);
         have_models = true;
@@ -186,11 +214,7 @@ int run(const Options& opt) {
         std::cout << "geomip-view: showing " << shown_bytes << " of " << total << " bytes, detail level " << detail
                   << "/" << ui.max_level << "\n";
       }
-      const std::string err = source.error();
-      if (!err.empty() && !reported_error) {
-        std::cerr << "geomip-view: " << err << "\n";
-        reported_error = true;
-      }
+      const std::string err = source.error();  // shown in the title; printed once, on exit
       const bool loaded = source.done();
 
       // morph / animate
@@ -253,7 +277,10 @@ int run(const Options& opt) {
         } else if (loaded) {
           break;  // the source ended with nothing to show
         } else if (std::chrono::duration<double>(t1 - start).count() > opt.timeout) {
-          std::cerr << "geomip-view: timed out after " << opt.timeout << " s waiting for the pack\n";
+          std::ostringstream o;
+          o << "timed out after " << opt.timeout << " s waiting for the pack (" << source.received() << " of "
+            << (source.total() ? std::to_string(source.total()) : std::string("?")) << " bytes received)";
+          timed_out = o.str();
           break;
         } else if (!have_models) {
           std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -261,7 +288,9 @@ int run(const Options& opt) {
       }
     }
 
-    if (headless) {
+    if (usage_error) {
+      exit_code = kExitBadInput;
+    } else if (headless) {
       if (!opt.screenshot.empty() && !last_pixels.empty()) {
         std::string e;
         if (!write_png(opt.screenshot, opt.width, opt.height, last_pixels, e)) {
@@ -275,14 +304,18 @@ int run(const Options& opt) {
                   << (opt.morph || opt.animate ? (wavelet ? "wavelet morph" : "linear morph") : "no morph") << ": "
                   << bench_ms / frames_after_load << " ms/frame over " << frames_after_load << " frames\n";
     }
-    const std::string err = source.error();
-    if (!have_models) {
+    // Exactly one line for whatever went wrong.
+    std::string err = source.error();
+    if (err.empty()) err = timed_out;
+    if (usage_error) {
+      // already said
+    } else if (!have_models) {
       std::cerr << "geomip-view: nothing to show"
                 << (err.empty() ? " from " + opt.source + " (no geometry arrived)" : " (" + err + ")") << "\n";
       exit_code = kExitBadInput;
     } else if (!source.complete()) {
-      std::cerr << "geomip-view: incomplete stream: kept the level from " << shown_bytes << " of " << total
-                << " bytes" << (err.empty() ? "" : " (" + err + ")") << "\n";
+      std::cerr << "geomip-view: incomplete stream: kept the level from " << shown_bytes << " of "
+                << (total ? total : source.total()) << " bytes" << (err.empty() ? "" : " (" + err + ")") << "\n";
       if (exit_code == kExitOk) exit_code = kExitPartial;
     }
   }
@@ -293,19 +326,46 @@ int run(const Options& opt) {
 
 }  // namespace
 
+/// A check for options that must be ≥ 0, with a short message (CLI11's own prints the largest double).
+static CLI::Validator non_negative(const std::string& what) {
+  return CLI::Validator(
+      [what](std::string& v) {
+        double x = 0;
+        return CLI::detail::lexical_cast(v, x) && x >= 0 ? std::string() : v + " is negative (" + what + ")";
+      },
+      "≥ 0");
+}
+
 int main(int argc, char** argv) {
   Options opt;
   CLI::App app{"geomip-view — progressive viewer of .gip packs (file or http:// URL).\n"
                "Keys: mouse drag orbit, wheel zoom, Up/Down level, L auto level, C checkerboard, W wireframe,\n"
                "Left/Right morph t, Space animate, S linear/wavelet schedule, Q quit.\n"
-               "Exit codes: 0 ok, 1 internal failure, 2 bad input or nothing to show, 3 stream failed part-way.",
+               "Exit codes: 0 ok, 1 internal failure, 2 bad input or nothing to show, 3 stream failed part-way.\n"
+               "Out-of-range --morph/--level/--model are errors (exit 2), never clamped. Nothing read is trusted:\n"
+               "a manifest laying out more than the source's real size is read up to that size (exit 3), one over\n"
+               "1 GiB is refused (exit 2); HTTP redirects are followed (at most 5).",
                "geomip-view"};
   app.add_option("pack", opt.source, "pack file or http:// URL")->required();
-  app.add_option("--level", opt.level, "grid level to draw (default: finest; interactive: auto)");
-  app.add_option("--morph", opt.morph, "morph time t in [0,1] from --model to the next model");
+  app.add_option("--level", opt.level,
+                 "grid level to draw, 0 … the model's finest (default: finest; interactive: auto); a level beyond "
+                 "the model's finest is an error (exit 2) once the manifest is known")
+      ->check(non_negative("a grid level"));
+  app.add_option("--morph", opt.morph,
+                 "morph time t in [0,1] from --model to the next model (outside [0,1], or a one-model pack: exit 2)")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            float t = 0;
+            return CLI::detail::lexical_cast(v, t) && t >= 0.0f && t <= 1.0f ? std::string()
+                                                                               : "t = " + v + " is outside [0, 1]";
+          },
+          "in [0,1]"));
   app.add_option("--schedule", opt.schedule, "morph schedule")->check(CLI::IsMember({"linear", "wavelet"}));
   app.add_option("--bands", opt.bands, "wavelet bands of the wavelet schedule")->check(CLI::Range(2, 8));
-  app.add_option("--model", opt.model, "model index to show (morph source)")->check(CLI::NonNegativeNumber);
+  app.add_option("--model", opt.model,
+                 "model index to show (morph source); an index past the pack's models is an error (exit 2) once "
+                 "the manifest is known")
+      ->check(non_negative("a model index"));
   app.add_flag("--animate", opt.animate, "cycle the morph through all models");
   app.add_flag("--no-align", opt.no_align,
                "keep each model in its own frame (default: models 1… are aligned to model 0 by the least-squares "
@@ -320,16 +380,20 @@ int main(int argc, char** argv) {
   app.add_flag("--bench", opt.bench, "headless: print ms/frame");
   app.add_flag("--checker", opt.checker, "checkerboard texture in parameter space");
   app.add_flag("--wireframe", opt.wireframe, "wireframe");
-  app.add_option("--limit-rate", opt.limit_rate, "download at most this many bytes per second");
-  app.add_option("--timeout", opt.timeout, "headless: seconds to wait for the pack");
+  app.add_option("--limit-rate", opt.limit_rate, "download (or read) at most this many bytes per second");
+  app.add_option("--timeout", opt.timeout, "headless: seconds to wait for the pack")->check(non_negative("seconds"));
   app.add_option("--yaw", opt.yaw, "camera yaw (radians)");
   app.add_option("--pitch", opt.pitch, "camera pitch (radians)");
   app.add_option("--distance", opt.distance, "camera distance (normalized units)");
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitBadInput;
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {  // one line, as every other error
+    std::cerr << "geomip-view: " << e.what() << " (see --help)\n";
+    return kExitBadInput;
   }
   try {
     return run(opt);

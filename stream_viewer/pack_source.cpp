@@ -44,37 +44,41 @@ bool PackSource::complete() const {
 }
 
 void PackSource::decode_loop() {
-  codec::PackInfo info;
-  bool have_info = false;
-  std::size_t next_chunk = 0;  // first chunk not yet complete
+  try {
+    decode_chunks();
+  } catch (const std::exception& e) {  // nothing leaves this thread: the error is reported by error()
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (decode_error_.empty()) decode_error_ = std::string("decode failed: ") + e.what();
+  }
+  // Idle for good once the fetch has ended (done() then becomes true).
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_ && !fetcher_->finished()) wake_.wait_for(lock, std::chrono::milliseconds(50));
+  decoder_idle_ = true;
+}
+
+void PackSource::decode_chunks() {
+  const codec::PackInfo* info = nullptr;  // the fetcher's, checked against the source's size
+  std::size_t next_chunk = 0;             // first chunk not yet complete
   for (;;) {
     std::uint64_t end = 0;
-    bool finished = false;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       for (;;) {
         if (stop_) return;
-        finished = fetcher_->finished();
+        const bool finished = fetcher_->finished();
         const std::uint64_t received = fetcher_->received();
-        const std::uint64_t total = fetcher_->total();
-        if (!have_info && total > 0) {
-          // the manifest arrived: the chunk table tells where complete chunks end
-          lock.unlock();
-          have_info = codec::read_pack_info({fetcher_->data(), static_cast<std::size_t>(received)}, info) ==
-                      codec::Status::kOk;
-          lock.lock();
-        }
+        if (!info) info = fetcher_->info();
         std::size_t c = next_chunk;
-        while (have_info && c < info.chunks.size() && info.chunks[c].offset + info.chunks[c].size <= received) ++c;
-        if (have_info && c > next_chunk) {
+        while (info && c < info->chunks.size() && info->chunks[c].offset + info->chunks[c].size <= received) ++c;
+        if (info && c > next_chunk && decode_error_.empty()) {
           next_chunk = c;
-          end = info.chunks[c - 1].offset + info.chunks[c - 1].size;
+          end = info->chunks[c - 1].offset + info->chunks[c - 1].size;
           decoder_idle_ = false;
           break;
         }
         if (finished) {
           decoder_idle_ = true;
-          if (stop_) return;
+          return;
         }
         wake_.wait_for(lock, std::chrono::milliseconds(50));
       }
@@ -89,11 +93,12 @@ void PackSource::decode_loop() {
       err = std::string("decode failed: ") + e.what();
     }
     if (status == codec::Status::kCorrupt || status == codec::Status::kUnsupportedVersion)
-      err = "decode: " + std::string(codec::status_message(status));
+      err = "decode stopped at byte " + std::to_string(used) + ": " + std::string(codec::status_message(status));
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!err.empty() && decode_error_.empty()) decode_error_ = err;
+    if (!err.empty() && decode_error_.empty()) decode_error_ = err;  // later chunks are not decoded
     decoded_end_ = end;
-    if (!models.empty()) pending_ = SourceUpdate{std::move(models), end, fetcher_->total()};
+    // bytes_used: what the shown models really come from (less than `end` when a chunk failed its CRC)
+    if (!models.empty()) pending_ = SourceUpdate{std::move(models), std::min<std::uint64_t>(used, end), fetcher_->total()};
   }
 }
 

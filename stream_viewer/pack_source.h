@@ -37,6 +37,8 @@ class PackSource {
 
   std::uint64_t received() const { return fetcher_->received(); }
   std::uint64_t total() const { return fetcher_->total(); }
+  /// Header + manifest once the fetch accepted them (then immutable), else nullptr.
+  const codec::PackInfo* info() const { return fetcher_->info(); }
   /// Fetch ended (complete or failed) and every byte that arrived has been decoded and taken or queued.
   bool done() const;
   /// Fetch or decode error, empty if none.
@@ -46,6 +48,7 @@ class PackSource {
 
  private:
   void decode_loop();
+  void decode_chunks();  ///< the decode loop proper; may throw (decode_loop turns that into error())
 
   morph::DecodeSettings decode_;
   std::unique_ptr<Fetcher> fetcher_;

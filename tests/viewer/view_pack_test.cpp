@@ -2,10 +2,13 @@
 // models): screenshots cover the decoded model's silhouette, morph end points equal the models alone, the
 // wavelet schedule's midpoint differs from the linear one's; streaming over HTTP from a local Range-capable
 // server (range_server.py) with a bandwidth limit shows a coarse model early, survives the server dying
-// mid-stream, and reports 404 / non-pack URLs. Runs under xvfb-run (CTest); skips without a display.
+// mid-stream, and reports 404 / non-pack URLs. A fetcher that trusts nothing: crafted manifests (valid CRC,
+// lying chunk table), endless bodies, redirects, stalls and --limit-rate on files end cleanly and promptly with
+// one line. Runs under xvfb-run (CTest); skips without a display.
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,6 +21,7 @@
 
 #include "stream_viewer/pack_source.h"
 #include "stream_viewer/png_write.h"
+#include "tests/viewer/crafted_pack.h"
 #include "tests/viewer/viewer_fixtures.h"
 
 extern char** environ;
@@ -58,6 +62,9 @@ std::vector<std::uint8_t> read_bytes(const fs::path& path) {
 struct ViewRun {
   int code = -1;
   std::string out, err;
+  bool signaled = false;  // killed by a signal (abort, segfault): never acceptable
+  double seconds = 0;     // wall time (measured runs)
+  long max_rss_kb = 0;    // peak resident memory of geomip-view (measured runs)
 };
 
 ViewRun view(const std::string& args) {
@@ -75,6 +82,36 @@ ViewRun view(const std::string& args) {
   r.err = se.str();
   return r;
 }
+
+/// Like view(), but spawned directly (sh exec's geomip-view) and waited for with wait4: wall time, peak RSS
+/// and whether a signal ended it.
+ViewRun view_measured(const std::string& args) {
+  static int counter = 0;
+  const fs::path out = work_dir() / ("mout" + std::to_string(counter) + ".txt");
+  const fs::path err = work_dir() / ("merr" + std::to_string(counter++) + ".txt");
+  std::string cmd = "exec " + std::string(GEOMIP_VIEW_BINARY) + " " + args + " > " + out.string() + " 2> " +
+                    err.string();
+  std::vector<char*> argv = {const_cast<char*>("/bin/sh"), const_cast<char*>("-c"), cmd.data(), nullptr};
+  ViewRun r;
+  const auto t0 = std::chrono::steady_clock::now();
+  pid_t pid = -1;
+  if (posix_spawn(&pid, "/bin/sh", nullptr, nullptr, argv.data(), environ) != 0) return r;
+  int status = 0;
+  rusage usage{};
+  ::wait4(pid, &status, 0, &usage);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.max_rss_kb = usage.ru_maxrss;
+  r.signaled = WIFSIGNALED(status);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::stringstream so, se;
+  so << std::ifstream(out).rdbuf();
+  se << std::ifstream(err).rdbuf();
+  r.out = so.str();
+  r.err = se.str();
+  return r;
+}
+
+std::size_t lines(const std::string& text) { return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')); }
 
 std::string size_args() { return "--frames 2 --width " + std::to_string(kW) + " --height " + std::to_string(kH); }
 
@@ -378,6 +415,234 @@ TEST_F(ViewPackTest, BenchTwoModelLevel8MorphAt1280x720) {
     ASSERT_NE(at, std::string::npos) << r.out;
     std::cout << r.out.substr(at);  // the figure for the report
   }
+}
+
+
+// ---- a fetcher that trusts nothing (issue 16, item 3) --------------------------------------------------------
+
+fs::path write_file(const std::string& name, const std::vector<std::uint8_t>& bytes) {
+  const fs::path path = work_dir() / name;
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                              static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
+/// Packs whose manifest passes its CRC but lies about the chunks (from the committed golden pack), and the exit
+/// codes allowed: 2 when nothing can be shown, 3 when a coarser level was kept.
+struct Crafted {
+  std::string name;
+  std::vector<std::uint8_t> bytes;
+  std::vector<int> codes;
+};
+
+std::vector<Crafted> crafted_packs() {
+  const auto golden = read_bytes(fs::path(GEOMIP_SOURCE_DIR) / "tests/data/golden-pillow-v2.gip");
+  std::vector<Crafted> out;
+  auto add = [&](std::string name, std::vector<std::uint8_t> bytes, std::vector<int> codes) {
+    EXPECT_FALSE(bytes.empty()) << name;
+    out.push_back({std::move(name), std::move(bytes), std::move(codes)});
+  };
+  // every chunk 2 GiB − 1 (the codec's per-chunk bound): ~150 GB laid out in a 5 KB file
+  add("crafted_huge_chunks.gip", craft_pack(golden, [](auto& s) { for (auto& v : s) v = 0x7fffffff; }), {2});
+  // 4 GiB in all, spread over the chunks after the first
+  add("crafted_4gib.gip", craft_pack(golden, [](auto& s) {
+        for (std::size_t c = 1; c < s.size(); ++c) s[c] = (std::uint64_t{4} << 30) / (s.size() - 1);
+      }), {2});
+  // the last chunk runs 1 MB past the end of the file: the prefix is still a coarser level
+  add("crafted_past_end.gip", craft_pack(golden, [](auto& s) { s.back() += 1 << 20; }), {3});
+  // the first chunk claims 100 MB (under the 1 GiB cap, far past the file): nothing decodable arrives
+  add("crafted_first_past_end.gip", craft_pack(golden, [](auto& s) { s.front() = 100u << 20; }), {2});
+  // every chunk zero-length: the bytes after the manifest belong to no chunk
+  add("crafted_zero_chunks.gip", craft_pack(golden, [](auto& s) { for (auto& v : s) v = 0; }), {2});
+  // one chunk shortened to zero, its bytes moved into the next: the CRCs fail from there on
+  add("crafted_zero_one.gip", craft_pack(golden, [](auto& s) { s[2] += s[1], s[1] = 0; }), {3});
+  // a chunk count that does not match the models' passes (huge count, table as long as it says is not there)
+  add("crafted_huge_count.gip", craft_pack(golden, [](auto&) {}, 1'000'000), {2});
+  // the manifest itself cut short: the file ends inside it
+  auto cut = golden;
+  cut.resize(200);
+  add("crafted_cut_manifest.gip", cut, {2});
+  return out;
+}
+
+// One clean line, no signal, the allowed code, and a peak RSS far below what the lie claims (the viewer's own
+// baseline under llvmpipe is ~100 MB; before the fix the 4 GiB claim zero-filled 4 GiB and the 150 GB one
+// aborted with std::bad_alloc).
+void expect_clean_failure(const ViewRun& r, const Crafted& c, const std::string& how) {
+  const std::string what = c.name + " " + how + ": " + r.err;
+  EXPECT_FALSE(r.signaled) << what;
+  EXPECT_NE(std::find(c.codes.begin(), c.codes.end(), r.code), c.codes.end()) << "exit " << r.code << ", " << what;
+  EXPECT_EQ(lines(r.err), 1u) << "exactly one line: " << what;
+  EXPECT_EQ(r.err.rfind("geomip-view: ", 0), 0u) << what;
+  EXPECT_LT(r.max_rss_kb, 600L * 1024) << "allocation bounded: " << what;
+  EXPECT_EQ(r.err.find("terminate"), std::string::npos) << what;
+}
+
+TEST_F(ViewPackTest, CraftedManifestsFailCleanlyFromAFile) {
+  for (const Crafted& c : crafted_packs()) {
+    const fs::path path = write_file(c.name, c.bytes);
+    expect_clean_failure(view_measured(path.string() + " " + size_args() + " --timeout 20"), c, "file");
+  }
+}
+
+TEST_F(ViewPackTest, CraftedManifestsFailCleanlyOverHttp) {
+  const auto packs = crafted_packs();
+  for (const Crafted& c : packs) write_file(c.name, c.bytes);
+  for (const std::vector<std::string>& mode : {std::vector<std::string>{}, {"--no-ranges"}, {"--no-ranges", "--no-length"}}) {
+    Server server(mode);
+    ASSERT_GT(server.port(), 0);
+    const std::string how = "http" + (mode.empty() ? std::string() : " " + mode[0] + (mode.size() > 1 ? " " + mode[1] : ""));
+    for (const Crafted& c : packs) {
+      Crafted expected = c;
+      // with no Content-Length the source's size is unknown: a 100 MB first chunk is waited for (and the
+      // connection then closes early) — still one clean line
+      if (mode.size() > 1) expected.codes = {2, 3};
+      expect_clean_failure(view_measured(server.url(c.name) + " " + size_args() + " --timeout 20"), expected, how);
+    }
+  }
+}
+
+// The status lines tell what was really shown: after a chunk that fails its CRC the last "showing N of M"
+// and the exit line agree on N < M.
+TEST_F(ViewPackTest, StatusLinesSayWhatWasReallyShown) {
+  auto bytes = read_bytes(fs::path(GEOMIP_SOURCE_DIR) / "tests/data/golden-pillow-v2.gip");
+  codec::PackInfo info;
+  ASSERT_EQ(codec::read_pack_info(bytes, info), codec::Status::kOk);
+  const auto& bad = info.chunks[info.chunks.size() / 2];
+  ASSERT_GT(bad.size, 0u);
+  bytes[bad.offset] ^= 0xff;  // fails its CRC
+  const fs::path path = write_file("bad_chunk.gip", bytes);
+  const ViewRun r = view_measured(path.string() + " " + size_args());
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  const auto at = r.out.rfind("showing ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::uint64_t shown = 0, total = 0;
+  std::string of;
+  std::istringstream(r.out.substr(at + 8)) >> shown >> of >> total;
+  EXPECT_EQ(total, bytes.size());
+  EXPECT_LE(shown, bad.offset) << "nothing from the bad chunk on is shown: " << r.out;
+  EXPECT_NE(r.err.find("kept the level from " + std::to_string(shown) + " of " + std::to_string(total)),
+            std::string::npos) << r.err;
+}
+
+TEST_F(ViewPackTest, EndlessBodiesAreCutAtThePacksSize) {
+  const fs::path pack = pack_file(6);
+  for (const std::vector<std::string>& mode : {std::vector<std::string>{"--endless"}, {"--endless", "--no-ranges"}}) {
+    Server server(mode);
+    ASSERT_GT(server.port(), 0);
+    const ViewRun r = view_measured(server.url(pack.filename().string()) + " " + size_args() + " --timeout 20");
+    EXPECT_EQ(r.code, 0) << mode.size() << ": " << r.err;
+    EXPECT_LT(r.seconds, 25.0) << "the body is cut at the manifest's size, not read for ever";
+    EXPECT_NE(r.out.find("showing " + std::to_string(fs::file_size(pack)) + " of "), std::string::npos) << r.out;
+    std::cout << "endless body (" << mode.size() << " options): " << r.seconds << " s\n";
+  }
+}
+
+TEST_F(ViewPackTest, RedirectsAreFollowedAndRedirectLoopsEnd) {
+  const fs::path pack = pack_file(6);
+  Server server({});
+  ASSERT_GT(server.port(), 0);
+  ViewRun r = view_measured(server.url("redirect/3/" + pack.filename().string()) + " " + size_args());
+  EXPECT_EQ(r.code, 0) << r.err;
+  r = view_measured(server.url("loop/" + pack.filename().string()) + " " + size_args() + " --timeout 20");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("redirects"), std::string::npos) << r.err;
+  EXPECT_LT(r.seconds, 25.0);
+}
+
+TEST_F(ViewPackTest, ServerIgnoringRangeGetsOneRequest) {
+  const fs::path pack = pack_file(6);
+  const fs::path log = work_dir() / "requests.txt";
+  fs::remove(log);
+  {
+    Server server({"--no-ranges", "--request-log", log.string()});
+    ASSERT_GT(server.port(), 0);
+    const ViewRun r = view_measured(server.url(pack.filename().string()) + " " + size_args());
+    EXPECT_EQ(r.code, 0) << r.err;
+  }
+  std::stringstream requests;
+  requests << std::ifstream(log).rdbuf();
+  EXPECT_EQ(lines(requests.str()), 1u) << requests.str();
+}
+
+TEST_F(ViewPackTest, StallsAndRateLimitsAreCancelledAtTheTimeout) {
+  const fs::path pack = pack_file(6);
+  {
+    Server server({"--stall-after", "2000"});  // headers and 2000 bytes, then silence on an open connection
+    ASSERT_GT(server.port(), 0);
+    const ViewRun r = view_measured(server.url(pack.filename().string()) + " " + size_args() + " --timeout 2");
+    EXPECT_TRUE(r.code == 2 || r.code == 3) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("timed out"), std::string::npos) << r.err;
+    EXPECT_LT(r.seconds, 2 + 5.0) << "ended, not hung";
+    std::cout << "stalled server, --timeout 2: exit after " << r.seconds << " s\n";
+  }
+  {
+    Server server({});
+    ASSERT_GT(server.port(), 0);
+    const ViewRun r = view_measured(server.url(pack.filename().string()) + " " + size_args() +
+                                    " --timeout 2 --limit-rate 1000");
+    EXPECT_TRUE(r.code == 2 || r.code == 3) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_LT(r.seconds, 2 + 5.0) << "ended, not hung";
+    std::cout << "HTTP --limit-rate 1000 --timeout 2: exit after " << r.seconds << " s\n";
+  }
+  const ViewRun r = view_measured(pack.string() + " " + size_args() + " --timeout 2 --limit-rate 1000");
+  EXPECT_TRUE(r.code == 2 || r.code == 3) << r.err;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("timed out"), std::string::npos) << r.err;
+  EXPECT_LT(r.seconds, 2 + 5.0) << "ended, not hung (was 17.6 s)";
+  std::cout << "file --limit-rate 1000 --timeout 2: exit after " << r.seconds << " s\n";
+}
+
+TEST_F(ViewPackTest, OutOfRangeOptionsExitTwoWithOneLine) {
+  const fs::path golden = fs::path(GEOMIP_SOURCE_DIR) / "tests/data/golden-pillow-v2.gip";  // 2 models, level 5
+  const fs::path single = work_dir() / "one_model.gip";
+  if (!fs::exists(single)) write_file(single.filename().string(), codec::write_pack({pack_input(4, 0)}));
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {golden.string() + " --morph 1.5", "--morph"},  {golden.string() + " --morph -0.25", "--morph"},
+      {golden.string() + " --model 2", "--model"},    {golden.string() + " --model 7 --morph 0.5", "--model"},
+      {golden.string() + " --level 6", "--level"},    {golden.string() + " --level -1", "--level"},
+      {single.string() + " --morph 0.5", "--morph"},
+  };
+  for (const auto& [args, option] : cases) {
+    const ViewRun r = view_measured(args + " " + size_args());
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(option), std::string::npos) << args << ": " << r.err;
+  }
+  // in range: fine
+  const ViewRun ok = view_measured(golden.string() + " --model 1 --level 5 --morph 1 " + size_args());
+  EXPECT_EQ(ok.code, 0) << ok.err;
+}
+
+
+// Cancelling (the destructor: Q in the window, the headless timeout) takes effect within ~50 ms, also during a
+// --limit-rate pause on a file, a rate-limited transfer and a stalled server. Bound: "ended, not hung" (1 s).
+TEST_F(ViewPackTest, FetcherCancelsPromptly) {
+  const fs::path pack = pack_file(6);
+  auto cancel_after = [](const std::string& source, std::uint64_t rate) {
+    auto fetcher = std::make_unique<Fetcher>(source, FetchOptions{.limit_rate = rate}, [] {});
+    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    EXPECT_FALSE(fetcher->finished()) << source;
+    const auto t0 = std::chrono::steady_clock::now();
+    fetcher.reset();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  };
+  const double file_ms = cancel_after(pack.string(), 1000);
+  EXPECT_LT(file_ms, 1000.0);
+  Server stalled({"--stall-after", "2000"});
+  ASSERT_GT(stalled.port(), 0);
+  const double stall_ms = cancel_after(stalled.url(pack.filename().string()), 0);
+  EXPECT_LT(stall_ms, 1000.0);
+  Server plain({});
+  ASSERT_GT(plain.port(), 0);
+  const double rate_ms = cancel_after(plain.url(pack.filename().string()), 1000);
+  EXPECT_LT(rate_ms, 1000.0);
+  std::cout << "cancel: file --limit-rate " << file_ms << " ms, stalled server " << stall_ms
+            << " ms, HTTP --limit-rate " << rate_ms << " ms\n";
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 
@@ -323,11 +324,22 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
     std::sort(index_and_base.begin(), index_and_base.end());
     std::vector<int> features;
     for (const auto& e : index_and_base) features.push_back(e.second);
+    const std::vector<Eigen::Vector2d> before = base.uv;
     const FeatureWarpResult r = warp_features(base.triangles, base.uv, features, targets);
     if (!r.unreached.empty()) {
-      throw SolverFailure("parameterize_consistently: the feature warp could not move " +
-                          std::to_string(r.unreached.size()) + " feature(s) of model '" + models[i].name +
-                          "' to their common position without folding");
+      // Not a solver bug: the correspondences ask for a map that would fold (features of one model lie too
+      // differently from the others', e.g. in another order around each other). Name the first one.
+      const int k = r.unreached.front();
+      const int feature = index_and_base[k].first;
+      const Eigen::Vector2d& from = before[features[k]];
+      char where[160];
+      std::snprintf(where, sizeof where, " from (%.3f, %.3f) to the common (%.3f, %.3f) in patch %zu", from.x(),
+                    from.y(), targets[k].x(), targets[k].y(), p);
+      throw InvalidInput("parameterize_consistently: feature " + std::to_string(feature) + " of model '" +
+                         models[i].name + "' (vertex " + std::to_string(models[i].features[feature]) +
+                         ") cannot move" + where + " without folding the parameterization" +
+                         (r.unreached.size() > 1 ? " (" + std::to_string(r.unreached.size() - 1) + " more)" : "") +
+                         "; corresponding features must lie alike on every model: check the correspondence file");
     }
     // Exact targets: the warp reaches them to rounding; store the common value itself.
     for (std::size_t j = 0; j < features.size(); ++j) base.uv[features[j]] = targets[j];

@@ -10,12 +10,17 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <limits>
 #include <ostream>
 #include <sstream>
+#include <string_view>
 
 namespace geomip {
 namespace {
@@ -43,6 +48,22 @@ void silence_openmesh() {
   }();
   (void)done;
 }
+
+// Some of OpenMesh's readers also write to std::cerr directly (the OFF reader's "Error in file format"):
+// while one parses, std::cerr goes nowhere, so that a tool's error stays the one line it prints itself.
+class SilencedCerr {
+ public:
+  SilencedCerr() : saved_(std::cerr.rdbuf(nullptr)) {}
+  ~SilencedCerr() {
+    std::cerr.rdbuf(saved_);
+    std::cerr.clear();
+  }
+  SilencedCerr(const SilencedCerr&) = delete;
+  SilencedCerr& operator=(const SilencedCerr&) = delete;
+
+ private:
+  std::streambuf* saved_;
+};
 
 std::string extension_of(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -215,29 +236,200 @@ class TriMeshExporter final : public OpenMesh::IO::BaseExporter {
   throw InvalidInput(path + ": " + problem);
 }
 
-// PLY header, parsed to check the data against it: OpenMesh reads past the end of a short binary file without
-// noticing. Only fixed-size vertex data and index lists with the common layouts can be counted exactly.
-struct PlyHeader {
-  bool binary = false;
-  bool ascii = false;
-  std::uint64_t header_bytes = 0;
-  std::uint64_t vertex_count = 0;
-  std::uint64_t face_count = 0;
-  std::uint64_t vertex_record_bytes = 0;  // 0 = unknown
-  bool vertex_fixed = true;
-  int face_count_bytes = 0;  // bytes of the list length
-  int face_index_bytes = 0;  // bytes of each index
-  bool face_simple = true;   // the face element has only the index list
-  std::vector<std::string> elements;      // in file order
-  std::vector<std::string> vertex_props;  // names, in record order
+// A read-only stream over bytes in memory (std::spanstream is C++23). read_mesh() reads a file once, with a
+// size bound, and every validator and OpenMesh's reader parse that copy: no second open of a path that could
+// have changed into a FIFO or grown meanwhile.
+class MemoryBuffer final : public std::streambuf {
+ public:
+  explicit MemoryBuffer(std::string_view bytes) {
+    char* begin = const_cast<char*>(bytes.data());  // never written: no put area, no putback into it
+    setg(begin, begin, begin + bytes.size());
+  }
+
+ protected:
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override {
+    if (!(which & std::ios_base::in)) return pos_type(off_type(-1));
+    const off_type size = egptr() - eback();
+    const off_type base = dir == std::ios_base::beg ? 0 : dir == std::ios_base::cur ? gptr() - eback() : size;
+    if (off < -base || off > size - base) return pos_type(off_type(-1));
+    setg(eback(), eback() + base + off, egptr());
+    return pos_type(base + off);
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    return seekoff(off_type(pos), std::ios_base::beg, which);
+  }
+  int_type pbackfail(int_type) override { return traits_type::eof(); }
 };
 
-int ply_type_size(const std::string& t) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
-  if (t == "double" || t == "float64") return 8;
-  return 0;
+class MemoryStream final : public std::istream {
+ public:
+  explicit MemoryStream(std::string_view bytes) : std::istream(nullptr), buffer_(bytes) { rdbuf(&buffer_); }
+
+ private:
+  MemoryBuffer buffer_;
+};
+
+// A read-only stream over two byte ranges, one after the other (a rewritten header, then the file's data)
+// without copying the second.
+class JoinedBuffer final : public std::streambuf {
+ public:
+  JoinedBuffer(std::string_view first, std::string_view second) : first_(first), second_(second) {
+    seek_to(0);
+  }
+
+ protected:
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    if (in_first_ && !second_.empty()) {
+      seek_to(static_cast<off_type>(first_.size()));
+      return traits_type::to_int_type(*gptr());
+    }
+    return traits_type::eof();
+  }
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode which) override {
+    if (!(which & std::ios_base::in)) return pos_type(off_type(-1));
+    const auto size = static_cast<off_type>(first_.size() + second_.size());
+    const off_type here = (in_first_ ? 0 : static_cast<off_type>(first_.size())) + (gptr() - eback());
+    const off_type base = dir == std::ios_base::beg ? 0 : dir == std::ios_base::cur ? here : size;
+    if (off < -base || off > size - base) return pos_type(off_type(-1));
+    seek_to(base + off);
+    return pos_type(base + off);
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    return seekoff(off_type(pos), std::ios_base::beg, which);
+  }
+  int_type pbackfail(int_type) override { return traits_type::eof(); }
+
+ private:
+  void seek_to(off_type pos) {
+    const auto first_size = static_cast<off_type>(first_.size());
+    in_first_ = pos < first_size;
+    const std::string_view part = in_first_ ? first_ : second_;
+    char* begin = const_cast<char*>(part.data());  // never written
+    setg(begin, begin + (in_first_ ? pos : pos - first_size), begin + part.size());
+  }
+
+  std::string_view first_, second_;
+  bool in_first_ = true;
+};
+
+class JoinedStream final : public std::istream {
+ public:
+  JoinedStream(std::string_view first, std::string_view second)
+      : std::istream(nullptr), buffer_(first, second) {
+    rdbuf(&buffer_);
+  }
+
+ private:
+  JoinedBuffer buffer_;
+};
+
+// Coordinates are read as 32-bit floats (OpenMesh's text readers, TriMesh consumers): a finite double beyond
+// ±FLT_MAX would become infinite, or make the reader drop the vertex (and the error surface as a wrong
+// index).
+constexpr double kMaxCoordinate = std::numeric_limits<float>::max();
+
+// "" when `v` is a usable coordinate, else the problem, starting with `vertex` ("vertex 12", "vertex").
+std::string coordinate_problem(double v, const std::string& vertex) {
+  if (!std::isfinite(v)) return vertex + " has a NaN or infinite coordinate";
+  if (std::fabs(v) > kMaxCoordinate) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return vertex + " coordinate " + text + " is out of range (beyond ±3.4e38, the 32-bit float range)";
+  }
+  return {};
+}
+
+// PLY header, parsed to walk the data the way OpenMesh's reader will, before it does: that reader trusts
+// every count (a list length of 4e9 in a corrupt file is 4e9 push_backs), reads an unknown list property as
+// one value (so everything after it is misaligned), and reads past the end of a short binary file.
+enum class PlyType { kChar, kUchar, kShort, kUshort, kInt, kUint, kFloat, kDouble };
+
+struct PlyProperty {
+  std::string name;
+  std::string declaration;         // "float x", "list uchar int vertex_indices": the tokens after "property"
+  PlyType type = PlyType::kFloat;  // of the value, or of a list's items
+  PlyType count_type = PlyType::kUchar;  // of a list's length
+  bool list = false;
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  bool binary = false;
+  bool big_endian = false;
+  std::uint64_t header_bytes = 0;
+  std::vector<PlyElement> elements;  // in file order
+
+  // The header as OpenMesh's reader is given it: what was validated and nothing else. Its own header parser
+  // reads tokens, not lines (a stray word on a line, an obj_info text, white space before end_header would
+  // each make it see other elements or start the binary data elsewhere than this check did).
+  std::string canonical() const {
+    std::string out = "ply\nformat ";
+    out += binary ? (big_endian ? "binary_big_endian" : "binary_little_endian") : "ascii";
+    out += " 1.0\n";
+    for (const auto& e : elements) {
+      out += "element " + e.name + " " + std::to_string(e.count) + "\n";
+      for (const auto& p : e.properties) out += "property " + p.declaration + "\n";
+    }
+    return out + "end_header\n";
+  }
+};
+
+bool ply_type(const std::string& t, PlyType& out) {
+  if (t == "char" || t == "int8")
+    out = PlyType::kChar;
+  else if (t == "uchar" || t == "uint8")
+    out = PlyType::kUchar;
+  else if (t == "short" || t == "int16")
+    out = PlyType::kShort;
+  else if (t == "ushort" || t == "uint16")
+    out = PlyType::kUshort;
+  else if (t == "int" || t == "int32")
+    out = PlyType::kInt;
+  else if (t == "uint" || t == "uint32")
+    out = PlyType::kUint;
+  else if (t == "float" || t == "float32")
+    out = PlyType::kFloat;
+  else if (t == "double" || t == "float64")
+    out = PlyType::kDouble;
+  else
+    return false;
+  return true;
+}
+
+int ply_size(PlyType t) {
+  switch (t) {
+    case PlyType::kChar:
+    case PlyType::kUchar:
+      return 1;
+    case PlyType::kShort:
+    case PlyType::kUshort:
+      return 2;
+    case PlyType::kInt:
+    case PlyType::kUint:
+    case PlyType::kFloat:
+      return 4;
+    case PlyType::kDouble:
+      return 8;
+  }
+  return 1;
+}
+
+bool ply_is_float(PlyType t) {
+  return t == PlyType::kFloat || t == PlyType::kDouble;
+}
+
+// The list properties OpenMesh's reader reads as lists (everything else it reads as one value).
+bool is_face_indices(const std::string& name) {
+  return name == "vertex_indices" || name == "vertex_index";
+}
+bool is_face_texcoords(const std::string& name) {
+  return name == "texcoord";
 }
 
 // Strict header check: OpenMesh's PLY reader crashes on some malformed headers (a property before any
@@ -248,8 +440,8 @@ bool parse_ply_header(std::istream& in, PlyHeader& h, std::string& problem) {
     problem = "not a PLY file (no 'ply' magic)";
     return false;
   }
-  std::string element;
   bool has_format = false;
+  std::string integer_coordinates;  // a vertex property that must be float in binary files
   auto bad = [&](const std::string& what) {
     problem = "malformed PLY header: " + what;
     return false;
@@ -263,53 +455,76 @@ bool parse_ply_header(std::istream& in, PlyHeader& h, std::string& problem) {
       std::string fmt, version;
       ls >> fmt >> version;
       if (fmt != "ascii" && fmt != "binary_little_endian" && fmt != "binary_big_endian") {
-        return bad("unknown format '" + fmt + "'");
+        return bad("unknown format '" + fmt.substr(0, 32) + "'");
       }
       if (version != "1.0") return bad("unknown version '" + version.substr(0, 16) + "' (PLY 1.0 expected)");
       h.binary = fmt != "ascii";
-      h.ascii = fmt == "ascii";
+      h.big_endian = fmt == "binary_big_endian";
       has_format = true;
     } else if (word == "element") {
+      std::string name;
       long long n = -1;
-      if (!(ls >> element >> n) || n < 0) return bad("bad element line '" + line + "'");
-      h.elements.push_back(element);
-      if (element == "vertex") h.vertex_count = static_cast<std::uint64_t>(n);
-      if (element == "face") h.face_count = static_cast<std::uint64_t>(n);
+      if (!(ls >> name >> n) || n < 0) return bad("bad element line '" + line.substr(0, 64) + "'");
+      for (const auto& e : h.elements) {
+        if (e.name == name) return bad("element '" + name.substr(0, 32) + "' declared twice");
+      }
+      h.elements.push_back({name, static_cast<std::uint64_t>(n), {}});
     } else if (word == "property") {
-      if (element.empty()) return bad("property before any element");
-      std::string type, name;
+      if (h.elements.empty()) return bad("property before any element");
+      PlyProperty prop;
+      std::string type;
       ls >> type;
       if (type == "list") {
-        std::string count_type, index_type;
-        ls >> count_type >> index_type >> name;
-        if (ply_type_size(count_type) == 0 || ply_type_size(index_type) == 0 || name.empty()) {
-          return bad("bad list property '" + line + "'");
+        std::string count_type, item_type;
+        ls >> count_type >> item_type >> prop.name;
+        if (!ply_type(count_type, prop.count_type) || ply_is_float(prop.count_type) ||
+            !ply_type(item_type, prop.type) || prop.name.empty()) {
+          return bad("bad list property '" + line.substr(0, 64) + "'");
         }
-        if (element == "vertex") {
-          h.vertex_fixed = false;
-        } else if (element == "face" && h.face_count_bytes == 0) {
-          h.face_count_bytes = ply_type_size(count_type);
-          h.face_index_bytes = ply_type_size(index_type);
-        } else if (element == "face") {
-          h.face_simple = false;
-        }
+        prop.list = true;
+        prop.declaration = "list " + count_type + " " + item_type + " " + prop.name;
       } else {
-        ls >> name;
-        const int size = ply_type_size(type);
-        if (size == 0 || name.empty()) return bad("bad property '" + line + "'");
-        if (element == "vertex") {
-          h.vertex_record_bytes += size;
-          h.vertex_props.push_back(name);
-        } else if (element == "face") {
-          h.face_simple = false;
-        }
+        ls >> prop.name;
+        if (!ply_type(type, prop.type) || prop.name.empty())
+          return bad("bad property '" + line.substr(0, 64) + "'");
+        prop.declaration = type + " " + prop.name;
       }
+      PlyElement& e = h.elements.back();
+      // OpenMesh's binary reader converts only float types to its float coordinates, normals and texture
+      // coordinates (it prints "unsupported conversion" for the others and reads 0).
+      static const char* const kFloatOnly[] = {"x",         "y",         "z",         "nx",       "ny",
+                                               "nz",        "u",         "v",         "s",        "t",
+                                               "texture_u", "texture_v", "texture_s", "texture_t"};
+      if (e.name == "vertex" && !prop.list && !ply_is_float(prop.type) &&
+          std::find(std::begin(kFloatOnly), std::end(kFloatOnly), prop.name) != std::end(kFloatOnly)) {
+        integer_coordinates = prop.name;
+      }
+      const bool understood_list =
+          e.name == "face" && (is_face_indices(prop.name) || is_face_texcoords(prop.name));
+      if (prop.list && !understood_list) {
+        return bad("list property '" + prop.name.substr(0, 32) + "' of element '" + e.name.substr(0, 32) +
+                   "' is not supported (only the face's vertex_indices and texcoord lists are)");
+      }
+      e.properties.push_back(prop);
     } else if (word == "comment" || word == "obj_info" || word.empty()) {
       continue;
     } else if (word == "end_header") {
       if (!has_format) return bad("no format line");
-      if (h.elements.empty() || h.elements[0] != "vertex") return bad("the first element is not 'vertex'");
-      h.header_bytes = static_cast<std::uint64_t>(in.tellg());
+      if (h.binary && !integer_coordinates.empty()) {
+        return bad("binary vertex property '" + integer_coordinates.substr(0, 32) +
+                   "' has an integer type (float or double expected)");
+      }
+      if (h.elements.empty() || h.elements[0].name != "vertex")
+        return bad("the first element is not 'vertex'");
+      for (const auto& e : h.elements) {
+        // Items without properties take no bytes: a reader would loop over a count no file size can bound.
+        if (e.count > 0 && e.properties.empty()) {
+          return bad("element '" + e.name.substr(0, 32) + "' has " + std::to_string(e.count) +
+                     " items but no properties");
+        }
+      }
+      const auto end = in.tellg();
+      h.header_bytes = end < 0 ? std::numeric_limits<std::uint64_t>::max() : static_cast<std::uint64_t>(end);
       return true;
     } else {
       return bad("unknown keyword '" + word.substr(0, 32) + "'");
@@ -351,6 +566,10 @@ bool parse_numbers(const char* p, int count, std::vector<double>& out) {
     // A number must end at whitespace or the end of the line: "0.1S63" is garbage, not 0.1 (OpenMesh's
     // stream-based ascii readers can loop forever on it).
     if (end == p || (*end != '\0' && !std::isspace(static_cast<unsigned char>(*end)))) return false;
+    // Hex floats: strtod reads them, iostreams (OpenMesh) do not.
+    if (std::find_if(p, static_cast<const char*>(end), [](char c) { return c == 'x' || c == 'X'; }) != end) {
+      return false;
+    }
     out.push_back(v);
     p = end;
   }
@@ -360,211 +579,505 @@ bool parse_numbers(const char* p, int count, std::vector<double>& out) {
 std::string at_line(std::size_t n) { return "line " + std::to_string(n) + ": "; }
 
 // An OBJ face corner: v, v/vt, v//vn or v/vt/vn, each an optionally negative integer (v required).
-bool is_obj_corner(const std::string& corner) {
+// Returns "" and the vertex index (as written: 1-based, or negative = relative) or the problem. OpenMesh
+// reads every index as an int and drops the face silently when one does not fit: "f 1 2
+// 99999999999999999999".
+std::string parse_obj_corner(const std::string& corner, long long& vertex) {
   std::size_t i = 0;
   for (int field = 0; field < 3; ++field) {
-    if (i < corner.size() && corner[i] == '-') ++i;
+    const std::size_t start = i;
+    const bool negative = i < corner.size() && corner[i] == '-';
+    if (negative) ++i;
     const std::size_t digits = i;
-    while (i < corner.size() && std::isdigit(static_cast<unsigned char>(corner[i]))) ++i;
-    if (field == 0 && i == digits) return false;  // the vertex index is required
-    if (i == corner.size()) return true;
-    if (corner[i] != '/') return false;
+    long long value = 0;
+    bool overflow = false;
+    while (i < corner.size() && std::isdigit(static_cast<unsigned char>(corner[i]))) {
+      value = value * 10 + (corner[i] - '0');
+      if (value > std::numeric_limits<int>::max()) {
+        overflow = true;
+        value = std::numeric_limits<int>::max();
+      }
+      ++i;
+    }
+    const bool empty = i == digits;
+    if (empty && (field == 0 || i != start)) return "malformed face corner '" + corner.substr(0, 24) + "'";
+    if (overflow) {
+      const char* what = field == 0 ? "vertex" : field == 1 ? "texture coordinate" : "normal";
+      return std::string("face ") + what + " index '" +
+             corner.substr(start, std::min<std::size_t>(i - start, 24)) +
+             "' is out of range (more than 2^31 - 1)";
+    }
+    if (field == 0) {
+      if (value == 0)
+        return "face corner '" + corner.substr(0, 24) + "' has vertex index 0 (OBJ counts from 1)";
+      vertex = negative ? -value : value;
+    }
+    if (i == corner.size()) return {};
+    if (corner[i] != '/') return "malformed face corner '" + corner.substr(0, 24) + "'";
     ++i;
   }
-  return false;
+  return "malformed face corner '" + corner.substr(0, 24) + "'";
 }
 
-void validate_obj(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+void validate_obj(const std::string& path, std::string_view bytes) {
+  MemoryStream in(bytes);
   LineScanner lines(in, 0);
   std::string line;
   std::vector<double> xyz;
+  long long vertices = 0;   // "v" lines so far
+  long long max_index = 0;  // largest positive vertex index of any face, and its line
+  std::size_t max_index_line = 0;
   while (lines.next(line)) {
-    const auto first = line.find_first_not_of(" \t");
-    const bool is_face = line.compare(first, 2, "f ") == 0 || line.compare(first, 2, "f\t") == 0;
-    if (is_face) {
+    // The keyword as OpenMesh's reader finds it: the line trimmed of " \t\r\n" (a line that then starts with
+    // other white space is skipped), then its first white-space-delimited token.
+    const auto first = line.find_first_not_of(" \t\r\n");
+    if (first == std::string::npos || std::isspace(static_cast<unsigned char>(line[first]))) continue;
+    std::size_t end = first;
+    while (end < line.size() && !std::isspace(static_cast<unsigned char>(line[end]))) ++end;
+    const std::string_view keyword(line.data() + first, end - first);
+    if (keyword == "f") {
       // Every corner must start with a (possibly negative) index: OpenMesh asserts on "f /8 2 3".
-      std::istringstream corners(line.substr(first + 1));
+      std::istringstream corners(line.substr(end));
       std::string corner;
       int count = 0;
       while (corners >> corner) {
-        if (!is_obj_corner(corner)) {
-          fail(path, at_line(lines.line_no()) + "malformed face corner '" + corner.substr(0, 16) + "'");
+        long long index = 0;
+        const std::string problem = parse_obj_corner(corner, index);
+        if (!problem.empty()) fail(path, at_line(lines.line_no()) + problem);
+        if (index < 0 && -index > vertices) {
+          fail(path, at_line(lines.line_no()) + "face references vertex " + std::to_string(index) +
+                         " (relative), but only " + std::to_string(vertices) + " vertices precede it");
+        }
+        if (index > max_index) {
+          max_index = index;
+          max_index_line = lines.line_no();
         }
         ++count;
       }
       if (count < 3) fail(path, at_line(lines.line_no()) + "face with fewer than 3 corners");
       continue;
     }
-    if (line.compare(first, 2, "v ") != 0 && line.compare(first, 2, "v\t") != 0) continue;
-    if (!parse_numbers(line.c_str() + first + 1, 3, xyz)) fail(path, at_line(lines.line_no()) + "malformed vertex");
+    if (keyword != "v") continue;
+    if (!parse_numbers(line.c_str() + end, 3, xyz)) fail(path, at_line(lines.line_no()) + "malformed vertex");
     for (double v : xyz) {
-      if (!std::isfinite(v)) fail(path, at_line(lines.line_no()) + "vertex has a NaN or infinite coordinate");
+      const std::string problem = coordinate_problem(v, "vertex");
+      if (!problem.empty()) fail(path, at_line(lines.line_no()) + problem);
     }
+    ++vertices;
+  }
+  if (max_index > vertices) {
+    fail(path, at_line(max_index_line) + "face references vertex " + std::to_string(max_index) +
+                   ", but the file has " + std::to_string(vertices) + " vertices (OBJ counts from 1)");
   }
 }
 
-void validate_off(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  LineScanner lines(in, 0);
-  std::string line;
-  if (!lines.next(line)) fail(path, "empty OFF file");
-  std::istringstream head(line);
-  std::string magic;
-  head >> magic;
-  if (magic.size() < 3 || magic.compare(magic.size() - 3, 3, "OFF") != 0) {
-    fail(path, "not an OFF file (the first word is not OFF)");
+// Whitespace-separated tokens of a text, as `std::istream >> x` sees them, with the line of each.
+class Tokens {
+ public:
+  explicit Tokens(std::string_view text, std::size_t start = 0) : text_(text), pos_(start) {}
+  // Next token; empty at the end of the text.
+  std::string_view next() {
+    while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+    const std::size_t begin = pos_;
+    while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+    token_begin_ = begin;
+    return text_.substr(begin, pos_ - begin);
   }
-  std::string word;
-  if (head >> word && word == "BINARY") fail(path, "binary OFF is not supported (use ascii OFF, PLY or OBJ)");
-  long long nv = -1, nf = -1;
-  std::istringstream counts(word + " " + std::string(std::istreambuf_iterator<char>(head), {}));
-  if (!(counts >> nv >> nf)) {
-    if (!lines.next(line)) fail(path, "truncated OFF: no vertex and face counts");
-    std::istringstream c(line);
-    if (!(c >> nv >> nf)) fail(path, at_line(lines.line_no()) + "expected the vertex and face counts");
+  // Skips the rest of the current line, its newline included (std::getline).
+  void skip_line() {
+    const std::size_t eol = text_.find('\n', pos_);
+    pos_ = eol == std::string_view::npos ? text_.size() : eol + 1;
   }
-  const auto file_size = static_cast<long long>(std::filesystem::file_size(path));
-  if (nv < 0 || nf < 0 || nv > file_size || nf > file_size) {
-    fail(path, "OFF counts " + std::to_string(nv) + " vertices, " + std::to_string(nf) + " faces are impossible for a " +
-                   std::to_string(file_size) + "-byte file");
+  // 1-based line of the last token (linear: for messages only).
+  std::size_t line() const {
+    return 1 + static_cast<std::size_t>(std::count(text_.begin(), text_.begin() + token_begin_, '\n'));
   }
-  std::vector<double> xyz;
+
+ private:
+  std::string_view text_;
+  std::size_t pos_ = 0;
+  std::size_t token_begin_ = 0;
+};
+
+// A whole token of decimal digits, at most `max`.
+bool parse_count(std::string_view token, long long max, long long& value) {
+  if (token.empty() || token.size() > 18) return false;
+  value = 0;
+  for (char c : token) {
+    if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+    value = value * 10 + (c - '0');
+  }
+  return value <= max;
+}
+
+// A whole token that is a decimal number (strtod alone would also take hex floats, which iostreams do not).
+bool parse_number(std::string_view token, double& value) {
+  if (token.empty() || token.size() > 64 || token.find_first_of("xX") != std::string_view::npos) return false;
+  const std::string text(token);
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size();
+}
+
+// OpenMesh's ascii OFF reader takes the first line as the keyword line (the rest of it is ignored), then
+// reads whitespace-separated tokens: the three counts, per vertex three coordinates and the rest of its line,
+// per face a corner count and that many indices (no line structure). This check reads the same tokens the
+// same way, so the counts it bounds are the counts the reader loops over.
+void validate_off(const std::string& path, std::string_view bytes) {
+  const std::size_t eol = std::min(bytes.find('\n'), bytes.size());
+  Tokens head(bytes.substr(0, eol));
+  const std::string_view magic = head.next();
+  const bool is_off = magic.size() >= 3 && magic.substr(magic.size() - 3) == "OFF";
+  if (!is_off) fail(path, "not an OFF file (the first line does not start with OFF)");
+  if (magic.find_first_of("4n") != std::string_view::npos) {
+    fail(path, "'" + std::string(magic) + "': only 3-dimensional OFF is supported");
+  }
+  for (std::string_view word = head.next(); !word.empty(); word = head.next()) {
+    long long ignored = 0;
+    if (word == "BINARY") fail(path, "binary OFF is not supported (use ascii OFF, PLY or OBJ)");
+    if (parse_count(word, std::numeric_limits<long long>::max(), ignored)) {
+      fail(path, "line 1: the vertex and face counts must be on the line after '" + std::string(magic) + "'");
+    }
+  }
+  Tokens tokens(bytes, std::min(eol + 1, bytes.size()));
+  const auto size = static_cast<long long>(bytes.size());
+  long long nv = 0, nf = 0, ne = 0;
+  const char* names[3] = {"vertex", "face", "edge"};
+  long long* counts[3] = {&nv, &nf, &ne};
+  for (int c = 0; c < 3; ++c) {
+    const std::string_view token = tokens.next();
+    if (token.empty()) fail(path, "truncated OFF: no " + std::string(names[c]) + " count");
+    if (!parse_count(token, std::numeric_limits<long long>::max(), *counts[c])) {
+      fail(path, at_line(tokens.line()) + "the " + names[c] + " count '" + std::string(token.substr(0, 24)) +
+                     "' is not a count");
+    }
+    if (*counts[c] > size) {
+      fail(path, at_line(tokens.line()) + "OFF " + names[c] + " count " + std::to_string(*counts[c]) +
+                     " is impossible for a " + std::to_string(size) + "-byte file");
+    }
+  }
   for (long long v = 0; v < nv; ++v) {
-    if (!lines.next(line)) {
-      fail(path, "truncated OFF: the header promises " + std::to_string(nv) + " vertices, the file ends after " +
-                     std::to_string(v));
-    }
-    if (!parse_numbers(line.c_str(), 3, xyz)) fail(path, at_line(lines.line_no()) + "malformed vertex");
-    for (double x : xyz) {
-      if (!std::isfinite(x)) {
-        fail(path, at_line(lines.line_no()) + "vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+    for (int c = 0; c < 3; ++c) {
+      const std::string_view token = tokens.next();
+      if (token.empty()) {
+        fail(path, "truncated OFF: the header promises " + std::to_string(nv) +
+                       " vertices, the file ends after " + std::to_string(v));
       }
+      double x = 0;
+      if (!parse_number(token, x)) {
+        fail(path, at_line(tokens.line()) + "malformed vertex " + std::to_string(v) + " ('" +
+                       std::string(token.substr(0, 24)) + "')");
+      }
+      const std::string problem = coordinate_problem(x, "vertex " + std::to_string(v));
+      if (!problem.empty()) fail(path, at_line(tokens.line()) + problem);
     }
+    tokens.skip_line();  // colors, texture coordinates: ignored by the reader too
   }
   for (long long f = 0; f < nf; ++f) {
-    if (!lines.next(line)) {
+    std::string_view token = tokens.next();
+    if (token.empty()) {
       fail(path, "truncated OFF: the header promises " + std::to_string(nf) + " faces, the file ends after " +
                      std::to_string(f));
     }
-    std::istringstream face(line);
-    // Whole-token integers: "5S" must not pass as 5 (OpenMesh's OFF reader can loop forever on it).
-    auto next_integer = [&](long long& value) {
-      std::string token;
-      if (!(face >> token)) return false;
-      char* end = nullptr;
-      value = std::strtoll(token.c_str(), &end, 10);
-      return end != token.c_str() && *end == '\0';
-    };
     long long k = 0;
-    if (!next_integer(k) || k < 3 || k > nv) fail(path, at_line(lines.line_no()) + "malformed face");
+    if (!parse_count(token, nv, k) || k < 3) {
+      fail(path, at_line(tokens.line()) + "malformed face " + std::to_string(f) + ": '" +
+                     std::string(token.substr(0, 24)) + "' is not a corner count from 3 to the " +
+                     std::to_string(nv) + " vertices");
+    }
     for (long long i = 0; i < k; ++i) {
+      token = tokens.next();
       long long index = -1;
-      if (!next_integer(index)) fail(path, at_line(lines.line_no()) + "malformed face");
-      if (index < 0 || index >= nv) {
-        fail(path, at_line(lines.line_no()) + "face " + std::to_string(f) + " references vertex " +
+      if (!parse_count(token, std::numeric_limits<long long>::max(), index)) {
+        fail(path, at_line(tokens.line()) + "malformed face " + std::to_string(f) + " ('" +
+                       std::string(token.substr(0, 24)) + "' is not a vertex index)");
+      }
+      if (index >= nv) {
+        fail(path, at_line(tokens.line()) + "face " + std::to_string(f) + " references vertex " +
                        std::to_string(index) + ", but the file has " + std::to_string(nv) + " vertices");
       }
     }
   }
 }
 
-void validate_ply(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+// Reads PLY values in file order, ascii (whitespace-separated tokens, as `std::istream >>` sees them) or
+// binary.
+class PlyValues {
+ public:
+  PlyValues(std::string_view bytes, const PlyHeader& h)
+      : bytes_(bytes),
+        pos_(static_cast<std::size_t>(h.header_bytes)),
+        binary_(h.binary),
+        big_endian_(h.big_endian) {}
+
+  enum class Result { kOk, kEnd, kMalformed };
+
+  // A value of type `t`. Ascii: the whole token must be a number of that type; an integer in its range
+  // (iostreams would stop at a fraction or an overflow and misalign everything after; floats are
+  // range-checked by the caller, who can name the problem).
+  Result read(PlyType t, double& value) {
+    if (binary_) {
+      const std::size_t n = static_cast<std::size_t>(ply_size(t));
+      if (bytes_.size() - pos_ < n) return Result::kEnd;
+      unsigned char b[8];
+      for (std::size_t k = 0; k < n; ++k)
+        b[k] = static_cast<unsigned char>(bytes_[pos_ + (big_endian_ ? n - 1 - k : k)]);
+      pos_ += n;
+      std::uint64_t u = 0;
+      for (std::size_t k = n; k-- > 0;) u = u << 8 | b[k];
+      switch (t) {
+        case PlyType::kChar:
+          value = static_cast<std::int8_t>(u);
+          break;
+        case PlyType::kUchar:
+          value = static_cast<double>(u);
+          break;
+        case PlyType::kShort:
+          value = static_cast<std::int16_t>(u);
+          break;
+        case PlyType::kUshort:
+          value = static_cast<double>(u);
+          break;
+        case PlyType::kInt:
+          value = static_cast<std::int32_t>(u);
+          break;
+        case PlyType::kUint:
+          value = static_cast<double>(u);
+          break;
+        case PlyType::kFloat: {
+          const auto u32 = static_cast<std::uint32_t>(u);
+          float f;
+          std::memcpy(&f, &u32, 4);
+          value = f;
+          break;
+        }
+        case PlyType::kDouble:
+          std::memcpy(&value, &u, 8);
+          break;
+      }
+      return Result::kOk;
+    }
+    const std::string_view token = next_token();
+    if (token.empty()) return Result::kEnd;
+    if (ply_is_float(t)) return parse_number(token, value) ? Result::kOk : Result::kMalformed;
+    const bool negative = token[0] == '-';
+    long long magnitude = 0;
+    if (!parse_count(negative ? token.substr(1) : token, std::numeric_limits<long long>::max(), magnitude)) {
+      return Result::kMalformed;
+    }
+    value = negative ? -static_cast<double>(magnitude) : static_cast<double>(magnitude);
+    const int bits = 8 * ply_size(t);
+    const bool is_signed = t == PlyType::kChar || t == PlyType::kShort || t == PlyType::kInt;
+    const double max = is_signed ? std::ldexp(1.0, bits - 1) - 1 : std::ldexp(1.0, bits) - 1;
+    const double min = is_signed ? -std::ldexp(1.0, bits - 1) : 0;
+    return value < min || value > max ? Result::kMalformed : Result::kOk;
+  }
+
+  // Line of the last ascii token (linear: for messages only).
+  std::string where() const {
+    if (binary_) return "byte " + std::to_string(pos_) + ": ";
+    return at_line(1 +
+                   static_cast<std::size_t>(std::count(bytes_.begin(), bytes_.begin() + token_begin_, '\n')));
+  }
+
+ private:
+  std::string_view next_token() {
+    while (pos_ < bytes_.size() && std::isspace(static_cast<unsigned char>(bytes_[pos_]))) ++pos_;
+    token_begin_ = pos_;
+    while (pos_ < bytes_.size() && !std::isspace(static_cast<unsigned char>(bytes_[pos_]))) ++pos_;
+    return bytes_.substr(token_begin_, pos_ - token_begin_);
+  }
+
+  std::string_view bytes_;
+  std::size_t pos_;
+  std::size_t token_begin_ = 0;
+  bool binary_;
+  bool big_endian_;
+};
+
+// Walks every value OpenMesh's PLY reader will read (the elements up to and including "face"), in its order,
+// checking counts, coordinates and face indices before it loops over them.
+PlyHeader validate_ply(const std::string& path, std::string_view bytes) {
+  MemoryStream in(bytes);
   PlyHeader h;
   std::string problem;
   if (!parse_ply_header(in, h, problem)) fail(path, problem);
-  const std::uint64_t size = std::filesystem::file_size(path);
-  if (h.binary && h.vertex_fixed) {
-    const std::uint64_t need_vertices = h.header_bytes + h.vertex_count * h.vertex_record_bytes;
-    if (size < need_vertices) {
-      fail(path, "truncated PLY: the header promises " + std::to_string(h.vertex_count) + " vertices (" +
-                     std::to_string(need_vertices) + " bytes) but the file has " + std::to_string(size) + " bytes");
+  const std::uint64_t size = bytes.size();
+  h.header_bytes = std::min(h.header_bytes, size);  // tellg() says -1 when end_header ends the file
+  // Every item of an element takes at least one byte: larger counts are lies, and would make the reader
+  // loop that many times.
+  std::uint64_t vertices = 0;
+  for (const auto& e : h.elements) {
+    if (e.count > size - h.header_bytes) {
+      fail(path, "truncated PLY: the header promises " + std::to_string(e.count) + " items of element '" +
+                     e.name.substr(0, 32) + "', more than the " + std::to_string(size - h.header_bytes) +
+                     " bytes after it can hold");
     }
-    if (h.face_simple && h.face_count_bytes > 0 && h.face_index_bytes > 0 && h.face_count > 0) {
-      // Lower bound: every face has at least 3 indices.
-      const std::uint64_t min_face = std::uint64_t(h.face_count_bytes) + 3ull * std::uint64_t(h.face_index_bytes);
-      if ((size - need_vertices) / min_face < h.face_count) {
-        fail(path, "truncated PLY: the header promises " + std::to_string(h.face_count) +
-                       " faces but the file ends after at most " + std::to_string((size - need_vertices) / min_face));
-      }
-    }
-    return;
+    if (e.name == "vertex") vertices = e.count;
   }
-  if (!h.ascii || h.elements.empty() || h.elements[0] != "vertex" || !h.vertex_fixed) return;
-  if (h.vertex_count > size || h.face_count > size) fail(path, "PLY element counts are impossible for the file size");
-  int xyz_index[3] = {-1, -1, -1};
-  for (std::size_t i = 0; i < h.vertex_props.size(); ++i) {
-    if (h.vertex_props[i] == "x") xyz_index[0] = int(i);
-    if (h.vertex_props[i] == "y") xyz_index[1] = int(i);
-    if (h.vertex_props[i] == "z") xyz_index[2] = int(i);
-  }
-  LineScanner lines(in, 0);
-  std::string line;
-  std::vector<double> record;
-  for (std::uint64_t v = 0; v < h.vertex_count; ++v) {
-    if (!lines.next(line)) {
-      fail(path, "truncated PLY: the header promises " + std::to_string(h.vertex_count) +
-                     " vertices, the file ends after " + std::to_string(v));
-    }
-    if (!parse_numbers(line.c_str(), int(h.vertex_props.size()), record)) {
-      fail(path, "malformed vertex " + std::to_string(v) + " in the ascii PLY data");
-    }
-    for (int k : xyz_index) {
-      if (k >= 0 && !std::isfinite(record[k])) {
-        fail(path, "vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
-      }
-    }
-  }
-  if (h.elements.size() >= 2 && h.elements[1] == "face") {
-    for (std::uint64_t f = 0; f < h.face_count; ++f) {
-      if (!lines.next(line)) {
-        fail(path, "truncated PLY: the header promises " + std::to_string(h.face_count) +
-                       " faces, the file ends after " + std::to_string(f));
-      }
-      if (!h.face_simple) continue;
-      // "k i1 ... ik" and nothing else, all integers.
-      std::istringstream face(line);
-      std::string token;
-      std::vector<long long> values;
-      while (face >> token) {
-        char* end = nullptr;
-        const long long value = std::strtoll(token.c_str(), &end, 10);
-        if (*end != '\0') fail(path, "malformed face " + std::to_string(f) + " in the ascii PLY data");
-        values.push_back(value);
-      }
-      if (values.empty() || values[0] < 3 || static_cast<long long>(values.size()) != values[0] + 1) {
-        fail(path, "malformed face " + std::to_string(f) + " in the ascii PLY data");
-      }
-      for (std::size_t k = 1; k < values.size(); ++k) {
-        if (values[k] < 0 || static_cast<std::uint64_t>(values[k]) >= h.vertex_count) {
-          fail(path, "face " + std::to_string(f) + " references vertex " + std::to_string(values[k]) +
-                         ", but the file has " + std::to_string(h.vertex_count) + " vertices");
+  PlyValues values(bytes, h);
+  auto truncated = [&](const PlyElement& e, std::uint64_t item) {
+    fail(path, "truncated PLY: the header promises " + std::to_string(e.count) + " " + e.name.substr(0, 32) +
+                   (e.count == 1 ? "" : "s") + ", the file ends in item " + std::to_string(item));
+  };
+  for (const PlyElement& e : h.elements) {
+    const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
+    for (std::uint64_t item = 0; item < e.count; ++item) {
+      for (const PlyProperty& prop : e.properties) {
+        double value = 0;
+        if (!prop.list) {
+          const auto r = values.read(prop.type, value);
+          if (r == PlyValues::Result::kEnd) truncated(e, item);
+          if (r == PlyValues::Result::kMalformed) {
+            fail(path, values.where() + "malformed value of property '" + prop.name.substr(0, 32) + "' of " +
+                           e.name.substr(0, 32) + " " + std::to_string(item));
+          }
+          const bool coordinate = is_vertex && (prop.name == "x" || prop.name == "y" || prop.name == "z");
+          // Coordinates: NaN, infinite or beyond float range, in either encoding. Other ascii floats too: the
+          // reader's `>> float` would fail there and misalign the rest (binary ones it just converts).
+          if (ply_is_float(prop.type) && (coordinate || !h.binary)) {
+            const std::string bad =
+                coordinate_problem(value, coordinate ? "vertex " + std::to_string(item)
+                                                     : "property '" + prop.name.substr(0, 32) + "' of " +
+                                                           e.name.substr(0, 32) + " " + std::to_string(item));
+            if (!bad.empty()) fail(path, values.where() + bad);
+          }
+          continue;
         }
+        double length = 0;
+        auto r = values.read(prop.count_type, length);
+        if (r == PlyValues::Result::kEnd) truncated(e, item);
+        const bool indices = is_face && is_face_indices(prop.name);
+        if (r == PlyValues::Result::kMalformed || length < 0 ||
+            (indices && (length < 3 || length > vertices))) {
+          fail(path, values.where() + "malformed " + e.name.substr(0, 32) + " " + std::to_string(item) +
+                         ": " +
+                         (indices ? "its corner count is not from 3 to the number of vertices"
+                                  : "bad length of list '" + prop.name.substr(0, 32) + "'"));
+        }
+        for (double k = 0; k < length; ++k) {
+          r = values.read(prop.type, value);
+          if (r == PlyValues::Result::kEnd) truncated(e, item);
+          if (r == PlyValues::Result::kMalformed || (indices && ply_is_float(prop.type))) {
+            fail(path, values.where() + "malformed " + e.name.substr(0, 32) + " " + std::to_string(item));
+          }
+          if (indices && (value < 0 || value >= static_cast<double>(vertices))) {
+            fail(path, values.where() + "face " + std::to_string(item) + " references vertex " +
+                           std::to_string(static_cast<long long>(value)) + ", but the file has " +
+                           std::to_string(vertices) + " vertices");
+          }
+        }
+      }
+    }
+    if (is_face) break;  // the reader stops after the faces
+  }
+  return h;
+}
+
+// Binary STL: 80-byte header, uint32 facet count, 50 bytes per facet. OpenMesh's stream reader cannot tell
+// binary from ascii by itself, so the size decides (an ascii file matching it by chance is vanishingly rare).
+bool is_binary_stl(const std::string& path, std::string_view bytes) {
+  const std::uint64_t size = bytes.size();
+  if (size < 84) return false;
+  const auto* c = reinterpret_cast<const unsigned char*>(bytes.data()) + 80;
+  const std::uint64_t facets = c[0] | (c[1] << 8) | (c[2] << 16) | (std::uint64_t(c[3]) << 24);
+  if (size == 84 + 50 * facets) return true;
+  if (bytes.substr(0, 5) != "solid") {
+    fail(path, "neither ascii STL (no 'solid') nor binary STL (" + std::to_string(facets) + " facets need " +
+                   std::to_string(84 + 50 * facets) + " bytes, the file has " + std::to_string(size) + ")");
+  }
+  return false;
+}
+
+// Ascii STL as OpenMesh's reader walks it: every line containing "outer" (or "OUTER") starts a facet whose
+// next three lines are "<word> x y z". The coordinates must be usable numbers: the reader parses them with
+// `>> float` (1e39 fails and leaves a stale value) and keys its vertex map on them (NaN breaks its ordering).
+void validate_ascii_stl(const std::string& path, std::string_view bytes) {
+  MemoryStream in(bytes);
+  std::string line;
+  std::size_t line_no = 0;
+  std::vector<double> xyz;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find("outer") == std::string::npos && line.find("OUTER") == std::string::npos) continue;
+    for (int corner = 0; corner < 3; ++corner) {
+      if (!std::getline(in, line))
+        fail(path, "truncated STL: the file ends inside the facet of line " + std::to_string(line_no));
+      ++line_no;
+      const auto first = line.find_first_not_of(" \t\r\n");
+      std::size_t end = first == std::string::npos ? line.size() : first;
+      while (end < line.size() && !std::isspace(static_cast<unsigned char>(line[end]))) ++end;
+      if (first == std::string::npos || !parse_numbers(line.c_str() + end, 3, xyz)) {
+        fail(path, at_line(line_no) + "malformed vertex (expected 'vertex x y z' after 'outer loop')");
+      }
+      for (double v : xyz) {
+        const std::string problem = coordinate_problem(v, "vertex");
+        if (!problem.empty()) fail(path, at_line(line_no) + problem);
       }
     }
   }
 }
 
-// Binary STL: 80-byte header, uint32 facet count, 50 bytes per facet. OpenMesh's stream reader cannot tell
-// binary from ascii by itself, so the size decides (an ascii file matching it by chance is vanishingly rare).
-bool is_binary_stl(const std::string& path) {
-  const std::uint64_t size = std::filesystem::file_size(path);
-  if (size < 84) return false;
-  std::ifstream in(path, std::ios::binary);
-  in.seekg(80);
-  unsigned char c[4] = {0, 0, 0, 0};
-  in.read(reinterpret_cast<char*>(c), 4);
-  const std::uint64_t facets = c[0] | (c[1] << 8) | (c[2] << 16) | (std::uint64_t(c[3]) << 24);
-  if (size == 84 + 50 * facets) return true;
-  std::string head(5, '\0');
-  in.seekg(0);
-  in.read(head.data(), 5);
-  if (head != "solid") {
-    fail(path, "neither ascii STL (no 'solid') nor binary STL (" + std::to_string(facets) + " facets need " +
-                   std::to_string(84 + 50 * facets) + " bytes, the file has " + std::to_string(size) + ")");
+// Binary STL: the vertex coordinates must be finite (NaN breaks the reader's vertex map ordering).
+void validate_binary_stl(const std::string& path, std::string_view bytes) {
+  for (std::size_t offset = 84; offset + 50 <= bytes.size(); offset += 50) {
+    for (int k = 3; k < 12; ++k) {
+      float v;
+      std::memcpy(&v, bytes.data() + offset + 4 * k, 4);
+      if (!std::isfinite(v)) {
+        fail(path,
+             "facet " + std::to_string((offset - 84) / 50) + " has a NaN or infinite vertex coordinate");
+      }
+    }
   }
-  return false;
+}
+
+// Only a regular file (or a link to one) is read: a device (/dev/zero), FIFO or socket would never end or
+// block, a directory is no file. Checked before the extension, so the message names the real problem.
+void check_regular_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) fail(path, "no such file");
+  if (ec) fail(path, "cannot read (" + ec.message() + ")");
+  switch (status.type()) {
+    case fs::file_type::regular:
+      break;
+    case fs::file_type::directory:
+      fail(path, "is a directory, not a mesh file");
+    case fs::file_type::fifo:
+      fail(path, "is a FIFO (named pipe), not a regular file: geomip reads mesh files only");
+    case fs::file_type::socket:
+      fail(path, "is a socket, not a regular file: geomip reads mesh files only");
+    case fs::file_type::character:
+    case fs::file_type::block:
+      fail(path, "is a device, not a regular file: geomip reads mesh files only");
+    default:
+      fail(path, "is not a regular file: geomip reads mesh files only");
+  }
+}
+
+// The file's bytes, read once, at most `max_bytes` of them (check_regular_file() first).
+std::string read_file_bounded(const std::string& path, std::uint64_t max_bytes) {
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(path, ec);
+  if (ec) fail(path, "cannot read (" + ec.message() + ")");
+  if (size == 0) fail(path, "empty file");
+  if (size > max_bytes) {
+    fail(path, "the file has " + std::to_string(size) + " bytes, more than geomip reads (" +
+                   std::to_string(max_bytes) + " bytes; ReadMeshOptions::max_file_bytes)");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, std::string("cannot open for reading (") + std::strerror(errno) + ")");
+  // Read what the size said, plus one byte to notice a file that grows meanwhile: never more.
+  std::string bytes(static_cast<std::size_t>(size) + 1, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const auto got = static_cast<std::uint64_t>(in.gcount());
+  if (in.bad()) fail(path, "read error");
+  if (got > size) fail(path, "the file grew while it was read");
+  bytes.resize(static_cast<std::size_t>(got));
+  if (bytes.empty()) fail(path, "empty file");
+  return bytes;
 }
 
 }  // namespace
@@ -579,29 +1092,49 @@ MeshFormat mesh_format_from_path(const std::string& path) {
 }
 
 TriMesh read_mesh(const std::string& path, const ReadMeshOptions& options) {
-  silence_openmesh();
+  check_regular_file(path);
   const MeshFormat format = mesh_format_from_path(path);
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
-  if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a mesh file");
-  {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe) fail(path, "cannot open for reading");
+  const std::string bytes = read_file_bounded(path, options.max_file_bytes);
+  return read_mesh_from_memory(bytes, format, path, options);
+}
+
+TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& path,
+                              const ReadMeshOptions& options) {
+  silence_openmesh();
+  if (bytes.empty()) fail(path, "empty file");
+  if (bytes.size() > options.max_file_bytes) {
+    fail(path, "the file has " + std::to_string(bytes.size()) + " bytes, more than geomip reads (" +
+                   std::to_string(options.max_file_bytes) + " bytes; ReadMeshOptions::max_file_bytes)");
   }
-  if (std::filesystem::file_size(path, ec) == 0) fail(path, "empty file");
+  bool binary_stl = false;
+  std::string ply_header;  // PLY: the validated header, rewritten (PlyHeader::canonical())
+  std::string_view data = bytes;
   switch (format) {
-    case MeshFormat::kObj: validate_obj(path); break;
-    case MeshFormat::kOff: validate_off(path); break;
-    case MeshFormat::kPly: validate_ply(path); break;
-    case MeshFormat::kStl: break;  // the facet count is checked against the size below
+    case MeshFormat::kObj:
+      validate_obj(path, bytes);
+      break;
+    case MeshFormat::kOff:
+      validate_off(path, bytes);
+      break;
+    case MeshFormat::kPly: {
+      const PlyHeader h = validate_ply(path, bytes);
+      ply_header = h.canonical();
+      data = bytes.substr(static_cast<std::size_t>(h.header_bytes));
+      break;
+    }
+    case MeshFormat::kStl:
+      binary_stl = is_binary_stl(path, bytes);  // the facet count is checked against the size
+      (binary_stl ? validate_binary_stl : validate_ascii_stl)(path, bytes);
+      break;
   }
 
   RecordingImporter importer;
   OpenMesh::IO::Options io_options;
-  if (format == MeshFormat::kStl && is_binary_stl(path)) io_options += OpenMesh::IO::Options::Binary;
+  if (binary_stl) io_options += OpenMesh::IO::Options::Binary;
   bool ok = false;
   try {
-    std::ifstream in(path, std::ios::binary);
+    JoinedStream in(ply_header, data);
+    const SilencedCerr quiet;
     // OpenMesh picks the reader by extension; STL variants all go through "stl".
     ok = OpenMesh::IO::IOManager().read(in, extension_of(format), importer, io_options);
   } catch (const std::exception& e) {
@@ -627,8 +1160,9 @@ TriMesh read_mesh(const std::string& path, const ReadMeshOptions& options) {
   }
   if (options.reject_non_finite) {
     for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-      if (!mesh.positions[v].allFinite()) {
-        fail(path, "vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+      for (int c = 0; c < 3; ++c) {
+        const std::string problem = coordinate_problem(mesh.positions[v][c], "vertex " + std::to_string(v));
+        if (!problem.empty()) fail(path, problem);
       }
     }
   }

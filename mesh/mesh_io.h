@@ -8,8 +8,10 @@
 
 #include "mesh/mesh.h"
 
+#include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <string_view>
 
 namespace geomip {
 
@@ -20,16 +22,32 @@ enum class MeshFormat { kObj, kPly, kOff, kStl };
 MeshFormat mesh_format_from_path(const std::string& path);
 
 struct ReadMeshOptions {
-  /// Reject NaN/Inf coordinates (on by default: nothing downstream can use them).
+  /// Reject NaN/Inf coordinates and finite ones beyond the 32-bit float range (±3.4e38) (on by default:
+  /// nothing downstream can use them).
   bool reject_non_finite = true;
+  /// Largest file read, in bytes (default 4 GiB, about 80 million triangles of binary PLY). read_mesh() holds
+  /// the whole file in memory while it parses, so this bounds its memory; larger files are refused unread.
+  std::uint64_t max_file_bytes = std::uint64_t{4} << 30;
 };
 
 /// Reads a mesh file. Polygons with more than three corners are triangulated as fans.
-/// Checks: the file exists and is readable, the parser accepts it, it has at least one face, every face index
-/// is in range, every referenced coordinate is finite (unless disabled), and the file is not truncated
-/// (binary PLY with fewer bytes than its header promises).
+/// Checks: the path is a regular file (not a directory, device such as /dev/zero, FIFO or socket: those are
+/// refused before a byte is read) of at most `options.max_file_bytes` bytes, the parser accepts it, it has at
+/// least one face, every face index is in range and fits an int (OBJ: the message names the line), every
+/// referenced coordinate is finite and within float range (unless disabled; text formats name the line), and
+/// the file is not truncated (binary PLY with fewer bytes than its header promises).
+/// The file is read once into memory, then parsed as read_mesh_from_memory() does.
 /// \throw InvalidInput with a message naming `path` and the problem.
 TriMesh read_mesh(const std::string& path, const ReadMeshOptions& options = {});
+
+/// Parses the bytes of a mesh file already in memory (`name` only labels the messages): the same checks as
+/// read_mesh() after its file checks. Before OpenMesh's reader sees the bytes, geomip walks them the way that
+/// reader will (its tokens, its counts, its list lengths) and refuses what it would misread, so work and
+/// memory stay bounded by `bytes.size()` (O(n log n): the STL reader's vertex map). The entry point of the mesh
+/// readers' fuzzer (tests/fuzz/mesh_fuzzer.cpp).
+/// \throw InvalidInput with a message naming `name` and the problem.
+TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& name,
+                              const ReadMeshOptions& options = {});
 
 struct WriteMeshOptions {
   /// PLY only: binary little-endian (default) or ascii.

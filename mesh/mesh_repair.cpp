@@ -12,7 +12,9 @@
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
 
+#include <algorithm>
 #include <map>
+#include <numeric>
 #include <set>
 #include <unordered_map>
 
@@ -39,6 +41,67 @@ struct PositionHash {
 struct PositionEqual {
   bool operator()(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const { return a == b; }
 };
+
+// Keeps the largest edge-connected component of `polygons` (by faces; the one with the first face on a tie),
+// then drops the points no kept face references, keeping the survivors' order.
+void keep_largest_component(std::vector<Point>& points, std::vector<std::array<std::size_t, 3>>& polygons,
+                            RepairResult& result) {
+  const std::size_t nf = polygons.size();
+  std::vector<std::size_t> parent(nf);
+  std::iota(parent.begin(), parent.end(), std::size_t{0});
+  auto find = [&](std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  // Faces sharing an undirected edge are joined (as analyze_topology() counts components).
+  std::vector<std::array<std::size_t, 3>> edges;  // (min vertex, max vertex, face)
+  edges.reserve(3 * nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t a = polygons[f][k], b = polygons[f][(k + 1) % 3];
+      edges.push_back({std::min(a, b), std::max(a, b), f});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 1; i < edges.size(); ++i) {
+    if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1]) {
+      const std::size_t a = find(edges[i][2]), b = find(edges[i - 1][2]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<std::size_t> size(nf, 0);
+  for (std::size_t f = 0; f < nf; ++f) ++size[find(f)];
+  std::size_t best = 0, components = 0;
+  for (std::size_t f = 0; f < nf; ++f) {
+    if (size[f] == 0) continue;
+    ++components;
+    if (size[f] > size[best]) best = f;
+  }
+  if (components <= 1) return;
+  result.removed_components = components - 1;
+  result.removed_component_faces = nf - size[best];
+
+  std::vector<std::array<std::size_t, 3>> kept;
+  kept.reserve(size[best]);
+  std::vector<char> used(points.size(), 0);
+  for (std::size_t f = 0; f < nf; ++f) {
+    if (find(f) != best) continue;
+    kept.push_back(polygons[f]);
+    for (std::size_t v : polygons[f]) used[v] = 1;
+  }
+  std::vector<std::size_t> remap(points.size(), 0);
+  std::vector<Point> kept_points;
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    if (!used[v]) continue;
+    remap[v] = kept_points.size();
+    kept_points.push_back(points[v]);
+  }
+  for (auto& t : kept) {
+    for (std::size_t& v : t) v = remap[v];
+  }
+  points = std::move(kept_points);
+  polygons = std::move(kept);
+}
 
 }  // namespace
 
@@ -94,6 +157,7 @@ RepairResult repair_mesh(const TriMesh& input, const RepairOptions& options) {
     polygons.push_back({std::size_t(r[0]), std::size_t(r[1]), std::size_t(r[2])});
   }
   if (polygons.empty()) throw InvalidInput("repair_mesh: every face is degenerate");
+  if (options.largest_component_only) keep_largest_component(points, polygons, result);
 
   // 3. Non-manifold vertices and edges: orient_polygon_soup duplicates the points it must split (appended).
   report(options, "splitting non-manifold vertices", 0.2);

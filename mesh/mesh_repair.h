@@ -7,12 +7,14 @@
 namespace geomip {
 
 struct RepairOptions {
+  /// Keep only the largest edge-connected component (by face count; the first one on a tie) and drop the
+  /// others before repairing: for scans with stray fragments, which cannot be parameterized as one surface.
+  bool largest_component_only = false;
   /// Close holes (CGAL Polygon Mesh Processing: triangulate, refine, fair; Liepa 2003).
   bool fill_holes = true;
-  /// Refinement density of the hole patches (CGAL's density_control_factor: larger is denser; CGAL's own
-  /// default √2 adds 328 vertices to the bunny's base). 0.5 closes the shared bunny's five holes with 17 new
-  /// vertices (69,698 faces; the paper's closed bunny has 69,642), enough interior vertices to fair the
-  /// larger holes without inventing detail.
+  /// Refinement density of the hole patches (CGAL's density_control_factor: larger is denser, CGAL's own
+  /// default is √2). 0.5 adds a few interior vertices to each large hole, enough to fair it without inventing
+  /// detail (figures on the bunny: docs/measurements.md).
   double hole_density = 0.5;
   /// Fairing continuity of the hole patches: 0 = C0 (flat), 1 = tangent, 2 = curvature continuous.
   unsigned int fairing_continuity = 1;
@@ -31,11 +33,15 @@ struct RepairResult {
   std::size_t unfaired_holes = 0;             ///< holes only triangulated and refined (fairing failed)
   std::size_t added_vertices = 0;             ///< appended by hole filling
   bool reoriented = false;                    ///< faces flipped so a closed mesh points outward
+  std::size_t removed_components = 0;         ///< components dropped by largest_component_only
+  std::size_t removed_component_faces = 0;    ///< their faces (not counted in removed_degenerate_faces)
 };
 
 /// Repairs `mesh`:
 /// 1. drops unreferenced vertices and merges vertices at identical positions (the first one is kept);
-/// 2. drops faces with a repeated vertex, duplicate faces, and zero-area faces (CGAL edge collapses);
+/// 2. drops faces with a repeated vertex, duplicate faces, and zero-area faces (CGAL edge collapses); with
+///    `largest_component_only`, the faces (and then vertices) of every edge-connected component but the
+///    largest;
 /// 3. splits non-manifold vertices and edges (CGAL orient_polygon_soup duplicates them);
 /// 4. fills every hole with CGAL's triangulate_refine_and_fair_hole;
 /// 5. orients a closed result outward.

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -27,6 +28,20 @@ struct DecodeArgs {
   bool json = false;
   bool quiet = false;
 };
+
+// Bytes up to the end of the first geometry chunk (pass 0) of every model: the shortest prefix from which
+// each model decodes to a shape.
+std::uint64_t first_level_bytes(const codec::PackInfo& info) {
+  std::uint64_t end = info.manifest_end;
+  std::vector<char> seen(info.models.size(), 0);
+  for (const codec::ChunkInfo& chunk : info.chunks) {
+    const auto m = static_cast<std::size_t>(chunk.model);
+    if (chunk.kind != codec::ChunkKind::kGeometry || m >= seen.size() || seen[m]) continue;
+    seen[m] = 1;
+    end = std::max(end, chunk.offset + chunk.size);
+  }
+  return end;
+}
 
 MeshFormat format_of(const std::string& path) {
   const std::string ext = std::filesystem::path(path).extension().string();
@@ -49,6 +64,17 @@ int run_decode(const DecodeArgs& args) {
   const double decode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   const bool prefix_asked = args.bytes >= 0;
+  if (decoded.status == codec::Status::kTruncated && decoded.models.empty()) {
+    // The bytes end inside the manifest: decode_pack() knows no chunk sizes, only the header's manifest size.
+    if (prefix_asked && static_cast<std::size_t>(args.bytes) < bytes.size()) {
+      throw InvalidInput(args.pack + ": the first " + std::to_string(args.bytes) +
+                         " bytes end inside the pack's manifest (" + std::to_string(manifest_end) +
+                         " bytes needed before any level of detail)");
+    }
+    throw InvalidInput(args.pack + ": the pack is truncated inside its manifest (the file has " +
+                       std::to_string(bytes.size()) + " bytes, the manifest alone needs " +
+                       std::to_string(manifest_end) + ")");
+  }
   if (decoded.status == codec::Status::kTruncated && !prefix_asked) {
     throw InvalidInput(args.pack + ": the pack is truncated (" + std::to_string(bytes.size()) + " of " +
                        std::to_string(decoded.info.file_size()) +
@@ -58,10 +84,18 @@ int run_decode(const DecodeArgs& args) {
   if (decoded.status != codec::Status::kOk && decoded.status != codec::Status::kTruncated) {
     throw InvalidInput(args.pack + ": " + std::string(codec::status_message(decoded.status)));
   }
-  if (decoded.models.empty()) {
-    throw InvalidInput(args.pack + ": the first " + std::to_string(args.bytes) +
-                       " bytes end inside the pack's manifest (" + std::to_string(decoded.info.manifest_end) +
-                       " bytes needed before any level of detail)");
+  if (decoded.models.empty()) throw InvalidInput(args.pack + ": the pack holds no model");
+  // The first level of detail: one complete geometry pass of every model. Before it a model's grids are
+  // still zero (a mesh of zero extent), so a prefix shorter than that is refused, not written.
+  const std::uint64_t first_level = first_level_bytes(decoded.info);
+  for (const auto& model : decoded.models) {
+    if (model.geometry_passes == 0) {
+      const std::size_t given =
+          prefix_asked ? std::min(bytes.size(), static_cast<std::size_t>(args.bytes)) : bytes.size();
+      throw InvalidInput(args.pack + ": the first " + std::to_string(given) +
+                         " bytes hold no level of detail; the first level needs " +
+                         std::to_string(first_level) + " bytes");
+    }
   }
   const int grid_level = decoded.models.front().geometry.front().level;
   if (args.level > grid_level)

@@ -114,7 +114,6 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
 
 int run_param(const ParamArgs& args) {
   const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param", args.common.quiet || args.common.json);
-  std::filesystem::create_directories(args.common.output);
   const std::vector<ParameterizationInput>& inputs = models.inputs;
   const std::vector<std::string>& paths = models.paths;
 
@@ -128,6 +127,8 @@ int run_param(const ParamArgs& args) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bar.finish();
 
+  // Only now: a failed run leaves no (empty) output directory behind.
+  std::filesystem::create_directories(args.common.output);
   nlohmann::json summary = nlohmann::json::array();
   for (std::size_t i = 0; i < result.size(); ++i) {
     const std::string stem = (std::filesystem::path(args.common.output) / inputs[i].name).string();

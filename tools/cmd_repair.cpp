@@ -18,6 +18,7 @@ struct RepairArgs {
   std::string input;
   std::string output;
   bool no_fill = false;
+  bool largest_component = false;
   bool ascii = false;
   bool json = false;
   bool quiet = false;
@@ -28,6 +29,10 @@ std::string summary(const RepairResult& r) {
   auto item = [&](std::size_t n, const char* what) {
     if (n) s << (s.tellp() > 0 ? ", " : "") << what << " " << n;
   };
+  if (r.removed_components) {
+    s << "dropped " << r.removed_components << " smaller component" << (r.removed_components > 1 ? "s" : "")
+      << " (" << r.removed_component_faces << " faces)";
+  }
   item(r.removed_unreferenced_vertices, "removed unreferenced vertices:");
   item(r.merged_duplicate_vertices, "merged duplicate vertices:");
   item(r.removed_degenerate_faces, "removed degenerate/duplicate faces:");
@@ -50,6 +55,7 @@ int run_repair(const RepairArgs& args) {
 
   RepairOptions options;
   options.fill_holes = !args.no_fill;
+  options.largest_component_only = args.largest_component;
   ProgressBar bar("repair", !args.quiet && !args.json);
   options.progress = bar.callback();
   const RepairResult result = repair_mesh(input, options);
@@ -76,6 +82,8 @@ int run_repair(const RepairArgs& args) {
     j["unfaired_holes"] = result.unfaired_holes;
     j["added_vertices"] = result.added_vertices;
     j["reoriented"] = result.reoriented;
+    j["removed_components"] = result.removed_components;
+    j["removed_component_faces"] = result.removed_component_faces;
     std::cout << j.dump(2) << "\n";
   } else if (!args.quiet) {
     std::cout << "repair " << args.input << ": " << summary(result) << "\n"
@@ -99,6 +107,9 @@ CommandRunner add_repair_command(CLI::App& app) {
   cmd->add_option("input", args->input, "Input mesh (.obj .ply .off .stl)")->required();
   cmd->add_option("-o,--output", args->output, "Output mesh (.obj .ply .off)")->required();
   cmd->add_flag("--no-fill", args->no_fill, "Do not fill holes");
+  cmd->add_flag("--largest-component", args->largest_component,
+                "Keep only the largest connected component (by face count) and drop the others, then repair: "
+                "param/convert take one connected surface per mesh");
   cmd->add_flag("--ascii", args->ascii, "Write PLY as ascii (default: binary little-endian)");
   cmd->add_flag("--json", args->json, "Machine-readable report on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar, no report");

@@ -7,6 +7,8 @@
 #include "param/partition_points.h"
 #include "tools/correspondence.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -14,11 +16,56 @@
 namespace geomip::tools {
 namespace {
 
+// The partition needs 4 partition points and 4 auxiliary points, distinct vertices (genus 0).
+constexpr std::size_t kMinParameterizableVertices = 8;
+
+// Signed volume enclosed by a closed, consistently oriented mesh (divergence theorem), about its centroid.
+double enclosed_volume(const TriMesh& mesh) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : mesh.positions) c += p;
+  c /= static_cast<double>(std::max<std::size_t>(mesh.positions.size(), 1));
+  double six_v = 0;
+  for (const auto& t : mesh.triangles) {
+    six_v += (mesh.positions[t[0]] - c).dot((mesh.positions[t[1]] - c).cross(mesh.positions[t[2]] - c));
+  }
+  return six_v / 6.0;
+}
+
+// What the parameterization needs of a prepared (closed, manifold) mesh and cannot say itself in words a user
+// can act on: one connected surface, enough vertices for the partition points, and a volume (a flat disk,
+// once its hole is filled, is two coincident sheets that no partition can cut into patches).
+void check_parameterizable(const std::string& path, const TriMesh& mesh, const TopologyReport& input_report) {
+  const TopologyReport r = analyze_topology(mesh);
+  if (r.components > 1) {
+    throw InvalidInput(path + ": the mesh has " + std::to_string(r.components) +
+                       " connected components; geomip parameterizes one connected surface: keep the largest "
+                       "with `geomip repair --largest-component IN -o OUT` and use OUT");
+  }
+  if (r.vertices < kMinParameterizableVertices) {
+    throw InvalidInput(path + ": too few vertices to parameterize (" + std::to_string(input_report.vertices) +
+                       " in the file, " + std::to_string(r.vertices) + " after repair; at least " +
+                       std::to_string(kMinParameterizableVertices) + " are needed)");
+  }
+  const double diagonal = r.bbox_diagonal;
+  if (!(diagonal > 0) || std::abs(enclosed_volume(mesh)) < 1e-6 * diagonal * diagonal * diagonal) {
+    throw InvalidInput(path + ": the mesh is flat (" +
+                       std::string(input_report.boundary_loops
+                                       ? "a surface with a boundary whose filled holes "
+                                         "enclose no volume"
+                                       : "it encloses no volume") +
+                       "); geomip parameterizes closed surfaces around a volume");
+  }
+}
+
 // The mesh ready for partitioning: repaired when open, non-manifold or degenerate (with a note on stderr).
 TriMesh prepare_mesh(const std::string& path, const TriMesh& input, const std::string& command, bool quiet) {
   const TopologyReport r = analyze_topology(input);
-  if (r.boundary_loops == 0 && r.manifold && r.degenerate_faces == 0) return input;
+  if (r.boundary_loops == 0 && r.manifold && r.degenerate_faces == 0) {
+    check_parameterizable(path, input, r);
+    return input;
+  }
   const RepairResult repaired = repair_mesh(input);
+  check_parameterizable(path, repaired.mesh, r);
   if (!quiet) {
     std::cerr << command << ": " << path << ": " << (r.boundary_loops ? "open" : "non-manifold or degenerate")
               << " mesh repaired first (as `geomip repair`): " << repaired.filled_holes << " holes filled, "

@@ -4,6 +4,7 @@
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <filesystem>
 #include <fstream>
@@ -94,7 +95,8 @@ TEST_F(MeshIo, RejectsBadInputWithOneClearLine) {
   expect_rejected(write_text(dir_, "empty.obj", ""), "empty file");
   expect_rejected(write_text(dir_, "nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n"), "NaN");
   expect_rejected(write_text(dir_, "inf.obj", "v 0 0 0\nv 1 0 0\nv 0 -inf 0\nf 1 2 3\n"), "NaN or infinite");
-  expect_rejected(write_text(dir_, "oob.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "references vertex 8");
+  expect_rejected(write_text(dir_, "oob.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
+                  "line 4: face references vertex 9");
   expect_rejected(write_text(dir_, "nan.off", "OFF\n3 1 0\n0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n"), "NaN");
   expect_rejected(write_text(dir_, "oob.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), "references vertex 3");
   expect_rejected(write_text(dir_, "short.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n"), "truncated OFF");
@@ -105,9 +107,103 @@ TEST_F(MeshIo, RejectsBadInputWithOneClearLine) {
   expect_rejected(write_text(dir_, "nan.ply", ply_head + "0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n"), "NaN");
   expect_rejected(write_text(dir_, "short_ascii.ply", ply_head + "0 0 0\n1 0 0\n"), "truncated PLY");
   expect_rejected(write_text(dir_, "mesh.xyz", "1 2 3\n"), "unsupported mesh format");
-  expect_rejected(dir_, "unsupported mesh format");  // a directory has no mesh extension
+  expect_rejected(dir_, "is a directory");  // the kind of file is checked before its extension
   std::filesystem::create_directory(dir_ + "/dir.obj");
   expect_rejected(dir_ + "/dir.obj", "is a directory");
+}
+
+TEST_F(MeshIo, RefusesNonRegularFilesUnreadAndBoundsTheSize) {
+  // Devices, FIFOs and directories are refused before a byte is read: /dev/zero never ends, a FIFO blocks.
+  expect_rejected("/dev/zero", "is a device, not a regular file");
+  std::filesystem::create_symlink("/dev/zero", dir_ + "/zero.obj");
+  expect_rejected(dir_ + "/zero.obj", "is a device, not a regular file");
+  ASSERT_EQ(::mkfifo((dir_ + "/pipe.obj").c_str(), 0600), 0);
+  expect_rejected(dir_ + "/pipe.obj", "FIFO");
+  std::filesystem::create_directory(dir_ + "/dir.ply");
+  expect_rejected(dir_ + "/dir.ply", "is a directory");
+  // Files above ReadMeshOptions::max_file_bytes are refused by their size (4 GiB by default).
+  const std::string tet = write_mesh_file(dir_, "tet.obj", test::tetrahedron());
+  const auto size = std::filesystem::file_size(tet);
+  ReadMeshOptions small;
+  small.max_file_bytes = size - 1;
+  try {
+    read_mesh(tet, small);
+    ADD_FAILURE() << "a file above max_file_bytes was read";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("more than geomip reads"), std::string::npos) << e.what();
+  }
+  small.max_file_bytes = size;
+  EXPECT_EQ(read_mesh(tet, small).triangles.size(), 4u);
+  EXPECT_GE(ReadMeshOptions{}.max_file_bytes, std::uint64_t{1} << 32);
+}
+
+TEST_F(MeshIo, ObjFaceIndicesThatDoNotFitAreErrorsNamingTheLine) {
+  const std::string head = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  // OpenMesh would drop this face silently (the index does not fit an int) and read an empty mesh as fine.
+  expect_rejected(write_text(dir_, "big.obj", head + "f 1 2 99999999999999999999\n"),
+                  "line 4: face vertex index '99999999999999999999' is out of range");
+  expect_rejected(write_text(dir_, "big2.obj", head + "f 1 2 3\nf 1 2 2147483648\n"),
+                  "line 5: face vertex index");
+  expect_rejected(write_text(dir_, "bigvt.obj", head + "vt 0 0\nf 1/1 2/1 3/99999999999\n"),
+                  "line 5: face texture coordinate index");
+  expect_rejected(write_text(dir_, "zero.obj", head + "f 1 2 0\n"),
+                  "line 4: face corner '0' has vertex index 0");
+  expect_rejected(write_text(dir_, "rel.obj", head + "f -1 -2 -4\n"), "line 4: face references vertex -4");
+  // Forward references are legal OBJ: checked against the whole file's vertex count.
+  EXPECT_EQ(read_mesh(write_text(dir_, "fwd.obj", "f 1 2 3\n" + head)).triangles.size(), 1u);
+  EXPECT_EQ(read_mesh(write_text(dir_, "neg.obj", head + "f -3 -2 -1\n")).triangles.size(), 1u);
+}
+
+TEST_F(MeshIo, CoordinatesBeyondFloatRangeAreErrorsNamingTheLine) {
+  // OpenMesh reads floats: 1e39 used to vanish and surface as "face 0 references vertex 0, but the file has
+  // 0".
+  expect_rejected(write_text(dir_, "far.obj", "v 1e39 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+                  "line 1: vertex coordinate 1e+39 is out of range");
+  expect_rejected(write_text(dir_, "far.off", "OFF\n3 1 0\n0 0 0\n1 -4e38 0\n0 1 0\n3 0 1 2\n"),
+                  "line 4: vertex 1 coordinate -4e+38 is out of range");
+  const std::string ply_head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  expect_rejected(write_text(dir_, "far.ply", ply_head + "0 0 0\n1 0 0\n0 1 1e39\n3 0 1 2\n"),
+                  "line 12: vertex 2 coordinate 1e+39 is out of range");
+  expect_rejected(write_text(dir_, "far.stl",
+                             "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1e39 0 0\n"
+                             "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n"),
+                  "line 5: vertex coordinate 1e+39 is out of range");
+  // Binary PLY of doubles: a finite double beyond float range is caught after parsing.
+  std::string bin =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\n"
+      "property double y\nproperty double z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const double xyz[9] = {1e300, 0, 0, 1, 0, 0, 0, 1, 0};
+  bin.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  const int face[3] = {0, 1, 2};
+  bin.push_back('\3');
+  bin.append(reinterpret_cast<const char*>(face), sizeof face);
+  expect_rejected(write_text(dir_, "far_bin.ply", bin), "out of range");
+  // The largest float itself is fine.
+  EXPECT_EQ(
+      read_mesh(write_text(dir_, "max.obj", "v 3.4e38 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).triangles.size(),
+      1u);
+}
+
+TEST_F(MeshIo, ReadsFromMemoryExactlyAsFromAFile) {
+  for (const char* name : {"t.obj", "t.ply", "t.off"}) {
+    const std::string path = write_mesh_file(dir_, name, test::torus(6, 4));
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    const TriMesh a = read_mesh(path);
+    const TriMesh b = read_mesh_from_memory(bytes, mesh_format_from_path(path), "memory");
+    EXPECT_EQ(a.triangles, b.triangles) << name;
+    EXPECT_EQ(a.positions, b.positions) << name;
+  }
+  try {
+    read_mesh_from_memory("v 0 0 0\nf 1 1 9\n", MeshFormat::kObj, "bytes.obj");
+    ADD_FAILURE() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("bytes.obj: line 2", 0), 0u) << e.what();
+  }
+  EXPECT_THROW(read_mesh_from_memory("", MeshFormat::kPly, "empty"), InvalidInput);
 }
 
 TEST_F(MeshIo, RejectsTruncatedBinaryPly) {

@@ -73,6 +73,33 @@ TEST(MeshRepair, OrientsAnInwardClosedMeshOutward) {
   expect_closed_genus0_manifold(r.mesh);
 }
 
+TEST(MeshRepair, LargestComponentOnlyKeepsTheBiggerPieceAndItsVertexOrder) {
+  // A sphere (48 faces) and, after it in the file, a small tetrahedron (4 faces) away from it.
+  const TriMesh sphere = test::sphere(1);
+  TriMesh tet = test::tetrahedron();
+  for (auto& p : tet.positions) p += Eigen::Vector3d(5, 0, 0);
+  for (const TriMesh& m : {test::join(sphere, tet), test::join(tet, sphere)}) {
+    ASSERT_EQ(analyze_topology(m).components, 2u);
+    EXPECT_EQ(analyze_topology(repair_mesh(m).mesh).components, 2u) << "off by default";
+    RepairOptions options;
+    options.largest_component_only = true;
+    const RepairResult r = repair_mesh(m, options);
+    EXPECT_EQ(r.removed_components, 1u);
+    EXPECT_EQ(r.removed_component_faces, 4u);
+    expect_closed_genus0_manifold(r.mesh);
+    EXPECT_EQ(analyze_topology(r.mesh).components, 1u);
+    EXPECT_EQ(r.mesh.triangles.size(), sphere.triangles.size());
+    ASSERT_EQ(r.mesh.positions.size(), sphere.positions.size());
+    for (std::size_t v = 0; v < sphere.positions.size(); ++v) {
+      ASSERT_EQ(r.mesh.positions[v], sphere.positions[v]) << "vertex " << v << " moved or reordered";
+    }
+  }
+  // One component: nothing to drop.
+  RepairOptions options;
+  options.largest_component_only = true;
+  EXPECT_EQ(repair_mesh(sphere, options).removed_components, 0u);
+}
+
 TEST(MeshRepair, RejectsEmptyMesh) { EXPECT_THROW(repair_mesh(TriMesh{}), InvalidInput); }
 
 TEST(MeshRepairReal, BunnyBecomesClosedGenusZeroOfAboutThePapersSize) {

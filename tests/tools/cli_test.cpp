@@ -5,8 +5,9 @@
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -146,6 +147,76 @@ TEST_F(Cli, RepairCowThenInfoSaysManifold) {
   EXPECT_EQ(j["genus"], 0);
 }
 
+// Issue #13: a device, FIFO or directory is refused before a byte is read (`info /dev/zero` used to grow to
+// 4.3 GB in 60 s), for mesh and pack inputs alike.
+TEST_F(Cli, NonRegularFilesAreRefusedUnread) {
+  fs::create_symlink("/dev/zero", dir_ + "/zero.obj");
+  ASSERT_EQ(::mkfifo((dir_ + "/pipe.ply").c_str(), 0600), 0);  // nobody writes: reading it would block
+  fs::create_directory(dir_ + "/dir.off");
+  const std::string out = dir_ + "/out.obj";
+  for (const std::string& path :
+       {std::string("/dev/zero"), dir_ + "/zero.obj", dir_ + "/pipe.ply", dir_ + "/dir.off"}) {
+    expect_bad_input("info '" + path + "'", path);
+    expect_bad_input("repair '" + path + "' -o '" + out + "'", path);
+    expect_bad_input("decode '" + path + "' -o '" + out + "'", path);
+  }
+  const Outcome r = geomip("info /dev/zero");
+  EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Issue #13: an index that does not fit an int used to drop the face silently (exit 0); a coordinate beyond
+// float range used to surface as "face 0 references vertex 0, but the file has 0 vertices".
+TEST_F(Cli, OverflowingIndicesAndCoordinatesNameTheLine) {
+  const std::string index =
+      file("index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 99999999999999999999\n");
+  expect_bad_input("info '" + index + "'", index);
+  Outcome r = geomip("info '" + index + "'");
+  EXPECT_NE(r.err.find("line 6: face vertex index '99999999999999999999' is out of range"), std::string::npos)
+      << r.err;
+  const std::string far = file("far.obj", "v 1e39 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  expect_bad_input("info '" + far + "'", far);
+  r = geomip("info '" + far + "'");
+  EXPECT_NE(r.err.find("line 1: vertex coordinate 1e+39 is out of range"), std::string::npos) << r.err;
+  expect_bad_input("repair '" + far + "' -o '" + dir_ + "/out.obj'", far);
+  EXPECT_FALSE(fs::exists(dir_ + "/out.obj"));
+}
+
+// `repair --largest-component` keeps the largest piece, so the advice for multi-component meshes is no
+// circle.
+TEST_F(Cli, RepairLargestComponentMakesATwoComponentMeshUsable) {
+  TriMesh small = test::tetrahedron();
+  for (auto& p : small.positions) p = 0.2 * p + Eigen::Vector3d(4, 0, 0);
+  const TriMesh big = test::sphere(2);
+  const std::string two = dir_ + "/two.obj";
+  {
+    std::ofstream out(two);
+    write_mesh(test::join(small, big), out, MeshFormat::kObj);
+  }
+  // param refuses it with one line that names the way out ...
+  const std::string param_out = dir_ + "/param";
+  expect_bad_input("param -q '" + two + "' -o '" + param_out + "'", two);
+  const Outcome refused = geomip("param -q '" + two + "' -o '" + param_out + "'");
+  EXPECT_NE(refused.err.find("2 connected components"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("geomip repair --largest-component"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(param_out));
+  // ... which keeps the sphere, repaired as usual.
+  const std::string one = dir_ + "/one.obj";
+  const Outcome r = geomip("repair --json --largest-component '" + two + "' -o '" + one + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["removed_components"], 1);
+  EXPECT_EQ(j["removed_component_faces"], 4);
+  EXPECT_EQ(j["after"]["components"], 1);
+  EXPECT_EQ(j["after"]["faces"], big.triangles.size());
+  const TriMesh kept = read_mesh(one);
+  EXPECT_EQ(kept.positions.size(), big.positions.size());
+  EXPECT_EQ(analyze_topology(kept).genus, 0);
+  // Without the flag the two components stay.
+  ASSERT_EQ(geomip("repair -q '" + two + "' -o '" + one + "'").exit_code, 0);
+  EXPECT_EQ(analyze_topology(read_mesh(one)).components, 2u);
+}
+
 TEST_F(Cli, RepairBunnyThenInfoSaysClosedGenusZero) {
   GEOMIP_REQUIRE_SHARED_MESH(bunny, "bunny.obj");
   const std::string out = dir_ + "/bunny.obj";
@@ -221,6 +292,30 @@ TEST_F(CliParam, WritesObjWithPerPatchTexcoordsAndJson) {
   EXPECT_EQ(groups, 2u);
   EXPECT_GT(vt, v);  // seam vertices have one vt per patch
   EXPECT_TRUE(vt_in_group);
+}
+
+// Issue #13: a single triangle or a flat fan used to end in "internal failure" (exit 1) with an empty output
+// folder left behind; now one InvalidInput line before any output exists.
+TEST_F(CliParam, TooSmallOrFlatMeshesExitTwoWithoutOutput) {
+  const std::string one = file("one.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::string fan_text = "v 0 0 0\n";
+  for (int k = 0; k < 12; ++k) {
+    const double a = 2 * M_PI * k / 12;
+    fan_text += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+  }
+  for (int k = 0; k < 12; ++k)
+    fan_text += "f 1 " + std::to_string(2 + k) + " " + std::to_string(2 + (k + 1) % 12) + "\n";
+  const std::string fan = file("fan.obj", fan_text);
+  for (const std::string& mesh : {one, fan}) {
+    const std::string out_dir = dir_ + "/param-out";
+    expect_bad_input("param -q '" + mesh + "' -o '" + out_dir + "'", mesh);
+    EXPECT_FALSE(fs::exists(out_dir)) << mesh;
+    const std::string pack = dir_ + "/x.gip";
+    expect_bad_input("convert -q '" + mesh + "' --level 3 -o '" + pack + "'", mesh);
+    EXPECT_FALSE(fs::exists(pack)) << mesh;
+    const Outcome r = geomip("param -q '" + mesh + "' -o '" + out_dir + "'");
+    EXPECT_EQ(r.err.find("internal failure"), std::string::npos) << r.err;
+  }
 }
 
 TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
@@ -533,6 +628,52 @@ TEST_F(CliPack, EncodeFromGimageDirectory) {
   const Outcome d = geomip("decode -q '" + dir_ + "/x.gip' -o '" + dir_ + "/x.obj'");
   ASSERT_EQ(d.exit_code, 0) << d.err;
   EXPECT_EQ(read_mesh(dir_ + "/x.obj").triangles.size(), 2u * 2 * 16 * 16);
+}
+
+// Issue #13: `decode --bytes N` before the first level of detail used to write a 262,144-face mesh of zero
+// extent (exit 0), and a file cut inside its manifest was reported as "477418 of 0 bytes".
+TEST_F(CliPack, PrefixesWithoutALevelOfDetailExitTwoWithoutOutput) {
+  const std::string pack = dir_ + "/spot.gip";
+  ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 -o '" + pack + "'").exit_code, 0);
+  const std::string bytes = slurp(pack);
+  ASSERT_GT(bytes.size(), 20u);
+  std::uint32_t manifest_size =
+      0;  // header: magic (8), version (2), flags (2), manifest size (4, LE), CRC (4)
+  for (int k = 3; k >= 0; --k) manifest_size = manifest_size << 8 | static_cast<unsigned char>(bytes[12 + k]);
+  const std::size_t manifest_end = 20 + manifest_size;
+  const std::string out = dir_ + "/out.obj";
+
+  const std::string just_manifest = std::to_string(manifest_end + 1);
+  expect_bad_input("decode '" + pack + "' --bytes " + just_manifest + " -o '" + out + "'", pack);
+  Outcome r = geomip("decode '" + pack + "' --bytes " + just_manifest + " -o '" + out + "'");
+  const std::string needs = "bytes hold no level of detail; the first level needs ";
+  const std::size_t at = r.err.find(needs);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the first " + just_manifest + " bytes"), std::string::npos) << r.err;
+  const std::size_t first_level = std::stoul(r.err.substr(at + needs.size()));
+  EXPECT_GT(first_level, manifest_end + 1);
+  EXPECT_LT(first_level, bytes.size());
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(
+      geomip("decode -q '" + pack + "' --bytes " + std::to_string(first_level - 1) + " -o '" + out + "'")
+          .exit_code,
+      2);
+  EXPECT_FALSE(fs::exists(out));
+  // From there on, a coarse model with an extent.
+  r = geomip("decode -q '" + pack + "' --bytes " + std::to_string(first_level) + " -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(analyze_topology(read_mesh(out)).bbox_diagonal, 0.1);
+
+  // Cut inside the manifest: the real byte counts, not "N of 0 bytes".
+  const std::string cut = file("cut.gip", bytes.substr(0, manifest_end - 5));
+  expect_bad_input("decode '" + cut + "' -o '" + dir_ + "/cut.obj'", cut);
+  r = geomip("decode '" + cut + "' -o '" + dir_ + "/cut.obj'");
+  EXPECT_NE(r.err.find("the file has " + std::to_string(manifest_end - 5) +
+                       " bytes, the manifest alone needs " + std::to_string(manifest_end)),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find(" of 0 bytes"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/cut.obj"));
 }
 
 TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {

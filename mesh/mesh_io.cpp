@@ -1,6 +1,7 @@
 #include "mesh/mesh_io.h"
 
 #include "mesh/errors.h"
+#include "mesh/gltf_io.h"
 
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/exporter/BaseExporter.hh>
@@ -78,6 +79,8 @@ const char* extension_of(MeshFormat f) {
     case MeshFormat::kPly: return "ply";
     case MeshFormat::kOff: return "off";
     case MeshFormat::kStl: return "stl";
+    case MeshFormat::kGltf: return "gltf";
+    case MeshFormat::kGlb: return "glb";
   }
   return "";
 }
@@ -1088,7 +1091,9 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (ext == "ply") return MeshFormat::kPly;
   if (ext == "off") return MeshFormat::kOff;
   if (ext == "stl" || ext == "stla" || ext == "stlb") return MeshFormat::kStl;
-  throw InvalidInput(path + ": unsupported mesh format '." + ext + "' (geomip reads .obj .ply .off .stl)");
+  if (ext == "gltf") return MeshFormat::kGltf;
+  if (ext == "glb") return MeshFormat::kGlb;
+  throw InvalidInput(path + ": unsupported mesh format '." + ext + "' (geomip reads .obj .ply .off .stl .gltf .glb)");
 }
 
 TriMesh read_mesh(const std::string& path, const ReadMeshOptions& options) {
@@ -1105,6 +1110,11 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
   if (bytes.size() > options.max_file_bytes) {
     fail(path, "the file has " + std::to_string(bytes.size()) + " bytes, more than geomip reads (" +
                    std::to_string(options.max_file_bytes) + " bytes; ReadMeshOptions::max_file_bytes)");
+  }
+  if (format == MeshFormat::kGltf || format == MeshFormat::kGlb) {
+    // JSON or binary, told by the bytes (a .gltf holding GLB still reads); external buffers beside the file.
+    const std::string base_dir = std::filesystem::path(path).parent_path().string();
+    return read_gltf_from_memory(bytes, path, base_dir.empty() ? "." : base_dir);
   }
   bool binary_stl = false;
   std::string ply_header;  // PLY: the validated header, rewritten (PlyHeader::canonical())
@@ -1126,6 +1136,9 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
       binary_stl = is_binary_stl(path, bytes);  // the facet count is checked against the size
       (binary_stl ? validate_binary_stl : validate_ascii_stl)(path, bytes);
       break;
+    case MeshFormat::kGltf:
+    case MeshFormat::kGlb:
+      break;  // read above
   }
 
   RecordingImporter importer;
@@ -1173,6 +1186,12 @@ void write_mesh(const TriMesh& mesh, std::ostream& out, MeshFormat format, const
   silence_openmesh();
   if (format == MeshFormat::kStl) throw InvalidInput("write_mesh: STL output is not supported (use OBJ or PLY)");
   if (mesh.triangles.empty()) throw InvalidInput("write_mesh: the mesh has no triangles");
+  if (format == MeshFormat::kGltf || format == MeshFormat::kGlb) {
+    GltfWriteOptions gltf;
+    gltf.binary = format == MeshFormat::kGlb;
+    write_gltf(mesh, {}, out, gltf);
+    return;
+  }
   TriMeshExporter exporter(mesh);
   OpenMesh::IO::Options io_options;
   if (format == MeshFormat::kPly && options.binary) {

@@ -1,4 +1,5 @@
-// Mesh file input and output: OBJ, PLY (ascii and binary), OFF and STL in; OBJ and PLY (and OFF) out.
+// Mesh file input and output: OBJ, PLY (ascii and binary), OFF, STL and glTF 2.0 (.gltf/.glb) in; OBJ, PLY,
+// OFF and glTF out (glTF through mesh/gltf_io.h).
 //
 // Parsing is OpenMesh's (its readers and writers), but the data goes through geomip's own importer and
 // exporter so that faces are recorded exactly as they are in the file: OpenMesh's half-edge importer drops
@@ -15,7 +16,7 @@
 
 namespace geomip {
 
-enum class MeshFormat { kObj, kPly, kOff, kStl };
+enum class MeshFormat { kObj, kPly, kOff, kStl, kGltf, kGlb };
 
 /// Format from the file name's extension (case-insensitive).
 /// \throw InvalidInput for an extension geomip does not read or write.

@@ -44,11 +44,12 @@ std::uint64_t first_level_bytes(const codec::PackInfo& info) {
 }
 
 MeshFormat format_of(const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".obj" || ext == ".OBJ") return MeshFormat::kObj;
-  if (ext == ".ply" || ext == ".PLY") return MeshFormat::kPly;
-  if (ext == ".off" || ext == ".OFF") return MeshFormat::kOff;
-  throw InvalidInput("-o " + path + ": the extension must be .obj, .ply or .off");
+  try {
+    const MeshFormat f = mesh_format_from_path(path);
+    if (f != MeshFormat::kStl) return f;
+  } catch (const InvalidInput&) {
+  }
+  throw InvalidInput("-o " + path + ": the extension must be .obj, .ply, .off, .gltf or .glb");
 }
 
 int run_decode(const DecodeArgs& args) {

@@ -42,7 +42,8 @@ int run_gimage(const GimageArgs& args) {
   }
   const PreparedModels models =
       prepare_models(args.common.meshes, args.common.points, "geomip gimage", args.common.quiet || args.common.json);
-  std::filesystem::create_directories(args.common.output);
+  if (std::filesystem::exists(args.common.output) && !std::filesystem::is_directory(args.common.output))
+    throw InvalidInput(args.common.output + " exists and is not a directory");
 
   ParameterizationOptions options;
   apply_sampling(args.common, options);
@@ -53,6 +54,8 @@ int run_gimage(const GimageArgs& args) {
   const std::vector<ModelParameterization> result = parameterize_consistently(models.inputs, options);
   const double param_seconds = seconds_since(t0);
   bar.finish();
+  // Only now: a failed parameterization leaves no (empty) output directory behind.
+  std::filesystem::create_directories(args.common.output);
 
   nlohmann::json summary = nlohmann::json::array();
   for (std::size_t i = 0; i < result.size(); ++i) {

@@ -48,7 +48,8 @@ int run_remesh(const RemeshArgs& args) {
   }
   const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip remesh",
                                                args.common.quiet || args.common.json);
-  std::filesystem::create_directories(args.common.output);
+  if (std::filesystem::exists(args.common.output) && !std::filesystem::is_directory(args.common.output))
+    throw InvalidInput(args.common.output + " exists and is not a directory");
 
   ParameterizationOptions options;
   apply_sampling(args.common, options);
@@ -59,6 +60,8 @@ int run_remesh(const RemeshArgs& args) {
   const std::vector<ModelParameterization> result = parameterize_consistently(models.inputs, options);
   const double param_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bar.finish();
+  // Only now: a failed parameterization leaves no (empty) output directory behind.
+  std::filesystem::create_directories(args.common.output);
 
   nlohmann::json summary = nlohmann::json::array();
   for (std::size_t i = 0; i < result.size() && uniform; ++i) {

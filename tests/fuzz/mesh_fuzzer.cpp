@@ -1,5 +1,5 @@
 // libFuzzer target for the mesh readers (mesh/mesh_io.h): every input is parsed from memory as each of the
-// four formats (OBJ, PLY ascii/binary, OFF, STL ascii/binary), so one corpus serves all of them. Any bytes
+// five formats (OBJ, PLY ascii/binary, OFF, STL ascii/binary, glTF JSON/GLB), so one corpus serves all of them. Any bytes
 // must either give a mesh that keeps read_mesh()'s promises (at least one triangle, every index in range,
 // every coordinate finite and within float range) or throw InvalidInput — never a crash, hang, other
 // exception, unbounded allocation or undefined behaviour (run under ASan + UBSan; OpenMesh itself is not
@@ -47,7 +47,8 @@ void check(const geomip::TriMesh& mesh) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
   for (geomip::MeshFormat format : {geomip::MeshFormat::kObj, geomip::MeshFormat::kPly,
-                                    geomip::MeshFormat::kOff, geomip::MeshFormat::kStl}) {
+                                    geomip::MeshFormat::kOff, geomip::MeshFormat::kStl,
+                                    geomip::MeshFormat::kGltf}) {
     try {
       check(geomip::read_mesh_from_memory(bytes, format, "fuzz"));
     } catch (const geomip::InvalidInput&) {

@@ -21,10 +21,7 @@ std::string to_gltf(const TriMesh& mesh, const MeshAttributes& attributes, bool 
   return out.str();
 }
 
-TriMesh float_rounded(TriMesh m) {
-  for (auto& p : m.positions) p = p.cast<float>().cast<double>();
-  return m;
-}
+TriMesh float_rounded(const TriMesh& m) { return test::float32(m); }
 
 TEST(GltfIo, RoundTripIsExactInFloatForGlbAndJson) {
   const TriMesh torus = float_rounded(test::torus(12, 7));

@@ -49,8 +49,7 @@ class MeshIo : public ::testing::Test {
 };
 
 TEST_F(MeshIo, RoundTripsEveryWritableFormatExactly) {
-  TriMesh mesh = test::torus(12, 7);
-  for (auto& p : mesh.positions) p = p.cast<float>().cast<double>();  // float32 data, as files hold
+  const TriMesh mesh = test::float32(test::torus(12, 7));  // float32 data, as files hold
   for (const char* name : {"t.obj", "t.ply", "t.off"}) {
     for (bool binary : {true, false}) {
       const TriMesh back = read_mesh(write_mesh_file(dir_, name, mesh, binary));
@@ -301,10 +300,28 @@ TEST(MeshIoFormat, ExtensionsAreCaseInsensitive) {
   EXPECT_EQ(mesh_format_from_path("x.Ply"), MeshFormat::kPly);
   EXPECT_EQ(mesh_format_from_path("x.off"), MeshFormat::kOff);
   EXPECT_EQ(mesh_format_from_path("x.stl"), MeshFormat::kStl);
-  EXPECT_THROW(mesh_format_from_path("x.gltf"), InvalidInput);
+  EXPECT_EQ(mesh_format_from_path("x.gltf"), MeshFormat::kGltf);
+  EXPECT_EQ(mesh_format_from_path("x.GLB"), MeshFormat::kGlb);
+  EXPECT_THROW(mesh_format_from_path("x.fbx"), InvalidInput);
   std::ostringstream out;
   EXPECT_THROW(write_mesh(test::tetrahedron(), out, MeshFormat::kStl), InvalidInput);
   EXPECT_THROW(write_mesh(TriMesh{}, out, MeshFormat::kObj), InvalidInput);
+}
+
+// glTF goes through the same entry points as the other formats: a file written by write_mesh() reads back
+// with the same triangles and float-exact positions, from .glb and from .gltf.
+TEST(MeshIoFormat, GltfAndGlbRoundTripThroughReadMesh) {
+  const std::string dir = test::temp_dir("mesh_io_gltf");
+  const TriMesh torus = test::float32(test::torus(9, 5));  // glTF stores float32
+  for (const char* name : {"t.glb", "t.gltf"}) {
+    const std::string path = write_mesh_file(dir, name, torus);
+    const TriMesh back = read_mesh(path);
+    EXPECT_EQ(back.triangles, torus.triangles) << name;
+    ASSERT_EQ(back.positions.size(), torus.positions.size()) << name;
+    for (std::size_t v = 0; v < back.positions.size(); ++v)
+      EXPECT_EQ(back.positions[v], torus.positions[v]) << name << " vertex " << v;
+  }
+  expect_rejected(write_text(dir, "bad.glb", "glTF not really"), "not a readable glTF");
 }
 
 }  // namespace

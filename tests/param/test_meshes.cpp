@@ -130,6 +130,16 @@ int nearest_vertex(const TriMesh& mesh, const Eigen::Vector3d& p) {
   return best;
 }
 
+TriMesh float32(TriMesh mesh) {
+  for (auto& p : mesh.positions) {
+    for (int c = 0; c < 3; ++c) {
+      const volatile float f = static_cast<float>(p[c]);
+      p[c] = f;
+    }
+  }
+  return mesh;
+}
+
 TriMesh join(const TriMesh& a, const TriMesh& b) {
   TriMesh m = a;
   const int offset = static_cast<int>(a.positions.size());

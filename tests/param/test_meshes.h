@@ -29,6 +29,12 @@ int nearest_vertex(const TriMesh& mesh, const Eigen::Vector3d& p);
 /// Concatenation of two meshes (indices of `b` shifted).
 TriMesh join(const TriMesh& a, const TriMesh& b);
 
+/// `mesh` with every coordinate rounded to float32 (what OBJ/PLY/glTF files of float data hold). Rounds
+/// through a volatile float: Debian's GCC 12.2 at -O2/-O3 miscompiles the plain in-place loop
+/// `p[c] = double(float(p[c]))` over xyz (its SLP vectorizer drops the rounding of two of the three
+/// components; seen 2026-12-02 with g++ 12.2.0-14).
+TriMesh float32(TriMesh mesh);
+
 /// Absolute path of a mesh in ../shared/meshes (empty when that folder is absent).
 std::string shared_mesh(const std::string& name);
 /// A fresh empty directory under the system temp dir, for test outputs.

@@ -313,6 +313,10 @@ TEST_F(CliParam, TooSmallOrFlatMeshesExitTwoWithoutOutput) {
     const std::string pack = dir_ + "/x.gip";
     expect_bad_input("convert -q '" + mesh + "' --level 3 -o '" + pack + "'", mesh);
     EXPECT_FALSE(fs::exists(pack)) << mesh;
+    for (const char* cmd : {"gimage -q --level 3", "remesh -q --level 3"}) {
+      expect_bad_input(std::string(cmd) + " '" + mesh + "' -o '" + out_dir + "'", mesh);
+      EXPECT_FALSE(fs::exists(out_dir)) << cmd << " " << mesh;
+    }
     const Outcome r = geomip("param -q '" + mesh + "' -o '" + out_dir + "'");
     EXPECT_EQ(r.err.find("internal failure"), std::string::npos) << r.err;
   }
@@ -618,6 +622,23 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
   EXPECT_LT(j["bytes_used"].get<std::size_t>(), bytes);
   EXPECT_EQ(analyze_topology(read_mesh(dir_ + "/prefix.ply")).boundary_loops, 0u);
   for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos);
+
+  // glTF out and in: the same decode as .glb and .gltf gives the same `geomip info` counts as the OBJ.
+  const auto info_of = [&](const std::string& path) {
+    const Outcome i = geomip("info --json '" + path + "'");
+    EXPECT_EQ(i.exit_code, 0) << i.err;
+    auto k = nlohmann::json::parse(i.out);
+    if (k.is_array()) k = k[0];
+    k.erase("file");
+    return k;
+  };
+  const nlohmann::json obj_info = info_of(dir_ + "/full.obj");
+  for (const char* name : {"/full.glb", "/full.gltf"}) {
+    r = geomip("decode -q '" + pack + "' -o '" + dir_ + name + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(info_of(dir_ + name), obj_info) << name;
+  }
+  expect_bad_input("decode -q '" + pack + "' -o '" + dir_ + "/x.stl'", "x.stl");
 }
 
 TEST_F(CliPack, EncodeFromGimageDirectory) {

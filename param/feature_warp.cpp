@@ -1,11 +1,12 @@
 // Foldover-free feature alignment ("triangulation over time", paper §3.4). The only translation unit of
 // geomip::param that includes CGAL's 2D triangulations: Delaunay_triangulation_2 builds the initial warp mesh
-// and CGAL's exact orientation predicate decides every sign; the kinetic part (moves, edge flips, barycentric
-// re-binding, base-mesh repair) works on a small triangle list of its own.
+// and the exact orientation predicate (orient2d, mesh/predicates.h) decides every sign; the kinetic part (moves,
+// edge flips, barycentric re-binding, base-mesh repair) works on a small triangle list of its own.
 #include "param/feature_warp.h"
-#include "param/unit_square.h"
 
 #include "mesh/errors.h"
+#include "mesh/predicates.h"
+#include "param/unit_square.h"
 
 // CGAL's headers shadow names freely; silence that for them only.
 #pragma GCC diagnostic push
@@ -35,15 +36,6 @@ constexpr int kCorners = 4;
 constexpr std::size_t kStallSteps = 500;  // a feature that gains < 0.1% of its remaining way in this many steps is stuck
 const Vec2* const kCornerUv = unit_square_corners().data();
 
-/// Exact sign of the orientation of (a, b, c): +1 counter-clockwise, 0 collinear, -1 clockwise.
-int orientation(const Vec2& a, const Vec2& b, const Vec2& c) {
-  return static_cast<int>(CGAL::orientation(Kernel::Point_2(a.x(), a.y()), Kernel::Point_2(b.x(), b.y()),
-                                            Kernel::Point_2(c.x(), c.y())));
-}
-/// Twice the signed area of (a, b, c) in floating point (for magnitudes; signs come from `orientation`).
-double area2(const Vec2& a, const Vec2& b, const Vec2& c) {
-  return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
-}
 bool on_boundary(const Vec2& p) { return p.x() == 0 || p.x() == 1 || p.y() == 0 || p.y() == 1; }
 bool strictly_inside(const Vec2& p, double margin) {
   return p.x() > margin && p.y() > margin && p.x() < 1 - margin && p.y() < 1 - margin;
@@ -91,7 +83,7 @@ bool kernel_centroid(const std::vector<std::pair<Vec2, Vec2>>& link, Vec2& centr
     for (std::size_t i = 0; i < poly.size(); ++i) {
       const Vec2& p = poly[i];
       const Vec2& q = poly[(i + 1) % poly.size()];
-      const double sp = area2(a, b, p), sq = area2(a, b, q);
+      const double sp = signed_double_area(a, b, p), sq = signed_double_area(a, b, q);
       if (sp > 0) next.push_back(p);
       if ((sp > 0) != (sq > 0) && sp != sq) next.push_back(p + (sp / (sp - sq)) * (q - p));
     }
@@ -113,7 +105,7 @@ bool kernel_centroid(const std::vector<std::pair<Vec2, Vec2>>& link, Vec2& centr
 }
 
 /// The point of a vertex's kernel that maximizes the smallest area of its star triangles (the local
-/// untangling LP of Freitag & Plassmann 2000): max z subject to area2(a, b, x) >= z for every directed link
+/// untangling LP of Freitag & Plassmann 2000): max z subject to signed_double_area(a, b, x) >= z for every directed link
 /// edge (a, b). The optimum is a vertex of that 3D polytope, so every triple of constraints is tried (stars
 /// are small). Returns false when no such point has a positive minimum.
 bool max_min_area_point(const std::vector<std::pair<Vec2, Vec2>>& link, Vec2& best) {
@@ -196,17 +188,17 @@ class WarpMesh {
   /// Position of warp vertex v, or `x` when v is `moving`.
   const Vec2& at(int v, int moving, const Vec2& x) const { return v == moving ? x : pos[v]; }
   int orientation_with(int t, int moving, const Vec2& x) const {
-    return orientation(at(tri[t][0], moving, x), at(tri[t][1], moving, x), at(tri[t][2], moving, x));
+    return orient2d(at(tri[t][0], moving, x), at(tri[t][1], moving, x), at(tri[t][2], moving, x));
   }
   double area2_with(int t, int moving, const Vec2& x) const {
-    return area2(at(tri[t][0], moving, x), at(tri[t][1], moving, x), at(tri[t][2], moving, x));
+    return signed_double_area(at(tri[t][0], moving, x), at(tri[t][1], moving, x), at(tri[t][2], moving, x));
   }
 
   /// Barycentric coordinates of p in triangle t (all >= 0 inside).
   Eigen::Vector3d barycentric(int t, const Vec2& p) const {
     const Vec2 &a = pos[tri[t][0]], &b = pos[tri[t][1]], &c = pos[tri[t][2]];
-    const double total = area2(a, b, c);
-    Eigen::Vector3d l(area2(p, b, c) / total, area2(a, p, c) / total, 0.0);
+    const double total = signed_double_area(a, b, c);
+    Eigen::Vector3d l(signed_double_area(p, b, c) / total, signed_double_area(a, p, c) / total, 0.0);
     l[2] = 1.0 - l[0] - l[1];
     return l;
   }
@@ -271,7 +263,7 @@ class WarpMesh {
           if (!flip_quad(t, i, m, p, q, r)) continue;
           const auto pt = [&](int v) { return Kernel::Point_2(pos[v].x(), pos[v].y()); };
           if (CGAL::side_of_oriented_circle(pt(m), pt(p), pt(q), pt(r)) != CGAL::ON_POSITIVE_SIDE) continue;
-          if (orientation(pos[m], pos[p], pos[r]) <= 0 || orientation(pos[m], pos[r], pos[q]) <= 0) continue;
+          if (orient2d(pos[m], pos[p], pos[r]) <= 0 || orient2d(pos[m], pos[r], pos[q]) <= 0) continue;
           for (int n : flip(t, i)) on_flip(n);
           ++flips;
           changed = true;
@@ -411,13 +403,13 @@ class Warper {
         // Both new triangles have an area linear in t; flip halfway between where they become valid and lo.
         double lower = 0;
         for (const Tri& n : {Tri{m, p, r}, Tri{m, r, qq}}) {
-          auto a = [&](const Vec2& x) { return area2(warp_.at(n[0], w, x), warp_.at(n[1], w, x), warp_.at(n[2], w, x)); };
+          auto a = [&](const Vec2& x) { return signed_double_area(warp_.at(n[0], w, x), warp_.at(n[1], w, x), warp_.at(n[2], w, x)); };
           const double g0 = a(x0), g1 = a(q);
           if (g0 <= 0 && g1 > g0) lower = std::max(lower, g0 / (g0 - g1));
         }
         auto flip_valid = [&](const Vec2& x) {
-          return warp_valid(x) && orientation(warp_.at(m, w, x), warp_.at(p, w, x), warp_.at(r, w, x)) > 0 &&
-                 orientation(warp_.at(m, w, x), warp_.at(r, w, x), warp_.at(qq, w, x)) > 0;
+          return warp_valid(x) && orient2d(warp_.at(m, w, x), warp_.at(p, w, x), warp_.at(r, w, x)) > 0 &&
+                 orient2d(warp_.at(m, w, x), warp_.at(r, w, x), warp_.at(qq, w, x)) > 0;
         };
         double ts = lower < lo ? lower + 0.5 * (lo - lower) : lo;
         int tries = 0;
@@ -526,7 +518,7 @@ class Warper {
   void note_area(int t) {
     const Tri& T = warp_.tri[t];
     result_.min_warp_triangle_area =
-        std::min(result_.min_warp_triangle_area, 0.5 * area2(warp_.pos[T[0]], warp_.pos[T[1]], warp_.pos[T[2]]));
+        std::min(result_.min_warp_triangle_area, 0.5 * signed_double_area(warp_.pos[T[0]], warp_.pos[T[1]], warp_.pos[T[2]]));
   }
 
  private:
@@ -542,7 +534,7 @@ class Warper {
   bool base_valid(const std::vector<int>& tris) const {
     for (int t : tris) {
       const Tri& T = triangles_[t];
-      if (orientation(uv_[T[0]], uv_[T[1]], uv_[T[2]]) <= 0) return false;
+      if (orient2d(uv_[T[0]], uv_[T[1]], uv_[T[2]]) <= 0) return false;
     }
     return true;
   }
@@ -564,7 +556,7 @@ class Warper {
   /// its area; succeeds when t grew at all.
   bool repair(int t, bool maximin, int rings) {
     const Tri& T = triangles_[t];
-    auto area = [&] { return area2(uv_[T[0]], uv_[T[1]], uv_[T[2]]); };
+    auto area = [&] { return signed_double_area(uv_[T[0]], uv_[T[1]], uv_[T[2]]); };
     auto contains = [](const std::vector<int>& list, int v) {
       return std::find(list.begin(), list.end(), v) != list.end();
     };
@@ -640,7 +632,7 @@ void check_inputs(const std::vector<Tri>& triangles, const std::vector<Vec2>& uv
     for (int v : t) {
       if (v < 0 || v >= int(uv.size())) fail("triangle index out of range");
     }
-    if (orientation(uv[t[0]], uv[t[1]], uv[t[2]]) <= 0) fail("the input embedding has a flipped or degenerate triangle");
+    if (orient2d(uv[t[0]], uv[t[1]], uv[t[2]]) <= 0) fail("the input embedding has a flipped or degenerate triangle");
   }
   std::vector<char> seen(uv.size(), 0);
   for (int f : features) {
@@ -829,7 +821,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
     result.max_feature_error = std::max(result.max_feature_error, (uv[features[k]] - targets[k]).norm());
   }
   for (const Tri& t : triangles) {
-    if (orientation(uv[t[0]], uv[t[1]], uv[t[2]]) <= 0) ++result.flipped_triangles;
+    if (orient2d(uv[t[0]], uv[t[1]], uv[t[2]]) <= 0) ++result.flipped_triangles;
   }
   if (options.keep_base_mesh_valid && result.flipped_triangles > 0) {
     throw SolverFailure("warp_features: " + std::to_string(result.flipped_triangles) +

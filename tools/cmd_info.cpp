@@ -1,9 +1,17 @@
-// geomip info MESH... [--json]: topology and size of mesh files, counted on the triangles as read.
+// geomip info MESH|PACK... [--json]: topology and size of mesh files, counted on the triangles as read; for a
+// .gip pack, its models, levels and chunk table (what a viewer receives, in order).
+#include "codec/pack.h"
+#include "mesh/errors.h"
 #include "mesh/mesh_io.h"
 #include "mesh/mesh_topology.h"
 #include "tools/commands.h"
+#include "tools/pack_file.h"
 #include "tools/report.h"
 
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -15,9 +23,96 @@ struct InfoArgs {
   bool json = false;
 };
 
+const char* kind_name(codec::ChunkKind kind) {
+  switch (kind) {
+    case codec::ChunkKind::kGeometry: return "geometry";
+    case codec::ChunkKind::kNormals: return "normals";
+    case codec::ChunkKind::kHoleMask: return "hole_mask";
+  }
+  return "unknown";
+}
+
+bool is_pack(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".gip";
+}
+
+// The pack's header and manifest as JSON: per model its grids and streams, then every chunk in file order with
+// the byte count a reader has once that chunk is complete ("cumulative").
+nlohmann::json pack_info(const std::string& path) {
+  const std::vector<std::uint8_t> bytes = read_pack_file(path);
+  codec::PackInfo info;
+  const codec::Status status = codec::read_pack_info(bytes, info);
+  if (status != codec::Status::kOk) {
+    throw InvalidInput(path + ": not a readable geomip pack (" + std::string(codec::status_message(status)) + ")");
+  }
+  nlohmann::json j;
+  j["file"] = path;
+  j["format_version"] = info.version;
+  j["bytes"] = bytes.size();
+  j["manifest_bytes"] = info.manifest_end;
+  if (info.file_size() != bytes.size()) j["bytes_laid_out"] = info.file_size();
+  nlohmann::json models = nlohmann::json::array();
+  for (const auto& m : info.models) {
+    nlohmann::json mj;
+    mj["name"] = m.name;
+    mj["level"] = m.geometry.level;
+    mj["patches"] = m.geometry.num_patches;
+    mj["geometry_passes"] = m.geometry.top_bitplane + 1;
+    mj["normals"] = m.has_normals;
+    if (m.has_normals) mj["normal_level"] = m.normals.level;
+    mj["hole_mask"] = !m.hole_mask.empty();
+    models.push_back(std::move(mj));
+  }
+  nlohmann::json chunks = nlohmann::json::array();
+  std::vector<std::uint64_t> first_level(info.models.size(), 0);
+  for (const auto& c : info.chunks) {
+    const std::uint64_t end = c.offset + c.size;
+    chunks.push_back({{"model", c.model}, {"kind", kind_name(c.kind)}, {"pass", c.pass}, {"bytes", c.size},
+                      {"cumulative", end}});
+    if (c.kind == codec::ChunkKind::kGeometry && c.pass == 0 && c.model >= 0 &&
+        static_cast<std::size_t>(c.model) < first_level.size())
+      first_level[c.model] = end;
+  }
+  std::uint64_t first = info.manifest_end;
+  for (std::uint64_t e : first_level) first = std::max(first, e);
+  j["first_level_bytes"] = first;  // every model's first geometry pass: the coarsest model a viewer can show
+  j["models"] = std::move(models);
+  j["chunks"] = std::move(chunks);
+  return j;
+}
+
+void print_pack(const nlohmann::json& j) {
+  std::printf("%s: geomip pack, format %d, %llu bytes (manifest %llu), first level of detail after %llu bytes\n",
+              j["file"].get<std::string>().c_str(), j["format_version"].get<int>(),
+              static_cast<unsigned long long>(j["bytes"].get<std::uint64_t>()),
+              static_cast<unsigned long long>(j["manifest_bytes"].get<std::uint64_t>()),
+              static_cast<unsigned long long>(j["first_level_bytes"].get<std::uint64_t>()));
+  for (std::size_t m = 0; m < j["models"].size(); ++m) {
+    const auto& mj = j["models"][m];
+    std::printf("  model %zu '%s': %d patches of (2^%d+1)^2 samples, %d geometry passes%s%s\n", m,
+                mj["name"].get<std::string>().c_str(), mj["patches"].get<int>(), mj["level"].get<int>(),
+                mj["geometry_passes"].get<int>(), mj["normals"].get<bool>() ? ", normal maps" : "",
+                mj["hole_mask"].get<bool>() ? ", hole mask" : "");
+  }
+  std::printf("  chunks (file order): model kind pass bytes -> cumulative\n");
+  for (const auto& c : j["chunks"]) {
+    std::printf("    %d %-9s %2d %9llu -> %llu\n", c["model"].get<int>(), c["kind"].get<std::string>().c_str(),
+                c["pass"].get<int>(), static_cast<unsigned long long>(c["bytes"].get<std::uint64_t>()),
+                static_cast<unsigned long long>(c["cumulative"].get<std::uint64_t>()));
+  }
+}
+
 int run_info(const InfoArgs& args) {
   nlohmann::json all = nlohmann::json::array();
   for (const auto& path : args.meshes) {
+    if (is_pack(path)) {
+      nlohmann::json j = pack_info(path);
+      if (!args.json) print_pack(j);
+      all.push_back(std::move(j));
+      continue;
+    }
     const TriMesh mesh = read_mesh(path);
     const TopologyReport report = analyze_topology(mesh);
     if (args.json) {
@@ -37,8 +132,9 @@ int run_info(const InfoArgs& args) {
 CommandRunner add_info_command(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* cmd = app.add_subcommand("info", "Report a mesh's topology: vertices, faces, components, boundary "
-                                             "loops, genus, manifoldness, degeneracies, bounding box");
-  cmd->add_option("mesh", args->meshes, "Mesh file(s): .obj .ply .off .stl")->required();
+                                             "loops, genus, manifoldness, degeneracies, bounding box; or a .gip "
+                                             "pack's models, levels and chunk table");
+  cmd->add_option("mesh", args->meshes, "Mesh file(s): .obj .ply .off .stl .gltf .glb, or packs: .gip")->required();
   cmd->add_flag("--json", args->json, "Machine-readable output (one object, or an array for several meshes)");
   return [args] { return run_info(*args); };
 }

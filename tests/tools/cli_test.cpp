@@ -641,6 +641,34 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
   expect_bad_input("decode -q '" + pack + "' -o '" + dir_ + "/x.stl'", "x.stl");
 }
 
+// `geomip info PACK`: the chunk table as a reader receives it (cumulative sizes end at the file's size, in
+// file order), the first level's byte count is one `decode --bytes` accepts, and a non-pack is refused.
+TEST_F(CliPack, InfoDescribesAPack) {
+  const std::string pack = dir_ + "/spot.gip";
+  ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 -o '" + pack + "'").exit_code, 0);
+  const Outcome r = geomip("info --json '" + pack + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["bytes"], fs::file_size(pack));
+  ASSERT_EQ(j["models"].size(), 1u);
+  EXPECT_EQ(j["models"][0]["level"], 4);
+  EXPECT_EQ(j["models"][0]["patches"], 2);
+  EXPECT_EQ(j["models"][0]["normals"], true);
+  std::uint64_t previous = j["manifest_bytes"];
+  for (const auto& c : j["chunks"]) {
+    EXPECT_EQ(c["cumulative"].get<std::uint64_t>(), previous + c["bytes"].get<std::uint64_t>());
+    previous = c["cumulative"];
+  }
+  EXPECT_EQ(previous, fs::file_size(pack));
+  const std::uint64_t first = j["first_level_bytes"];
+  EXPECT_LT(first, fs::file_size(pack));
+  EXPECT_EQ(geomip("decode -q '" + pack + "' --bytes " + std::to_string(first) + " -o '" + dir_ + "/first.obj'").exit_code, 0);
+  EXPECT_EQ(geomip("decode -q '" + pack + "' --bytes " + std::to_string(first - 1) + " -o '" + dir_ + "/none.obj'").exit_code, 2);
+  const Outcome text = geomip("info '" + pack + "'");
+  EXPECT_NE(text.out.find("first level of detail after " + std::to_string(first) + " bytes"), std::string::npos) << text.out;
+  expect_bad_input("info '" + file("junk.gip", "not a pack") + "'", "junk.gip");
+}
+
 TEST_F(CliPack, EncodeFromGimageDirectory) {
   ASSERT_EQ(geomip("gimage -q '" + spot_ + "' --level 4 -o '" + dir_ + "/gi'").exit_code, 0);
   const Outcome r = geomip("encode --json '" + dir_ + "/gi' -o '" + dir_ + "/x.gip'");

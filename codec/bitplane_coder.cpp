@@ -128,6 +128,8 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
         b.kcls = std::min(k - 1, 2);
         b.offset = band_offset(layout, k, orient);
         b.start = layout.start_plane[static_cast<std::size_t>(k)];
+        // Deferred (framed) bands hold (normal, tangent, bitangent) components: contexts of their own.
+        if (b.start >= 0 && layout.own_deferred_contexts) b.cls += 2;
         b.dx = b.dy = 2 * s;
         const bool odd_x = orient != 2, odd_y = orient != 1;
         b.x0 = odd_x ? s : 0;
@@ -177,7 +179,8 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
   return bands;
 }
 
-constexpr int kNodeContexts = 3 * 3 * 4 * 3 * 2;
+constexpr int kClasses = 5;  // coarse, row/column, diagonal; deferred row/column, deferred diagonal
+constexpr int kNodeContexts = kClasses * 3 * 4 * 3 * 2;
 
 /// The shared traversal of encoder and decoder: every decision goes through sym(), so both walk the same
 /// path.
@@ -425,9 +428,9 @@ class PlaneCoder {
   ArithmeticEncoder* enc_ = nullptr;
   ArithmeticDecoder dec_{{}};
   Context node_ctx_[kNodeContexts];
-  Context chan_ctx_[3 * 3 * 2];
-  Context late_ctx_[3 * 3];
-  Context ref_ctx_[3];
+  Context chan_ctx_[kClasses * 3 * 2];
+  Context late_ctx_[kClasses * 3];
+  Context ref_ctx_[kClasses];
 };
 
 /// The encoder's quadtree of highest set bits of band `b` (max over the three channels) from `cf`.

@@ -405,6 +405,7 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
 BitplaneLayout make_layout(const GeometryCodecHeader& h) {
   BitplaneLayout layout{h.level, h.steps, h.num_patches, h.version >= 2, h.joint_segments};
   layout.orientation_weights = h.orientation_weights;
+  layout.own_deferred_contexts = h.version >= 3;
   for (int k = 1; k <= h.frame_steps && k <= static_cast<int>(h.frame_start.size()); ++k)
     layout.start_plane[static_cast<std::size_t>(k)] = h.frame_start[static_cast<std::size_t>(k - 1)];
   return layout;

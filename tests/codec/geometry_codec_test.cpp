@@ -380,7 +380,7 @@ TEST(GeometryCodec, GoldenStreamIsStable) {
     o.orientation_weights = v3_tools;
     const auto enc = encode_geometry(patches, {}, o);
     ASSERT_EQ(enc.header.step, 1.0);
-    EXPECT_EQ(stream_hash(enc), v3_tools ? 0x8297ee457489bad9ull : 0x382710ca3802b988ull) << std::hex << "0x" << stream_hash(enc);
+    EXPECT_EQ(stream_hash(enc), v3_tools ? 0xa3aa021d93df34fcull : 0x382710ca3802b988ull) << std::hex << "0x" << stream_hash(enc);
     std::vector<std::span<const std::uint8_t>> segs(enc.segments.begin(), enc.segments.end());
     DecodedGeometry dec;
     ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec), Status::kOk);

@@ -554,7 +554,10 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
   // Before coding `plane`: the hook for the bands that start there, and their new magnitudes.
   const auto run_hook = [&](int plane) {
     if (std::find(hooks.begin(), hooks.end(), plane) == hooks.end()) return;
-    if (before_plane) before_plane(plane, encoder_view(bands, coefs, plane, static_cast<int>(size)), coefs);
+    if (before_plane) {
+      std::vector<PatchCoefficients> view = encoder_view(bands, coefs, plane, static_cast<int>(size));
+      before_plane(plane, view, coefs);
+    }
     for (auto& b : bands) {
       if (b.start != plane) continue;
       compute_msb(b, coefs[b.patch], static_cast<int>(size));
@@ -811,7 +814,10 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
     const std::size_t a = cuts[r], b = cuts[r + 1];
     if (a >= decodable) break;
     for (int h : hooks) {
-      if (static_cast<std::size_t>(top_bitplane - h) == a && before_plane) before_plane(h, view());
+      if (static_cast<std::size_t>(top_bitplane - h) == a && before_plane) {
+        std::vector<PatchCoefficients> v = view();
+        before_plane(h, v);
+      }
     }
     if (a < joint) {
       std::vector<StreamPart> slice(joint_parts.begin() + static_cast<std::ptrdiff_t>(a),

@@ -128,9 +128,9 @@ struct BitplaneEncoding {
 /// Deferred steps (layout.start_plane): `before_plane(plane, view, coefficients)` is called before coding
 /// each weighted plane that is some step's start plane, with `view` the decoder's reconstruction of every
 /// coefficient at that point (what decode_bitplanes() would output given the planes above: zero for
-/// deferred bands not yet started) and the encoder's own copy of the coefficients, which the hook may change
-/// for the bands starting at this plane (their magnitudes must stay below 2^(plane − offset + 1)).
-using EncodeHook = std::function<void(int plane, const std::vector<PatchCoefficients>& view,
+/// deferred bands not yet started; the hook may use it as scratch) and the encoder's own copy of the
+/// coefficients, which the hook may change for the bands starting at this plane (their magnitudes must stay below 2^(plane − offset + 1)).
+using EncodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view,
                                       std::vector<PatchCoefficients>& coefficients)>;
 BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
                                   const std::vector<PatchCoefficients>& coefficients,
@@ -150,8 +150,9 @@ struct BitplaneDecodeResult {
 /// coefficient beyond kMaxCoefficientPlane); never throws on bytes, never reads outside them, and always
 /// leaves `out` holding the reconstruction of what was decoded.
 /// Deferred steps: `before_plane(plane, view)` is called, once all planes above were decoded completely, before
-/// decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got.
-using DecodeHook = std::function<void(int plane, const std::vector<PatchCoefficients>& view)>;
+/// decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got
+/// (scratch for the hook).
+using DecodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view)>;
 Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,

@@ -441,7 +441,8 @@ void compute_msb(Band& b, const PatchCoefficients& cf, int size) {
       if (!(b.state[b.node(0, x, y)] & kActive)) continue;
       const std::uint32_t index = b.grid_index(x, y, size);
       std::int64_t m = 0;
-      for (int c = 0; c < 3; ++c) m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
+      for (int c = 0; c < 3; ++c)
+        m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
       if (m >= (std::int64_t{1} << (kMaxCoefficientPlane + 1))) {
         throw std::invalid_argument("encode_bitplanes: coefficient magnitude " + std::to_string(m) +
                                     " too large");
@@ -498,8 +499,8 @@ void reconstruct_band(const Band& band, PatchCoefficients& patch) {
     for (int ch = 0; ch < 3; ++ch) {
       if (!(sm.flags & (1 << ch))) continue;
       // The middle of the interval [mag, mag + 2^q) (see the header).
-      const std::int64_t v = static_cast<std::int64_t>(sm.mag[ch]) +
-                             (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
+      const std::int64_t v =
+          static_cast<std::int64_t>(sm.mag[ch]) + (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
       patch[ch][sm.index] = static_cast<std::int32_t>((sm.flags >> (3 + ch)) & 1 ? -v : v);
     }
   }

@@ -129,7 +129,8 @@ struct BitplaneEncoding {
 /// each weighted plane that is some step's start plane, with `view` the decoder's reconstruction of every
 /// coefficient at that point (what decode_bitplanes() would output given the planes above: zero for
 /// deferred bands not yet started; the hook may use it as scratch) and the encoder's own copy of the
-/// coefficients, which the hook may change for the bands starting at this plane (their magnitudes must stay below 2^(plane − offset + 1)).
+/// coefficients, which the hook may change for the bands starting at this plane (their magnitudes must stay
+/// below 2^(plane − offset + 1)).
 using EncodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view,
                                       std::vector<PatchCoefficients>& coefficients)>;
 BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
@@ -149,14 +150,15 @@ struct BitplaneDecodeResult {
 /// (more segments than planes, a tail after the last plane, stream sizes that do not fit their segment, a
 /// coefficient beyond kMaxCoefficientPlane); never throws on bytes, never reads outside them, and always
 /// leaves `out` holding the reconstruction of what was decoded.
-/// Deferred steps: `before_plane(plane, view)` is called, once all planes above were decoded completely, before
-/// decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got
+/// Deferred steps: `before_plane(plane, view)` is called, once all planes above were decoded completely,
+/// before decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got
 /// (scratch for the hook).
 using DecodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view)>;
 Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,
                         std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
-                        BitplaneDecodeResult& result, int max_threads = 0, const DecodeHook& before_plane = {});
+                        BitplaneDecodeResult& result, int max_threads = 0,
+                        const DecodeHook& before_plane = {});
 
 }  // namespace geomip::codec

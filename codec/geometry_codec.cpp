@@ -134,7 +134,8 @@ bool header_ok(const GeometryCodecHeader& h) {
     return false;
   if (h.version < 3 && (h.orientation_weights || h.frame_steps != 0 || h.tangential_shift != 0)) return false;
   if (h.frame_steps < 0 || h.frame_steps > h.steps || h.tangential_shift < 0 ||
-      h.tangential_shift > kMaxTangentialShift || h.frame_start.size() != static_cast<std::size_t>(h.frame_steps))
+      h.tangential_shift > kMaxTangentialShift ||
+      h.frame_start.size() != static_cast<std::size_t>(h.frame_steps))
     return false;
   for (int v : h.frame_start) {
     if (v < 0 || v > h.top_bitplane) return false;
@@ -233,7 +234,8 @@ std::int64_t round_shift(std::int64_t v, int s) {
 /// The frame whose normal is N (any length; identity rows for N = 0).
 Frame make_frame(std::int64_t n0, std::int64_t n1, std::int64_t n2) {
   constexpr std::int32_t one = 1 << kFrameBits;
-  const int bits = static_cast<int>(std::bit_width(static_cast<std::uint64_t>(std::max({std::abs(n0), std::abs(n1), std::abs(n2)}))));
+  const int bits = static_cast<int>(
+      std::bit_width(static_cast<std::uint64_t>(std::max({std::abs(n0), std::abs(n1), std::abs(n2)}))));
   if (bits > 20) n0 >>= bits - 20, n1 >>= bits - 20, n2 >>= bits - 20;  // floor halvings: < 2^20
   const std::uint64_t len = isqrt(static_cast<std::uint64_t>(n0 * n0 + n1 * n1 + n2 * n2));
   if (len == 0) return {one, 0, 0, 0, one, 0, 0, 0, one};
@@ -267,9 +269,9 @@ struct FrameField {
   int level = 0, steps = 0, frame_steps = 0, tangential_shift = 0;
   WaveletFilter filter = WaveletFilter::kCubic;
   const Ownership* own = nullptr;
-  std::vector<int> start;                  // start plane of step k at [k − 1]
+  std::vector<int> start;                                         // start plane of step k at [k − 1]
   std::vector<std::vector<std::array<std::int64_t, 3>>> normals;  // [patch][grid index]
-  std::vector<std::uint8_t> ready;  // [k − 1]: normals of step k computed
+  std::vector<std::uint8_t> ready;                                // [k − 1]: normals of step k computed
 
   /// The frame at a framed position (built when needed: only non-zero coefficients need one).
   Frame frame(std::size_t p, int idx) const {
@@ -295,7 +297,8 @@ struct FrameField {
         for_step(k, [&](int, int, int idx) {
           if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
           std::int64_t w[3];
-          for (int r = 0; r < 3; ++r) w[r] = coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)];
+          for (int r = 0; r < 3; ++r)
+            w[r] = coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)];
           if (w[0] == 0 && w[1] == 0 && w[2] == 0) return;
           const Frame f = frame(p, idx);
           w[1] *= std::int64_t{1} << tangential_shift;
@@ -327,7 +330,8 @@ struct FrameField {
     to_xyz(w, min_k);
     const std::size_t size = (std::size_t{1} << level) + 1, samples = size * size;
     for (const auto& [copy, owner] : own->copies) {
-      for (int c = 0; c < 3; ++c) w[copy / samples][c][copy % samples] = w[owner / samples][c][owner % samples];
+      for (int c = 0; c < 3; ++c)
+        w[copy / samples][c][copy % samples] = w[owner / samples][c][owner % samples];
     }
     const int s = 1 << (min_k - 1), sub_level = level - (min_k - 1), sub_steps = steps - (min_k - 1);
     const std::size_t sub = (std::size_t{1} << sub_level) + 1;
@@ -342,14 +346,16 @@ struct FrameField {
         wavelet_inverse(g[c], sub_level, sub_steps, filter);
       }
       const auto at = [&](int c, int i, int j) {
-        return static_cast<std::int64_t>(g[c][static_cast<std::size_t>(j / s) * sub + static_cast<std::size_t>(i / s)]);
+        return static_cast<std::int64_t>(
+            g[c][static_cast<std::size_t>(j / s) * sub + static_cast<std::size_t>(i / s)]);
       };
       for (int k = min_k; k <= frame_steps; ++k) {
         if (start[static_cast<std::size_t>(k - 1)] != plane) continue;
         const int d = 1 << (k - 1);
         for_step(k, [&](int i, int j, int idx) {
           if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
-          const int i0 = std::max(i - d, 0), i1 = std::min(i + d, m), j0 = std::max(j - d, 0), j1 = std::min(j + d, m);
+          const int i0 = std::max(i - d, 0), i1 = std::min(i + d, m), j0 = std::max(j - d, 0),
+                    j1 = std::min(j + d, m);
           std::int64_t a[3], b[3];
           for (int c = 0; c < 3; ++c) {
             a[c] = at(c, i1, j) - at(c, i0, j);
@@ -374,7 +380,8 @@ struct FrameField {
         for_step(k, [&](int, int, int idx) {
           if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
           std::int64_t d[3];
-          for (int c = 0; c < 3; ++c) d[c] = coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)];
+          for (int c = 0; c < 3; ++c)
+            d[c] = coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)];
           if (d[0] == 0 && d[1] == 0 && d[2] == 0) return;
           const Frame f = frame(p, idx);
           for (int r = 0; r < 3; ++r) {
@@ -402,7 +409,8 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
   ff.ready.assign(static_cast<std::size_t>(h.frame_steps), 0);
   if (h.frame_steps > 0) {
     const std::size_t size = static_cast<std::size_t>(grid_size(h.level));
-    ff.normals.assign(static_cast<std::size_t>(h.num_patches), std::vector<std::array<std::int64_t, 3>>(size * size));
+    ff.normals.assign(static_cast<std::size_t>(h.num_patches),
+                      std::vector<std::array<std::int64_t, 3>>(size * size));
   }
   return ff;
 }
@@ -586,7 +594,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
         ff.for_step(k, [&](int i, int j, int idx) {
           if (!own.coded[static_cast<std::size_t>(p)][static_cast<std::size_t>(idx)]) return;
           std::int64_t mx = 0;
-          for (int c = 0; c < 3; ++c) mx = std::max<std::int64_t>(mx, std::abs(static_cast<std::int64_t>(coefs[p][c][idx])));
+          for (int c = 0; c < 3; ++c)
+            mx = std::max<std::int64_t>(mx, std::abs(static_cast<std::int64_t>(coefs[p][c][idx])));
           if (mx == 0) return;
           const bool odd_x = (i / s) & 1, odd_y = (j / s) & 1;
           const int orient = odd_x && odd_y ? 3 : (odd_x ? 1 : 2);

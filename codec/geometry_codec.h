@@ -50,11 +50,12 @@ struct Grid3 {
 struct GeometryCodecOptions {
   /// Quantization: the step is (largest bounding-box extent of all patches) / 2^quantization_bits, the origin
   /// the bounding-box minimum; in [1, 24]. Full decoding is lossless up to this quantization (error ≤ step/2
-  /// per coordinate) when frame_steps is 0; near-lossless with frames (see frame_steps). Cost of the bottom planes, measured on the Stanford bunny (2 patches of 257², cubic):
-  /// 10 bits 72 KB, 12 bits 100 KB, 14 bits 165 KB, 16 bits 254 KB in all; prefixes of a given size give
-  /// nearly the same quality whatever this is (the top planes hardly change). Default 14: the bunny's
-  /// level-8 pack decodes to the same 80.9 dB as with 16 bits (the geometry image, not the quantization, is
-  /// the limit), in 165 KB instead of 254 KB and 25 % less full-decode time.
+  /// per coordinate) when frame_steps is 0; near-lossless with frames (see frame_steps). Cost of the bottom
+  /// planes, measured on the Stanford bunny (2 patches of 257², cubic): 10 bits 72 KB, 12 bits 100 KB, 14
+  /// bits 165 KB, 16 bits 254 KB in all; prefixes of a given size give nearly the same quality whatever this
+  /// is (the top planes hardly change). Default 14: the bunny's level-8 pack decodes to the same 80.9 dB as
+  /// with 16 bits (the geometry image, not the quantization, is the limit), in 165 KB instead of 254 KB and
+  /// 25 % less full-decode time.
   int quantization_bits = 14;
   /// kCubic by default: on the bunny (2 × 257²) it gives 0.6–2.9 dB more grid PSNR and 1.6–3.5 dB more
   /// surface PSNR than kLinear at the same byte count (256 B – 128 KB), and 4% fewer bytes in all

@@ -364,9 +364,9 @@ struct FrameField {
           // Differences of garbage (a corrupt stream) can reach 2^33: keep the cross product below 2^63.
           // Never active for streams of this encoder (quantized values < 2^25).
           for (std::int64_t* v : {a, b}) {
-            const int w = static_cast<int>(std::bit_width(
+            const int bits = static_cast<int>(std::bit_width(
                 static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}))));
-            if (w > 30) v[0] >>= w - 30, v[1] >>= w - 30, v[2] >>= w - 30;
+            if (bits > 30) v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
           }
           normals[p][static_cast<std::size_t>(idx)] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
                                                        a[0] * b[1] - a[1] * b[0]};

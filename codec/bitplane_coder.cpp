@@ -128,6 +128,8 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
         b.kcls = std::min(k - 1, 2);
         b.offset = band_offset(layout, k, orient);
         b.start = layout.start_plane[static_cast<std::size_t>(k)];
+        // Deferred (framed) bands hold (normal, tangent, bitangent) components: contexts of their own.
+        if (b.start >= 0 && layout.own_deferred_contexts) b.cls += 2;
         b.dx = b.dy = 2 * s;
         const bool odd_x = orient != 2, odd_y = orient != 1;
         b.x0 = odd_x ? s : 0;
@@ -177,7 +179,8 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
   return bands;
 }
 
-constexpr int kNodeContexts = 3 * 3 * 4 * 3 * 2;
+constexpr int kClasses = 5;  // coarse, row/column, diagonal; deferred row/column, deferred diagonal
+constexpr int kNodeContexts = kClasses * 3 * 4 * 3 * 2;
 
 /// The shared traversal of encoder and decoder: every decision goes through sym(), so both walk the same
 /// path.
@@ -425,9 +428,9 @@ class PlaneCoder {
   ArithmeticEncoder* enc_ = nullptr;
   ArithmeticDecoder dec_{{}};
   Context node_ctx_[kNodeContexts];
-  Context chan_ctx_[3 * 3 * 2];
-  Context late_ctx_[3 * 3];
-  Context ref_ctx_[3];
+  Context chan_ctx_[kClasses * 3 * 2];
+  Context late_ctx_[kClasses * 3];
+  Context ref_ctx_[kClasses];
 };
 
 /// The encoder's quadtree of highest set bits of band `b` (max over the three channels) from `cf`.
@@ -438,7 +441,8 @@ void compute_msb(Band& b, const PatchCoefficients& cf, int size) {
       if (!(b.state[b.node(0, x, y)] & kActive)) continue;
       const std::uint32_t index = b.grid_index(x, y, size);
       std::int64_t m = 0;
-      for (int c = 0; c < 3; ++c) m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
+      for (int c = 0; c < 3; ++c)
+        m = std::max<std::int64_t>(m, std::abs(static_cast<std::int64_t>(cf[c][index])));
       if (m >= (std::int64_t{1} << (kMaxCoefficientPlane + 1))) {
         throw std::invalid_argument("encode_bitplanes: coefficient magnitude " + std::to_string(m) +
                                     " too large");
@@ -495,8 +499,8 @@ void reconstruct_band(const Band& band, PatchCoefficients& patch) {
     for (int ch = 0; ch < 3; ++ch) {
       if (!(sm.flags & (1 << ch))) continue;
       // The middle of the interval [mag, mag + 2^q) (see the header).
-      const std::int64_t v = static_cast<std::int64_t>(sm.mag[ch]) +
-                             (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
+      const std::int64_t v =
+          static_cast<std::int64_t>(sm.mag[ch]) + (sm.q[ch] > 0 ? (std::int64_t{1} << (sm.q[ch] - 1)) : 0);
       patch[ch][sm.index] = static_cast<std::int32_t>((sm.flags >> (3 + ch)) & 1 ? -v : v);
     }
   }
@@ -551,7 +555,10 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
   // Before coding `plane`: the hook for the bands that start there, and their new magnitudes.
   const auto run_hook = [&](int plane) {
     if (std::find(hooks.begin(), hooks.end(), plane) == hooks.end()) return;
-    if (before_plane) before_plane(plane, encoder_view(bands, coefs, plane, static_cast<int>(size)), coefs);
+    if (before_plane) {
+      std::vector<PatchCoefficients> view = encoder_view(bands, coefs, plane, static_cast<int>(size));
+      before_plane(plane, view, coefs);
+    }
     for (auto& b : bands) {
       if (b.start != plane) continue;
       compute_msb(b, coefs[b.patch], static_cast<int>(size));
@@ -808,7 +815,10 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
     const std::size_t a = cuts[r], b = cuts[r + 1];
     if (a >= decodable) break;
     for (int h : hooks) {
-      if (static_cast<std::size_t>(top_bitplane - h) == a && before_plane) before_plane(h, view());
+      if (static_cast<std::size_t>(top_bitplane - h) == a && before_plane) {
+        std::vector<PatchCoefficients> v = view();
+        before_plane(h, v);
+      }
     }
     if (a < joint) {
       std::vector<StreamPart> slice(joint_parts.begin() + static_cast<std::ptrdiff_t>(a),

@@ -11,7 +11,15 @@
 // Weighting. The synthesis function of an interpolating-wavelet coefficient at spacing s has an L2 norm ∝ s,
 // so the coder orders bits by the weighted magnitude |c|·2^offset with offset = k − 1 for the details of step
 // k and offset = steps for the coarse band. Weighted bit-plane b of a band is its plain bit-plane b − offset;
-// bands skip the weighted planes below their offset.
+// bands skip the weighted planes below their offset. With orientation weights (codec header version 3) the
+// row- and column-detail bands and the coarse band get offset + 1: the synthesis norms of the cubic
+// interpolating wavelet are about 1.13·2^(k−1) for rows and columns and 0.80·2^(k−1) for diagonals, a factor
+// √2 that the nearest whole plane rounds up to 2.
+//
+// Deferred steps (version 3, BitplaneLayout::start_plane): the detail bands of such a step are not visited in
+// the weighted planes above its start plane; just before it, encoder and decoder call a hook with the
+// decoder's reconstruction so far (geometry_codec puts those coefficients into local frames there). The
+// decoder decodes its planes in ranges between hooks, all patches synchronized at each hook.
 //
 // Joint channels. One quadtree per band over sample positions, with magnitude max(|x|, |y|, |z|). A node is
 // significant at plane p when its magnitude is ≥ 2^p. Each plane: (1) sorting pass, for every band: each
@@ -93,6 +101,8 @@ struct BitplaneLayout {
   /// decoder call their `before_plane` hooks (see encode_bitplanes()), which is where geometry_codec puts
   /// the local frames of those steps' coefficients.
   std::array<int, 13> start_plane = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
+  /// Deferred bands use contexts of their own (classes 3 and 4 beside coarse, row/column and diagonal).
+  bool own_deferred_contexts = false;
 };
 
 /// Weighted offset of a band: its plain bit-plane p is coded in weighted plane p + offset. Coarse band
@@ -118,9 +128,10 @@ struct BitplaneEncoding {
 /// Deferred steps (layout.start_plane): `before_plane(plane, view, coefficients)` is called before coding
 /// each weighted plane that is some step's start plane, with `view` the decoder's reconstruction of every
 /// coefficient at that point (what decode_bitplanes() would output given the planes above: zero for
-/// deferred bands not yet started) and the encoder's own copy of the coefficients, which the hook may change
-/// for the bands starting at this plane (their magnitudes must stay below 2^(plane − offset + 1)).
-using EncodeHook = std::function<void(int plane, const std::vector<PatchCoefficients>& view,
+/// deferred bands not yet started; the hook may use it as scratch) and the encoder's own copy of the
+/// coefficients, which the hook may change for the bands starting at this plane (their magnitudes must stay
+/// below 2^(plane − offset + 1)).
+using EncodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view,
                                       std::vector<PatchCoefficients>& coefficients)>;
 BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
                                   const std::vector<PatchCoefficients>& coefficients,
@@ -139,13 +150,15 @@ struct BitplaneDecodeResult {
 /// (more segments than planes, a tail after the last plane, stream sizes that do not fit their segment, a
 /// coefficient beyond kMaxCoefficientPlane); never throws on bytes, never reads outside them, and always
 /// leaves `out` holding the reconstruction of what was decoded.
-/// Deferred steps: `before_plane(plane, view)` is called, once all planes above were decoded completely, before
-/// decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got.
-using DecodeHook = std::function<void(int plane, const std::vector<PatchCoefficients>& view)>;
+/// Deferred steps: `before_plane(plane, view)` is called, once all planes above were decoded completely,
+/// before decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got
+/// (scratch for the hook).
+using DecodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view)>;
 Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,
                         std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
-                        BitplaneDecodeResult& result, int max_threads = 0, const DecodeHook& before_plane = {});
+                        BitplaneDecodeResult& result, int max_threads = 0,
+                        const DecodeHook& before_plane = {});
 
 }  // namespace geomip::codec

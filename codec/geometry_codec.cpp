@@ -134,7 +134,8 @@ bool header_ok(const GeometryCodecHeader& h) {
     return false;
   if (h.version < 3 && (h.orientation_weights || h.frame_steps != 0 || h.tangential_shift != 0)) return false;
   if (h.frame_steps < 0 || h.frame_steps > h.steps || h.tangential_shift < 0 ||
-      h.tangential_shift > kMaxTangentialShift || h.frame_start.size() != static_cast<std::size_t>(h.frame_steps))
+      h.tangential_shift > kMaxTangentialShift ||
+      h.frame_start.size() != static_cast<std::size_t>(h.frame_steps))
     return false;
   for (int v : h.frame_start) {
     if (v < 0 || v > h.top_bitplane) return false;
@@ -210,15 +211,13 @@ class Reader {
 constexpr int kFrameBits = 14;
 using Frame = std::array<std::int32_t, 9>;
 
-/// floor(√v), exact (integer Newton iteration).
+/// floor(√v) for v < 2^62, exact: the double square root (correctly rounded everywhere, WASM included) only
+/// seeds it, the integer fix-up decides.
 std::uint64_t isqrt(std::uint64_t v) {
-  if (v < 2) return v;
-  std::uint64_t x = std::uint64_t{1} << ((std::bit_width(v) + 1) / 2);  // ≥ √v
-  while (true) {
-    const std::uint64_t y = (x + v / x) / 2;
-    if (y >= x) return x;
-    x = y;
-  }
+  std::uint64_t s = static_cast<std::uint64_t>(std::sqrt(static_cast<double>(v)));
+  while (s * s > v) --s;
+  while ((s + 1) * (s + 1) <= v) ++s;
+  return s;
 }
 
 /// round(num / den) for den > 0, halves up (floor((2·num + den) / (2·den))).
@@ -235,9 +234,9 @@ std::int64_t round_shift(std::int64_t v, int s) {
 /// The frame whose normal is N (any length; identity rows for N = 0).
 Frame make_frame(std::int64_t n0, std::int64_t n1, std::int64_t n2) {
   constexpr std::int32_t one = 1 << kFrameBits;
-  while (std::max({std::abs(n0), std::abs(n1), std::abs(n2)}) >= (std::int64_t{1} << 20)) {
-    n0 >>= 1, n1 >>= 1, n2 >>= 1;
-  }
+  const int bits = static_cast<int>(
+      std::bit_width(static_cast<std::uint64_t>(std::max({std::abs(n0), std::abs(n1), std::abs(n2)}))));
+  if (bits > 20) n0 >>= bits - 20, n1 >>= bits - 20, n2 >>= bits - 20;  // floor halvings: < 2^20
   const std::uint64_t len = isqrt(static_cast<std::uint64_t>(n0 * n0 + n1 * n1 + n2 * n2));
   if (len == 0) return {one, 0, 0, 0, one, 0, 0, 0, one};
   const std::int64_t n[3] = {round_div(n0 * one, static_cast<std::int64_t>(len)),
@@ -270,9 +269,15 @@ struct FrameField {
   int level = 0, steps = 0, frame_steps = 0, tangential_shift = 0;
   WaveletFilter filter = WaveletFilter::kCubic;
   const Ownership* own = nullptr;
-  std::vector<int> start;                  // start plane of step k at [k − 1]
-  std::vector<std::vector<Frame>> frames;  // [patch][grid index]
-  std::vector<std::uint8_t> ready;         // [k − 1]: frames of step k computed
+  std::vector<int> start;                                         // start plane of step k at [k − 1]
+  std::vector<std::vector<std::array<std::int64_t, 3>>> normals;  // [patch][grid index]
+  std::vector<std::uint8_t> ready;                                // [k − 1]: normals of step k computed
+
+  /// The frame at a framed position (built when needed: only non-zero coefficients need one).
+  Frame frame(std::size_t p, int idx) const {
+    const auto& n = normals[p][static_cast<std::size_t>(idx)];
+    return make_frame(n[0], n[1], n[2]);
+  }
 
   /// Calls f(i, j, index) for every detail position of step k.
   template <typename F>
@@ -291,9 +296,11 @@ struct FrameField {
         if (!ready[static_cast<std::size_t>(k - 1)]) continue;
         for_step(k, [&](int, int, int idx) {
           if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
-          const Frame& f = frames[p][static_cast<std::size_t>(idx)];
           std::int64_t w[3];
-          for (int r = 0; r < 3; ++r) w[r] = coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)];
+          for (int r = 0; r < 3; ++r)
+            w[r] = coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)];
+          if (w[0] == 0 && w[1] == 0 && w[2] == 0) return;
+          const Frame f = frame(p, idx);
           w[1] *= std::int64_t{1} << tangential_shift;
           w[2] *= std::int64_t{1} << tangential_shift;
           for (int c = 0; c < 3; ++c) {
@@ -313,17 +320,18 @@ struct FrameField {
   /// spacing of the finest such step is reconstructed; the normal at a detail of step k (spacing s) is the
   /// cross product of the central differences (i ± s, j) and (i, j ± s) of that reconstruction (one-sided on
   /// the border).
-  void compute(int plane, const std::vector<PatchCoefficients>& view) {
+  void compute(int plane, std::vector<PatchCoefficients>& view) {
     int min_k = 0;
     for (int k = frame_steps; k >= 1; --k) {
       if (start[static_cast<std::size_t>(k - 1)] == plane) min_k = k;
     }
     if (min_k == 0) return;
-    std::vector<PatchCoefficients> w = view;
+    std::vector<PatchCoefficients>& w = view;  // scratch: changed in place
     to_xyz(w, min_k);
     const std::size_t size = (std::size_t{1} << level) + 1, samples = size * size;
     for (const auto& [copy, owner] : own->copies) {
-      for (int c = 0; c < 3; ++c) w[copy / samples][c][copy % samples] = w[owner / samples][c][owner % samples];
+      for (int c = 0; c < 3; ++c)
+        w[copy / samples][c][copy % samples] = w[owner / samples][c][owner % samples];
     }
     const int s = 1 << (min_k - 1), sub_level = level - (min_k - 1), sub_steps = steps - (min_k - 1);
     const std::size_t sub = (std::size_t{1} << sub_level) + 1;
@@ -338,21 +346,30 @@ struct FrameField {
         wavelet_inverse(g[c], sub_level, sub_steps, filter);
       }
       const auto at = [&](int c, int i, int j) {
-        return static_cast<std::int64_t>(g[c][static_cast<std::size_t>(j / s) * sub + static_cast<std::size_t>(i / s)]);
+        return static_cast<std::int64_t>(
+            g[c][static_cast<std::size_t>(j / s) * sub + static_cast<std::size_t>(i / s)]);
       };
       for (int k = min_k; k <= frame_steps; ++k) {
         if (start[static_cast<std::size_t>(k - 1)] != plane) continue;
         const int d = 1 << (k - 1);
         for_step(k, [&](int i, int j, int idx) {
           if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
-          const int i0 = std::max(i - d, 0), i1 = std::min(i + d, m), j0 = std::max(j - d, 0), j1 = std::min(j + d, m);
+          const int i0 = std::max(i - d, 0), i1 = std::min(i + d, m), j0 = std::max(j - d, 0),
+                    j1 = std::min(j + d, m);
           std::int64_t a[3], b[3];
           for (int c = 0; c < 3; ++c) {
             a[c] = at(c, i1, j) - at(c, i0, j);
             b[c] = at(c, i, j1) - at(c, i, j0);
           }
-          frames[p][static_cast<std::size_t>(idx)] =
-              make_frame(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]);
+          // Differences of garbage (a corrupt stream) can reach 2^33: keep the cross product below 2^63.
+          // Never active for streams of this encoder (quantized values < 2^25).
+          for (std::int64_t* v : {a, b}) {
+            const int bits = static_cast<int>(std::bit_width(
+                static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}))));
+            if (bits > 30) v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
+          }
+          normals[p][static_cast<std::size_t>(idx)] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                                                       a[0] * b[1] - a[1] * b[0]};
         });
       }
     }
@@ -369,9 +386,11 @@ struct FrameField {
         if (start[static_cast<std::size_t>(k - 1)] != plane) continue;
         for_step(k, [&](int, int, int idx) {
           if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
-          const Frame& f = frames[p][static_cast<std::size_t>(idx)];
           std::int64_t d[3];
-          for (int c = 0; c < 3; ++c) d[c] = coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)];
+          for (int c = 0; c < 3; ++c)
+            d[c] = coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)];
+          if (d[0] == 0 && d[1] == 0 && d[2] == 0) return;
+          const Frame f = frame(p, idx);
           for (int r = 0; r < 3; ++r) {
             const std::int64_t v = static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r)]) * d[0] +
                                    static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r + 1)]) * d[1] +
@@ -397,7 +416,8 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
   ff.ready.assign(static_cast<std::size_t>(h.frame_steps), 0);
   if (h.frame_steps > 0) {
     const std::size_t size = static_cast<std::size_t>(grid_size(h.level));
-    ff.frames.assign(static_cast<std::size_t>(h.num_patches), std::vector<Frame>(size * size));
+    ff.normals.assign(static_cast<std::size_t>(h.num_patches),
+                      std::vector<std::array<std::int64_t, 3>>(size * size));
   }
   return ff;
 }
@@ -405,6 +425,7 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
 BitplaneLayout make_layout(const GeometryCodecHeader& h) {
   BitplaneLayout layout{h.level, h.steps, h.num_patches, h.version >= 2, h.joint_segments};
   layout.orientation_weights = h.orientation_weights;
+  layout.own_deferred_contexts = h.version >= 3;
   for (int k = 1; k <= h.frame_steps && k <= static_cast<int>(h.frame_start.size()); ++k)
     layout.start_plane[static_cast<std::size_t>(k)] = h.frame_start[static_cast<std::size_t>(k - 1)];
   return layout;
@@ -580,7 +601,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
         ff.for_step(k, [&](int i, int j, int idx) {
           if (!own.coded[static_cast<std::size_t>(p)][static_cast<std::size_t>(idx)]) return;
           std::int64_t mx = 0;
-          for (int c = 0; c < 3; ++c) mx = std::max<std::int64_t>(mx, std::abs(static_cast<std::int64_t>(coefs[p][c][idx])));
+          for (int c = 0; c < 3; ++c)
+            mx = std::max<std::int64_t>(mx, std::abs(static_cast<std::int64_t>(coefs[p][c][idx])));
           if (mx == 0) return;
           const bool odd_x = (i / s) & 1, odd_y = (j / s) & 1;
           const int orient = odd_x && odd_y ? 3 : (odd_x ? 1 : 2);
@@ -596,7 +618,7 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   // "no automatic choice").
   BitplaneLayout layout = make_layout(h);
   layout.joint_segments = 0;
-  const EncodeHook hook = [&](int plane, const std::vector<PatchCoefficients>& view,
+  const EncodeHook hook = [&](int plane, std::vector<PatchCoefficients>& view,
                               std::vector<PatchCoefficients>& cf) {
     ff.compute(plane, view);
     ff.to_frames(plane, cf);
@@ -620,7 +642,7 @@ Status decode_geometry(const GeometryCodecHeader& header,
   std::vector<PatchCoefficients> coefs;
   BitplaneDecodeResult r;
   FrameField ff = make_frame_field(header, own);
-  const DecodeHook hook = [&](int plane, const std::vector<PatchCoefficients>& view) { ff.compute(plane, view); };
+  const DecodeHook hook = [&](int plane, std::vector<PatchCoefficients>& view) { ff.compute(plane, view); };
   const Status status = decode_bitplanes(make_layout(header), header.top_bitplane, own.coded, segments,
                                          partial_tail, coefs, r, options.max_threads, hook);
   out.segments_complete = r.segments_complete;

@@ -9,6 +9,10 @@
 // copies it to the other patches before the inverse transform, so every decoded prefix is watertight with
 // bit-identical seam samples.
 //
+// Version 3 (docs/codec-v3.md): the detail coefficients of the finest steps are coded in local frames
+// (normal, tangent, bitangent) that the decoder derives from its own coarser reconstruction, the tangential
+// components one bit-plane coarser; row and column details are weighted above diagonal ones.
+//
 // The output is a list of segments, one per bit-plane pass, coarsest information first. Segments are
 // self-delimiting only through their sizes (stored by the container, pack.h); a decoder given the first k
 // complete segments plus a byte prefix of segment k+1 reconstructs the best approximation those bytes allow.
@@ -46,11 +50,12 @@ struct Grid3 {
 struct GeometryCodecOptions {
   /// Quantization: the step is (largest bounding-box extent of all patches) / 2^quantization_bits, the origin
   /// the bounding-box minimum; in [1, 24]. Full decoding is lossless up to this quantization (error ≤ step/2
-  /// per coordinate). Cost of the bottom planes, measured on the Stanford bunny (2 patches of 257², cubic):
-  /// 10 bits 72 KB, 12 bits 100 KB, 14 bits 165 KB, 16 bits 254 KB in all; prefixes of a given size give
-  /// nearly the same quality whatever this is (the top planes hardly change). Default 14: the bunny's
-  /// level-8 pack decodes to the same 80.9 dB as with 16 bits (the geometry image, not the quantization, is
-  /// the limit), in 165 KB instead of 254 KB and 25 % less full-decode time.
+  /// per coordinate) when frame_steps is 0; near-lossless with frames (see frame_steps). Cost of the bottom
+  /// planes, measured on the Stanford bunny (2 patches of 257², cubic): 10 bits 72 KB, 12 bits 100 KB, 14
+  /// bits 165 KB, 16 bits 254 KB in all; prefixes of a given size give nearly the same quality whatever this
+  /// is (the top planes hardly change). Default 14: the bunny's level-8 pack decodes to the same 80.9 dB as
+  /// with 16 bits (the geometry image, not the quantization, is the limit), in 165 KB instead of 254 KB and
+  /// 25 % less full-decode time.
   int quantization_bits = 14;
   /// kCubic by default: on the bunny (2 × 257²) it gives 0.6–2.9 dB more grid PSNR and 1.6–3.5 dB more
   /// surface PSNR than kLinear at the same byte count (256 B – 128 KB), and 4% fewer bytes in all
@@ -143,7 +148,8 @@ struct DecodedGeometry {
 /// planes that exist are still decoded). kInvalidArgument (and no patches) for a header that parse() would
 /// refuse (built by hand) or a negative drop_finest_steps. Cost: proportional to the bytes decoded; a
 /// version-2 stream decodes its patches on parallel threads (options.max_threads). Measured on the bunny
-/// (2 patches of 257², 14 bits, tests/bench/codec_bench.cpp --pack): 2 KB 1.9 ms, 16 KB 3.6 ms, the full
+/// (2 patches of 257², 14 bits, tests/bench/codec_bench.cpp --pack, a version-2 stream; version 3 in
+/// docs/codec-v3.md): 2 KB 1.9 ms, 16 KB 3.6 ms, the full
 /// 164 KB 16–17.5 ms on one core; 1.4, 2.5 and 9.1–9.4 ms on two.
 Status decode_geometry(const GeometryCodecHeader& header,
                        std::span<const std::span<const std::uint8_t>> segments,

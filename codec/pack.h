@@ -100,8 +100,12 @@ struct PackModelInput {
 struct PackWriteOptions {
   GeometryCodecOptions geometry;  ///< defaults: 14 bits, cubic interpolating wavelet
   /// Normal maps: no local frames (they are unit vectors, not displacements on a surface).
-  GeometryCodecOptions normal_codec{.quantization_bits = 10, .filter = WaveletFilter::kCubic, .steps = -1,
-                                    .frame_steps = 0, .tangential_shift = 0, .orientation_weights = false};
+  GeometryCodecOptions normal_codec{.quantization_bits = 10,
+                                    .filter = WaveletFilter::kCubic,
+                                    .steps = -1,
+                                    .frame_steps = 0,
+                                    .tangential_shift = 0,
+                                    .orientation_weights = false};
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.
   int normals_delay = 4;

@@ -11,8 +11,9 @@
 // 20·log10(bbox diagonal / RMS), plus the full decode time; with --mesh, also the surface PSNR (Metro-style
 // symmetric RMS distance to mesh M, gimage/surface_distance.h) of the decoded grids; with --surface on, the
 // same against the uncompressed grids (the codec's own error, tangential displacement not counted).
-// CODEC_BUDGETS=2000,4700,... in the environment measures only those byte budgets. CODEC_DUMP=PATH in the environment also writes the encoded stream (u32 header size, header, u32 segment
-// count, then u32 size + bytes per segment; little-endian) for decoder experiments outside this program.
+// CODEC_BUDGETS=2000,4700,... in the environment measures only those byte budgets. CODEC_DUMP=PATH in the
+// environment also writes the encoded stream (u32 header size, header, u32 segment count, then u32 size +
+// bytes per segment; little-endian) for decoder experiments outside this program.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -177,11 +178,11 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
         filter == WaveletFilter::kCubic ? "cubic" : "linear", enc.header.level, m.patches.size(),
         enc.segments.size(), total, enc.header.serialize().size(),
         std::chrono::duration<double, std::milli>(t1 - t0).count());
-    std::vector<std::size_t> budgets = {256,   512,   1024,  2000,  2048,  4096,   4700,   8192,  8800,
+    std::vector<std::size_t> budgets = {256,   512,   1024,  2000,  2048,  4096,   4700,   8192, 8800,
                                         16000, 16384, 32000, 32768, 65536, 131072, 262144, total};
-    if (const char* list = std::getenv("CODEC_BUDGETS")) {  // e.g. "2000,4700,8800": only these
+    if (const char* only = std::getenv("CODEC_BUDGETS")) {  // e.g. "2000,4700,8800": only these
       budgets.clear();
-      for (const char* c = list; *c;) {
+      for (const char* c = only; *c;) {
         char* end;
         budgets.push_back(std::strtoull(c, &end, 10));
         c = *end ? end + 1 : end;

@@ -122,9 +122,9 @@ TEST(Pack, EveryPrefixDecodesToACoarserModelOrTruncated) {
       for (const Grid3& g : m.geometry)
         EXPECT_TRUE(std::all_of(g.values.begin(), g.values.end(), [](float v) { return std::isfinite(v); }));
     }
-    // At chunk boundaries (whole passes), more bytes never make the model worse — up to 5 %: with local frames
-    // (version 3) a pass that refines normal components can move a sample by the frame rotation's rounding
-    // (measured on this fixture: +3 % once, 0.0677 → 0.0698, and +1.6 % at the last pass).
+    // At chunk boundaries (whole passes), more bytes never make the model worse — up to 5 %: with local
+    // frames (version 3) a pass that refines normal components can move a sample by the frame rotation's
+    // rounding (measured on this fixture: +3 % once, 0.0677 → 0.0698, and +1.6 % at the last pass).
     const bool boundary = std::any_of(info.chunks.begin(), info.chunks.end(),
                                       [&](const ChunkInfo& c) { return c.offset + c.size == n; });
     if (boundary) {
@@ -310,7 +310,8 @@ TEST_P(GoldenPack, Decodes) {
                                                 pillow_model(5, "b", 2.0, true)};
   for (std::size_t m = 0; m < 2; ++m) {
     EXPECT_EQ(r.models[m].name, expected[m].name);
-    // Version 3 codes local frames: near-lossless (rotation rounding, tangential components one plane coarser).
+    // Version 3 codes local frames: near-lossless (rotation rounding, tangential components one plane
+    // coarser).
     EXPECT_LE(max_error(r.models[m].geometry, expected[m].geometry),
               (version >= 3 ? 8.0 : 1.0) * (m == 0 ? 2.0 : 4.0) / 16384.0);
     ASSERT_EQ(r.models[m].normals.size(), 2u);

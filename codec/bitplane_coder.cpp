@@ -8,6 +8,7 @@
 #include <string>
 
 #include "codec/arithmetic_coder.h"
+#include "codec/byte_io.h"
 #include "codec/parallel.h"
 
 namespace geomip::codec {
@@ -611,12 +612,7 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
       if (st.size() > kMaxStreamBytes)
         throw std::length_error("encode_bitplanes: a patch stream of one plane over 1 GiB");
       sizes.push_back(st.size());
-      std::uint64_t v = st.size();
-      while (v >= 0x80) {
-        segment.push_back(static_cast<std::uint8_t>(v | 0x80));
-        v >>= 7;
-      }
-      segment.push_back(static_cast<std::uint8_t>(v));
+      detail::put_varint(segment, st.size());
     }
     std::vector<std::size_t> taken(streams.size(), 0);
     Interleaver order(sizes);
@@ -686,13 +682,9 @@ bool split_segment(std::span<const std::uint8_t> seg, bool complete, int np,
   std::uint64_t total = 0;
   for (int p = 0; p < np; ++p) {
     std::uint64_t v = 0;
-    for (int i = 0;; ++i) {
-      if (pos >= seg.size()) return !complete;  // a prefix that ends inside the sizes: nothing arrived
-      if (i == 5) return false;
-      const std::uint8_t byte = seg[pos++];
-      v |= static_cast<std::uint64_t>(byte & 0x7F) << (7 * i);
-      if (!(byte & 0x80)) break;
-    }
+    const detail::VarintRead read = detail::read_varint(seg, pos, v, 5, false);
+    if (read == detail::VarintRead::kTruncated) return !complete;  // a prefix ending inside the sizes: nothing arrived
+    if (read != detail::VarintRead::kOk) return false;
     if (v > kMaxStreamBytes) return false;
     sizes.push_back(v);
     total += v;

@@ -28,15 +28,14 @@
 // not); a significant leaf (sample) codes the significance of each channel (the last inferred when needed)
 // and the signs, and joins the band's significant-sample list (LSP); (2) refinement pass, for every band:
 // each sample significant before this plane codes bit p of its significant channels and the significance of
-// the others. (Refinement before sorting gives 0.1–0.7 dB more grid PSNR for prefixes ending inside a plane,
-// but 0.6–1.7 dB less surface PSNR — the product's measure — on the bunny at 2–128 KB: sorting stays first.)
+// the others. (Sorting comes first because it gives more surface PSNR, the product's measure, though less
+// grid PSNR: docs/measurements.md.)
 // Contexts: node significance by band class (coarse / row-or-column / diagonal), step (1, 2, ≥
 // 3), quadtree depth (0, 1, 2, ≥ 3), number of significant 4-neighbours at the same depth (0, 1, ≥ 2) and the
 // significance of the parent (the same place one step coarser, same orientation); channel significance by
 // class, channel and whether another channel is significant; the first refinement bit of a coefficient by
-// class; later refinement bits and signs are coded as raw (bypass) bits (measured on the bunny:
-// context-coding the second and third refinement bits saves only 0.15% of the bytes, and raw bits decode
-// several times faster).
+// class; later refinement bits and signs are coded as raw (bypass) bits (context-coding them saves almost
+// nothing and raw bits decode several times faster: docs/measurements.md).
 //
 // Segments. One segment per weighted bit-plane, from top_bitplane down to 0; the arithmetic coder is flushed
 // at each segment end and the contexts carry over. Samples whose `coded` mask entry is 0 (seam copies owned
@@ -51,16 +50,15 @@
 // the interleave a function of the sizes alone: byte k of stream p is placed at (k + ½)/size_p, merged by
 // that time. So the decoder takes the streams apart before decoding and runs the patches in parallel, and
 // a byte prefix of a segment holds the same fraction of every patch's plane — close to the order of one
-// joint coder. Measured on the bunny (2 patches of 257², 14 bits, surface PSNR of `geomip rd`): per-patch
-// coders from the first plane lost 0.3 dB at 1.5–2 KB (separate contexts, sizes, flushes) and, with
-// patch-major order (stream 0, then stream 1), up to 0.9 dB between plane boundaries; the joint start
-// (geometry_codec: joint until 2 KB) and the interleave remove both. Full decode 20 → 9 ms on 2 cores.
+// joint coder. Per-patch coders from the first plane (separate contexts, sizes, flushes) and patch-major order
+// both cost surface PSNR at low rates; the joint start (geometry_codec: joint until 2 KB) and the interleave
+// remove both (figures: docs/measurements.md).
 // Version 1 (independent_patches false): one stream for all patches throughout; still decoded.
 //
 // Decoding reconstructs each significant coefficient at the middle of its remaining uncertainty interval
 // (known bits down to plane q: |c| ∈ [known, known + 2^q), reconstructed as known + 2^(q−1)); insignificant
-// ones as 0. (3/8 of the interval, the usual choice for Laplacian data, gave +0.03–0.17 dB grid PSNR but
-// −0.2–0.4 dB surface PSNR on the bunny at 2–32 KB.) Given complete segments plus a byte prefix of the next,
+// ones as 0. (3/8 of the interval, the usual choice for Laplacian data, loses surface PSNR here:
+// docs/measurements.md.) Given complete segments plus a byte prefix of the next,
 // it stops at the first symbol that would need a byte past the prefix (the range decoder's prefix property),
 // so everything decoded is exactly what the encoder coded.
 #pragma once

@@ -12,6 +12,40 @@
 
 namespace geomip::codec::detail {
 
+/// Appends `v` as unsigned LEB128 (7 bits a byte, least significant first, high bit = more follow). The
+/// codec's one varint writer: the pack manifest, the codec headers and the per-patch stream sizes use it.
+inline void put_varint(std::vector<std::uint8_t>& out, std::uint64_t v) {
+  while (v >= 0x80) {
+    out.push_back(static_cast<std::uint8_t>(v | 0x80));
+    v >>= 7;
+  }
+  out.push_back(static_cast<std::uint8_t>(v));
+}
+
+enum class VarintRead { kOk, kTruncated, kCorrupt };
+
+/// Reads an unsigned LEB128 at bytes[pos…] of at most `max_bytes` bytes (≤ 10) and advances `pos` past it.
+/// kTruncated when the bytes end inside it (pos unchanged); kCorrupt when it is longer than `max_bytes`,
+/// overflows 64 bits or, with `canonical`, ends in a redundant zero byte. The codec's one varint reader:
+/// each format states its rule (manifest: 10 bytes; codec header: 5 bytes, canonical; stream sizes: 5 bytes).
+inline VarintRead read_varint(std::span<const std::uint8_t> bytes, std::size_t& pos, std::uint64_t& v,
+                              int max_bytes, bool canonical) {
+  v = 0;
+  std::size_t p = pos;
+  for (int i = 0; i < max_bytes && i < 10; ++i) {
+    if (p >= bytes.size()) return VarintRead::kTruncated;
+    const std::uint8_t b = bytes[p++];
+    if (i == 9 && b > 1) return VarintRead::kCorrupt;  // beyond 64 bits
+    v |= static_cast<std::uint64_t>(b & 0x7F) << (7 * i);
+    if (!(b & 0x80)) {
+      if (canonical && i > 0 && b == 0) return VarintRead::kCorrupt;
+      pos = p;
+      return VarintRead::kOk;
+    }
+  }
+  return VarintRead::kCorrupt;
+}
+
 class ByteWriter {
  public:
   void u8(std::uint8_t v) { bytes_.push_back(v); }
@@ -19,14 +53,8 @@ class ByteWriter {
   void u32(std::uint32_t v) { fixed(v, 4); }
   void u64(std::uint64_t v) { fixed(v, 8); }
   void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
-  /// Unsigned LEB128.
-  void varint(std::uint64_t v) {
-    while (v >= 0x80) {
-      bytes_.push_back(static_cast<std::uint8_t>(v | 0x80));
-      v >>= 7;
-    }
-    bytes_.push_back(static_cast<std::uint8_t>(v));
-  }
+  /// Unsigned LEB128 (put_varint).
+  void varint(std::uint64_t v) { put_varint(bytes_, v); }
   void string(const std::string& s) {
     varint(s.size());
     bytes_.insert(bytes_.end(), s.begin(), s.end());
@@ -73,17 +101,10 @@ class ByteReader {
     v = std::bit_cast<double>(x);
     return true;
   }
-  /// Unsigned LEB128 of at most 10 bytes; false on overflow or end of data.
+  /// Unsigned LEB128 of at most 10 bytes (read_varint); false on overflow or end of data.
   bool varint(std::uint64_t& v) {
-    v = 0;
-    for (int shift = 0; shift < 64; shift += 7) {
-      std::uint8_t b;
-      if (!u8(b)) return false;
-      if (shift == 63 && b > 1) return fail();
-      v |= static_cast<std::uint64_t>(b & 0x7f) << shift;
-      if (!(b & 0x80)) return true;
-    }
-    return fail();
+    if (failed_) return false;
+    return read_varint(bytes_, pos_, v, 10, false) == VarintRead::kOk || fail();
   }
   /// A varint that must be <= max.
   bool bounded(std::uint64_t& v, std::uint64_t max) { return varint(v) && (v <= max || fail()); }

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "codec/bitplane_coder.h"
+#include "codec/byte_io.h"
 
 namespace geomip::codec {
 namespace {
@@ -147,13 +148,7 @@ bool header_ok(const GeometryCodecHeader& h) {
   return true;
 }
 
-void put_varint(std::vector<std::uint8_t>& out, std::uint64_t v) {
-  while (v >= 0x80) {
-    out.push_back(static_cast<std::uint8_t>(v | 0x80));
-    v >>= 7;
-  }
-  out.push_back(static_cast<std::uint8_t>(v));
-}
+using detail::put_varint;
 
 void put_double(std::vector<std::uint8_t>& out, double d) {
   std::uint64_t bits;
@@ -171,16 +166,7 @@ class Reader {
     return true;
   }
   /// Varint of at most 5 bytes (values < 2^35), canonical (no trailing zero byte).
-  bool varint(std::uint64_t& v) {
-    v = 0;
-    for (int i = 0; i < 5; ++i) {
-      std::uint8_t b;
-      if (!byte(b)) return false;
-      v |= static_cast<std::uint64_t>(b & 0x7F) << (7 * i);
-      if (!(b & 0x80)) return !(i > 0 && b == 0);
-    }
-    return false;
-  }
+  bool varint(std::uint64_t& v) { return detail::read_varint(bytes_, pos_, v, 5, true) == detail::VarintRead::kOk; }
   bool small_int(int& out, std::uint64_t max) {
     std::uint64_t v;
     if (!varint(v) || v > max) return false;

@@ -50,16 +50,12 @@ struct Grid3 {
 struct GeometryCodecOptions {
   /// Quantization: the step is (largest bounding-box extent of all patches) / 2^quantization_bits, the origin
   /// the bounding-box minimum; in [1, 24]. Full decoding is lossless up to this quantization (error ≤ step/2
-  /// per coordinate) when frame_steps is 0; near-lossless with frames (see frame_steps). Cost of the bottom
-  /// planes, measured on the Stanford bunny (2 patches of 257², cubic): 10 bits 72 KB, 12 bits 100 KB, 14
-  /// bits 165 KB, 16 bits 254 KB in all; prefixes of a given size give nearly the same quality whatever this
-  /// is (the top planes hardly change). Default 14: the bunny's level-8 pack decodes to the same 80.9 dB as
-  /// with 16 bits (the geometry image, not the quantization, is the limit), in 165 KB instead of 254 KB and
-  /// 25 % less full-decode time.
+  /// per coordinate) when frame_steps is 0; near-lossless with frames (see frame_steps). More bits cost only
+  /// the bottom planes (prefixes of a given size hardly change); 14 is where a level-8 geometry image, not
+  /// the quantization, limits the accuracy (figures: docs/measurements.md).
   int quantization_bits = 14;
-  /// kCubic by default: on the bunny (2 × 257²) it gives 0.6–2.9 dB more grid PSNR and 1.6–3.5 dB more
-  /// surface PSNR than kLinear at the same byte count (256 B – 128 KB), and 4% fewer bytes in all
-  /// (tests/bench/codec_bench.cpp --rd).
+  /// kCubic by default: more grid and surface PSNR than kLinear at every byte count, and fewer bytes in all
+  /// (figures: docs/measurements.md; tests/bench/codec_bench.cpp --rd).
   WaveletFilter filter = WaveletFilter::kCubic;
   /// Wavelet steps; -1 = all the way down to the 2×2 grid of corners (level 0).
   int steps = -1;
@@ -147,10 +143,8 @@ struct DecodedGeometry {
 /// error. kCorrupt also for more segments than header.top_bitplane + 1, or a tail after the last one (the
 /// planes that exist are still decoded). kInvalidArgument (and no patches) for a header that parse() would
 /// refuse (built by hand) or a negative drop_finest_steps. Cost: proportional to the bytes decoded; a
-/// version-2 stream decodes its patches on parallel threads (options.max_threads). Measured on the bunny
-/// (2 patches of 257², 14 bits, tests/bench/codec_bench.cpp --pack, a version-2 stream; version 3 in
-/// docs/codec-v3.md): 2 KB 1.9 ms, 16 KB 3.6 ms, the full
-/// 164 KB 16–17.5 ms on one core; 1.4, 2.5 and 9.1–9.4 ms on two.
+/// version-2/3 stream decodes its patches on parallel threads (options.max_threads); version 3 adds the
+/// frame construction of its framed steps (timings: tests/bench/codec_bench.cpp --pack, docs/codec-v3.md).
 Status decode_geometry(const GeometryCodecHeader& header,
                        std::span<const std::span<const std::uint8_t>> segments,
                        std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,

@@ -31,6 +31,11 @@ struct BoundingBox {
 };
 BoundingBox referenced_bounding_box(const TriMesh& mesh);
 
+/// Per-vertex unit normals: the area-weighted sum of the incident triangles' normals (counter-clockwise
+/// triangles give outward normals), normalized. A vertex without incident area (unreferenced, or only
+/// degenerate triangles) gets (0, 0, 1). \pre every index is in range. Cost: O(#F + #V).
+std::vector<Eigen::Vector3d> vertex_normals(const TriMesh& mesh);
+
 /// Progress callback for long operations: `stage` is a short human-readable name, `fraction` ∈ [0,1] of that
 /// stage. Called from the calling thread; may be empty.
 using ProgressCallback = std::function<void(const char* stage, double fraction)>;

@@ -1189,7 +1189,9 @@ void write_mesh(const TriMesh& mesh, std::ostream& out, MeshFormat format, const
   if (format == MeshFormat::kGltf || format == MeshFormat::kGlb) {
     GltfWriteOptions gltf;
     gltf.binary = format == MeshFormat::kGlb;
-    write_gltf(mesh, {}, out, gltf);
+    MeshAttributes attributes;  // smooth shading in glTF viewers: area-weighted vertex normals
+    for (const auto& n : vertex_normals(mesh)) attributes.normals.push_back(n.cast<float>());
+    write_gltf(mesh, attributes, out, gltf);
     return;
   }
   TriMeshExporter exporter(mesh);

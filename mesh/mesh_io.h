@@ -57,7 +57,8 @@ struct WriteMeshOptions {
   int precision = 9;
 };
 
-/// Writes `mesh` to `out` in `format` (OBJ, PLY or OFF). Writes every triangle as it is: no manifold
+/// Writes `mesh` to `out` in `format` (OBJ, PLY, OFF, or glTF/GLB with area-weighted vertex normals
+/// (vertex_normals()) for smooth shading). Writes every triangle as it is: no manifold
 /// requirement. Does not open or rename files: tools/ write to a temporary file and rename (atomic output).
 /// \throw InvalidInput for STL (not written) or an empty mesh, IoError when the stream fails.
 void write_mesh(const TriMesh& mesh, std::ostream& out, MeshFormat format, const WriteMeshOptions& options = {});

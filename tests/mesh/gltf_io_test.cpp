@@ -3,6 +3,7 @@
 // message instead of a crash (accessors past their buffers, indices out of range, garbage).
 #include "mesh/errors.h"
 #include "mesh/gltf_io.h"
+#include "mesh/mesh_io.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>
@@ -149,6 +150,32 @@ TEST(GltfIo, IndicesBeyondTheVertexCountAreRefused) {
   // The index buffer is the last 4·3·F bytes of the BIN chunk: set its last index to 0xFFFFFFFF.
   for (int k = 1; k <= 4; ++k) bytes[n - k] = '\xff';
   expect_refused(bytes, "beyond the");
+}
+
+TEST(VertexNormals, AreUnitAndOutwardOnASphereAndDefinedForLooseVertices) {
+  TriMesh sphere = test::sphere(2);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : sphere.positions) centre += p;
+  centre /= static_cast<double>(sphere.positions.size());
+  sphere.positions.emplace_back(5, 5, 5);  // referenced by no triangle
+  const std::vector<Eigen::Vector3d> n = vertex_normals(sphere);
+  ASSERT_EQ(n.size(), sphere.positions.size());
+  for (std::size_t v = 0; v + 1 < n.size(); ++v) {
+    EXPECT_NEAR(n[v].norm(), 1.0, 1e-12) << v;
+    EXPECT_GT(n[v].dot((sphere.positions[v] - centre).normalized()), 0.9) << v;
+  }
+  EXPECT_EQ(n.back(), Eigen::Vector3d(0, 0, 1));
+}
+
+// write_mesh's glTF carries the vertex normals, so viewers shade it smoothly.
+TEST(GltfIo, WriteMeshAddsVertexNormals) {
+  const TriMesh cube = test::cube();
+  std::ostringstream out;
+  write_mesh(cube, out, MeshFormat::kGltf);
+  const auto j = nlohmann::json::parse(out.str());
+  const auto& attributes = j["meshes"][0]["primitives"][0]["attributes"];
+  ASSERT_TRUE(attributes.contains("NORMAL"));
+  EXPECT_EQ(j["accessors"][attributes["NORMAL"].get<int>()]["count"], cube.positions.size());
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 // fuzzer's time on them would leave it at ~25 inputs/s instead of a thousand and more. The check is here, in
 // the harness: it reads the same manifest the decoder reads, with read_pack_info(), and changes nothing in
 // codec/.
+#include "tests/fuzz/fuzz_bounds.h"
 #include "codec/pack.h"
 
 #include <cstddef>
@@ -15,28 +16,8 @@
 
 namespace {
 
-// Samples of the grids a pack's manifest announces (geometry, normal maps, hole masks), saturating.
-std::uint64_t announced_samples(const geomip::codec::PackInfo& info) {
-  constexpr std::uint64_t kCap = std::uint64_t{1} << 40;
-  auto grid = [](int level) {
-    if (level < 0 || level > 16) return kCap;
-    const std::uint64_t side = (std::uint64_t{1} << level) + 1;
-    return side * side;
-  };
-  std::uint64_t total = 0;
-  for (const auto& m : info.models) {
-    const auto patches = static_cast<std::uint64_t>(m.geometry.num_patches < 0 ? 0 : m.geometry.num_patches);
-    total += patches * grid(m.geometry.level);
-    if (m.has_normals) total += patches * grid(m.normals.level);
-    total += patches * grid(m.fine_hole_mask_level);
-    if (total > kCap) return kCap;
-  }
-  return total;
-}
-
-// About 2 ms of decoding under ASan: every seed (tests/fuzz/seeds/pack/: cubes at levels 1 to 3, with and
-// without normal maps, an open cube with its hole mask, two models) fits; a mutated level byte does not.
-constexpr std::uint64_t kMaxSamples = 2'500;
+using geomip::fuzz::announced_samples;
+using geomip::fuzz::kMaxSamples;
 
 }  // namespace
 

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <span>
 
+#include "tests/fuzz/fuzz_bounds.h"
 #include "codec/pack.h"
 #include "stream_viewer/fetch_plan.h"
 
@@ -28,26 +29,8 @@ namespace {
 
 using geomip::viewer::FetchPlan;
 
-// Samples the manifest announces, saturating: a mutated level byte must not make one input cost seconds
-// (the same harness bound as pack_fuzzer.cpp).
-std::uint64_t announced_samples(const geomip::codec::PackInfo& info) {
-  constexpr std::uint64_t kCap = std::uint64_t{1} << 40;
-  auto grid = [](int level) {
-    if (level < 0 || level > 16) return kCap;
-    const std::uint64_t side = (std::uint64_t{1} << level) + 1;
-    return side * side;
-  };
-  std::uint64_t total = 0;
-  for (const auto& m : info.models) {
-    const auto patches = static_cast<std::uint64_t>(m.geometry.num_patches < 0 ? 0 : m.geometry.num_patches);
-    total += patches * grid(m.geometry.level);
-    if (m.has_normals) total += patches * grid(m.normals.level);
-    total += patches * grid(m.fine_hole_mask_level);
-    if (total > kCap) return kCap;
-  }
-  return total;
-}
-constexpr std::uint64_t kMaxSamples = 2'500;
+using geomip::fuzz::announced_samples;
+using geomip::fuzz::kMaxSamples;
 
 void check(bool ok) {
   if (!ok) __builtin_trap();

@@ -12,6 +12,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
@@ -329,4 +330,57 @@ std::vector<double> distances_to_surface(const TriMesh& surface, const std::vect
   return distances;
 }
 
+struct SurfaceLines::Impl {
+  explicit Impl(const TriMesh& mesh) : surface(mesh) {}
+  SearchSurface surface;
+};
+
+SurfaceLines::SurfaceLines(const TriMesh& surface) {
+  validate(surface, "surface");
+  impl_ = std::make_unique<Impl>(surface);
+}
+
+SurfaceLines::~SurfaceLines() = default;
+
+std::optional<Eigen::Vector3d> SurfaceLines::crossing_near(const Eigen::Vector3d& origin,
+                                                           const Eigen::Vector3d& direction,
+                                                           const Eigen::Vector3d& hint, double radius) const {
+  const double length = direction.norm();
+  if (!(length > 0) || !std::isfinite(length) || !origin.allFinite() || !hint.allFinite() ||
+      !(radius > 0) || !std::isfinite(radius)) {
+    return std::nullopt;
+  }
+  // The part of the line within `radius` of `hint`: a segment centred at hint's projection onto the line.
+  const Eigen::Vector3d d = direction / length;
+  const Eigen::Vector3d centre = origin + (hint - origin).dot(d) * d;
+  const double off_line2 = (hint - centre).squaredNorm();
+  if (off_line2 > radius * radius) return std::nullopt;
+  const double half = std::sqrt(radius * radius - off_line2);
+  const Kernel::Segment_3 segment(to_point(centre - half * d), to_point(centre + half * d));
+
+  using Hit = Tree::Intersection_and_primitive_id<Kernel::Segment_3>::Type;
+  std::vector<Hit> hits;
+  impl_->surface.tree().all_intersections(segment, std::back_inserter(hits));
+  std::optional<Eigen::Vector3d> best;
+  double best2 = radius * radius;
+  const auto consider = [&](const Point& p) {
+    const Eigen::Vector3d q(p.x(), p.y(), p.z());
+    const double d2 = (q - hint).squaredNorm();
+    if (d2 <= best2) {
+      best2 = d2;
+      best = q;
+    }
+  };
+  for (const Hit& hit : hits) {
+    if (const Point* p = boost::get<Point>(&hit.first)) {
+      consider(*p);
+    } else if (const Kernel::Segment_3* s = boost::get<Kernel::Segment_3>(&hit.first)) {
+      consider(s->source());
+      consider(s->target());
+    }
+  }
+  return best;
+}
+
 }  // namespace geomip
+

@@ -15,6 +15,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <vector>
 
 namespace geomip {
@@ -94,5 +96,28 @@ SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh&
 /// AABB tree as measure_surface_distance()), in the mesh's units.
 /// \throw InvalidInput as measure_surface_distance() for a bad `surface`.
 std::vector<double> distances_to_surface(const TriMesh& surface, const std::vector<Eigen::Vector3d>& points);
+
+/// Line queries against one surface: its nonzero-area triangles in the same kind of AABB tree as
+/// measure_surface_distance(), built once. Queries are const and may run concurrently. Used by the encoder's
+/// normal-mesh resampling (codec/normal_mesh.h), which asks where a line along a predicted normal crosses the
+/// surface.
+class SurfaceLines {
+ public:
+  /// \throw InvalidInput as measure_surface_distance() for a bad `surface` (named "surface").
+  explicit SurfaceLines(const TriMesh& surface);
+  ~SurfaceLines();
+  SurfaceLines(const SurfaceLines&) = delete;
+  SurfaceLines& operator=(const SurfaceLines&) = delete;
+
+  /// Of the points where the line {origin + t·direction} meets the surface, the one closest to `hint`,
+  /// provided it lies within `radius` of `hint`; std::nullopt when there is none (or `direction` is zero or
+  /// an argument is not finite). Where the line lies in a triangle's plane, the ends of its overlap count.
+  std::optional<Eigen::Vector3d> crossing_near(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                               const Eigen::Vector3d& hint, double radius) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace geomip

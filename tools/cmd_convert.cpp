@@ -26,6 +26,8 @@ struct ConvertArgs {
   int quantization_bits = 14;
   int hole_mask_level = -1;
   bool no_normals = false;
+  int normal_mesh_steps = ConvertOptions{}.normal_mesh_steps;
+  double normal_mesh_reach = ConvertOptions{}.normal_mesh_max_shift;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -40,6 +42,12 @@ int run_convert(const ConvertArgs& args) {
                        std::to_string(args.level) + ", 10]");
   if (args.quantization_bits < 8 || args.quantization_bits > 24)
     throw InvalidInput("--bits " + std::to_string(args.quantization_bits) + " is outside [8, 24]");
+  if (args.normal_mesh_steps < -1 || args.normal_mesh_steps > args.level)
+    throw InvalidInput("--normal-mesh " + std::to_string(args.normal_mesh_steps) + " is outside [0, " +
+                       std::to_string(args.level) + "] (the level)");
+  if (args.normal_mesh_steps > 0 && (args.common.meshes.size() > 1 || !args.common.points.empty()))
+    throw InvalidInput("--normal-mesh moves samples off the parameterization, which the morphs of a consistent "
+                       "set rely on: use it with one mesh");
   const bool report = !args.common.quiet && !args.common.json;
   const auto t_start = std::chrono::steady_clock::now();
   const PreparedModels models =
@@ -53,6 +61,8 @@ int run_convert(const ConvertArgs& args) {
   options.quantization_bits = args.quantization_bits;
   options.hole_mask_level = args.hole_mask_level;
   options.sampling_exponent = args.common.sampling_exponent;
+  options.normal_mesh_steps = args.normal_mesh_steps;
+  options.normal_mesh_max_shift = args.normal_mesh_reach;
   options.progress = bar.callback();
   const ConvertResult converted = convert_models(models, options);
   const std::vector<std::uint8_t>& pack = converted.pack;
@@ -76,6 +86,10 @@ int run_convert(const ConvertArgs& args) {
                                 {"level", args.level},
                                 {"normals", !args.no_normals},
                                 {"models", j_models},
+                                {"normal_mesh", {{"steps", converted.normal_mesh_steps},
+                                                 {"samples", converted.normal_mesh_candidates},
+                                                 {"moved", converted.normal_mesh_moved},
+                                                 {"mean_shift", converted.normal_mesh_mean_shift}}},
                                 {"param_seconds", converted.param_seconds},
                                 {"resample_seconds", converted.resample_seconds},
                                 {"encode_seconds", converted.encode_seconds},
@@ -110,6 +124,13 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_option("--hole-mask-level", args->hole_mask_level,
                   "Grid level of the mask of filled holes (default: N; coarser costs fewer bytes)");
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack (for rate–distortion comparisons)");
+  cmd->add_option("--normal-mesh", args->normal_mesh_steps,
+                  "Normal-mesh resampling: move the samples of the finest STEPS wavelet steps onto the surface "
+                  "along their predicted normals, so their details are normal offsets (fewer bits); one mesh "
+                  "only (default " + std::to_string(kAutoNormalMeshSteps) + " for one mesh, 0 = off)");
+  cmd->add_option("--normal-mesh-reach", args->normal_mesh_reach,
+                  "Largest move of a normal-mesh sample, in sample spacings of its level")
+      ->check(CLI::Range(0.0, 4.0));
   return [args] { return run_convert(*args); };
 }
 

@@ -55,6 +55,7 @@ struct RdArgs {
   unsigned threads = 0;     // 0 = hardware_concurrency
   int level = 8;            // geomip: geometry image level of the pack whose prefixes are measured
   bool no_geomip = false;   // only the baselines
+  int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -191,12 +192,13 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
 
 /// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only pack),
 /// then one job per prefix size: decode the first N bytes and build the level-N mesh.
-Series geomip_series(const std::string& mesh_path, int level, bool quick, std::vector<std::uint8_t>& pack_out,
-                     ProgressBar& progress) {
+Series geomip_series(const std::string& mesh_path, int level, int normal_mesh_steps, bool quick,
+                     std::vector<std::uint8_t>& pack_out, ProgressBar& progress) {
   const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true);
   ConvertOptions options;
   options.level = level;
   options.normals = false;
+  options.normal_mesh_steps = normal_mesh_steps;
   options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
   auto pack = std::make_shared<const std::vector<std::uint8_t>>(convert_models(models, options).pack);
   pack_out = *pack;
@@ -282,7 +284,7 @@ int run_rd(const RdArgs& args) {
   ProgressBar progress("rd", !args.json);
   std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
-  if (!args.no_geomip) plan.push_back(geomip_series(args.mesh, args.level, args.quick, pack, progress));
+  if (!args.no_geomip) plan.push_back(geomip_series(args.mesh, args.level, args.normal_mesh_steps, args.quick, pack, progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -432,6 +434,9 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_option("--level", args->level, "geomip: geometry image level of the measured pack (default 8)")
       ->check(CLI::Range(1, 10));
   cmd->add_flag("--no-geomip", args->no_geomip, "Only the baselines (no geomip pack)");
+  cmd->add_option("--normal-mesh", args->normal_mesh_steps,
+                  "geomip: normal-mesh resampling of the finest STEPS wavelet steps (as `geomip convert`; 0 = off)")
+      ->check(CLI::Range(0, 10));
   return [args] { return run_rd(*args); };
 }
 

@@ -1,18 +1,52 @@
 #include "tools/convert_pipeline.h"
 
+#include "codec/normal_mesh.h"
 #include "gimage/hole_mask.h"
 #include "gimage/resample.h"
+#include "gimage/surface_distance.h"
+#include "mesh/errors.h"
 #include "param/consistent_parameterization.h"
 #include "tools/pack_models.h"
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
+#include <utility>
 
 namespace geomip::tools {
 namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Moves the finest steps' samples of every patch onto the surface along their predicted normals.
+void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, const ConvertOptions& options,
+                 ConvertResult& result) {
+  const SurfaceLines lines(surface);
+  const codec::SurfaceCrossing crossing = [&](const codec::Point3d& origin, const codec::Point3d& direction,
+                                              const codec::Point3d& hint,
+                                              double radius) -> std::optional<codec::Point3d> {
+    const auto hit = lines.crossing_near(Eigen::Vector3d(origin[0], origin[1], origin[2]),
+                                         Eigen::Vector3d(direction[0], direction[1], direction[2]),
+                                         Eigen::Vector3d(hint[0], hint[1], hint[2]), radius);
+    if (!hit) return std::nullopt;
+    return codec::Point3d{hit->x(), hit->y(), hit->z()};
+  };
+  codec::NormalMeshOptions normal;
+  normal.steps = steps;
+  normal.max_shift = options.normal_mesh_max_shift;
+  double shift_sum = result.normal_mesh_mean_shift * static_cast<double>(result.normal_mesh_moved);
+  for (GeometryImage& image : images.geometry) {
+    codec::Grid3 grid{image.level, std::move(image.values)};
+    const codec::NormalMeshStats stats = codec::normal_mesh_resample(grid, crossing, normal);
+    image.values = std::move(grid.values);
+    result.normal_mesh_candidates += stats.candidates;
+    result.normal_mesh_moved += stats.moved;
+    shift_sum += stats.mean_shift * static_cast<double>(stats.moved);
+  }
+  if (result.normal_mesh_moved > 0)
+    result.normal_mesh_mean_shift = shift_sum / static_cast<double>(result.normal_mesh_moved);
 }
 
 }  // namespace
@@ -22,6 +56,14 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
     if (options.progress) options.progress(stage, fraction);
   };
   ConvertResult result;
+  if (options.normal_mesh_steps > 0 && models.inputs.size() > 1) {
+    throw InvalidInput("normal-mesh resampling moves samples off the parameterization, which the morphs of a "
+                       "consistent set rely on: use it with one mesh");
+  }
+  const int normal_mesh_steps =
+      options.normal_mesh_steps >= 0 ? options.normal_mesh_steps
+                                     : (models.inputs.size() == 1 ? std::min(kAutoNormalMeshSteps, options.level) : 0);
+  result.normal_mesh_steps = normal_mesh_steps;
   ParameterizationOptions param;
   param.measure_mvc_baseline = false;
   param.curvature_sampling = options.sampling_exponent > 0;
@@ -39,7 +81,8 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
     ResampleOptions resample;
     resample.normals = options.normals;
     resample.normal_level = options.normal_level;
-    const GeometryImages images = resample_geometry(params[m], options.level, resample);
+    GeometryImages images = resample_geometry(params[m], options.level, resample);
+    if (normal_mesh_steps > 0) normal_mesh(images, params[m].mesh, normal_mesh_steps, options, result);
     HoleMaskResult mask;
     if (m < models.originals.size() && !models.originals[m].triangles.empty())
       mask = hole_mask(params[m], models.originals[m], mask_level);

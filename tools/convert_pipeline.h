@@ -11,6 +11,11 @@
 
 namespace geomip::tools {
 
+/// Normal-mesh steps of a one-model pack by default: the codec's framed steps (GeometryCodecOptions::
+/// frame_steps), where tangential components cost less; more steps lose (docs/codec-v3.md, "Normal-mesh
+/// resampling").
+constexpr int kAutoNormalMeshSteps = 3;
+
 struct ConvertOptions {
   int level = 8;              ///< geometry image level N: (2^N+1)² samples per patch
   int normal_level = -1;      ///< normal map level (-1: N+1, at most 10)
@@ -22,12 +27,23 @@ struct ConvertOptions {
   /// default here because it costs the codec at low rates; the remeshing commands default to 1/3; README,
   /// "Curvature sampling").
   double sampling_exponent = 0;
+  /// Normal-mesh resampling of the finest `normal_mesh_steps` wavelet steps' samples before coding
+  /// (codec/normal_mesh.h; 0 = off). One model only: it moves samples off the parameterization, which the
+  /// morphs of a consistent set rely on (InvalidInput when asked for with several models). -1 (default) =
+  /// kAutoNormalMeshSteps for one model, off for several.
+  int normal_mesh_steps = -1;
+  /// Largest move of a normal-mesh sample, in local sample spacings (NormalMeshOptions::max_shift).
+  double normal_mesh_max_shift = 0.5;
   ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode"
 };
 
 struct ConvertResult {
   std::vector<std::uint8_t> pack;
   std::vector<std::size_t> masked_quads;  ///< per model: grid quads left out as filled holes
+  /// Normal-mesh resampling: the steps applied (0 = off) and figures over all patches.
+  int normal_mesh_steps = 0;
+  std::size_t normal_mesh_candidates = 0, normal_mesh_moved = 0;
+  double normal_mesh_mean_shift = 0;  ///< mean move of the moved samples, in local sample spacings
   double param_seconds = 0, resample_seconds = 0, encode_seconds = 0;
 };
 

@@ -311,5 +311,34 @@ TEST(SurfaceDistance, BadInputThrowsInvalidInput) {
   expect_invalid(flat, "nonzero area");
 }
 
+TEST(SurfaceLines, CrossingNearestTheHintWithinReach) {
+  const TriMesh unit_sphere = test::sphere(3);  // vertices on the unit sphere, flat faces inside it
+  const SurfaceLines lines(unit_sphere);
+  const Eigen::Vector3d origin(0.01, 0.02, 0), direction(0, 0, 3);  // any length
+  const auto top = lines.crossing_near(origin, direction, Eigen::Vector3d(0, 0, 0.9), 0.3);
+  ASSERT_TRUE(top.has_value());
+  EXPECT_NEAR(top->x(), 0.01, 1e-12);
+  EXPECT_NEAR(top->y(), 0.02, 1e-12);
+  EXPECT_GT(top->z(), 0.9);  // the polyhedron lies inside the sphere, near it
+  EXPECT_LE(top->z(), 1.0);
+  const auto bottom = lines.crossing_near(origin, direction, Eigen::Vector3d(0, 0, -0.9), 0.3);
+  ASSERT_TRUE(bottom.has_value());
+  EXPECT_NEAR(bottom->z(), -top->z(), 0.05);
+  EXPECT_FALSE(lines.crossing_near(origin, direction, Eigen::Vector3d(0, 0, 0.5), 0.3).has_value());
+  EXPECT_FALSE(lines.crossing_near(origin, direction, Eigen::Vector3d(0.5, 0, 0.95), 0.3).has_value())
+      << "the hint is farther than the reach from the line";
+  EXPECT_FALSE(lines.crossing_near(origin, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.9), 0.3));
+  EXPECT_FALSE(lines.crossing_near(origin, direction, Eigen::Vector3d(0, 0, NAN), 0.3));
+}
+
+TEST(SurfaceLines, LineInATrianglesPlaneTakesTheOverlapsEnds) {
+  const SurfaceLines lines(square(4));
+  const auto hit = lines.crossing_near(Eigen::Vector3d(-1, 0.5, 0), Eigen::Vector3d(1, 0, 0),
+                                       Eigen::Vector3d(-0.1, 0.5, 0), 0.5);
+  ASSERT_TRUE(hit.has_value());
+  EXPECT_NEAR(hit->x(), 0.0, 1e-12);  // the square's edge x = 0 is the nearest point of the overlap
+  EXPECT_THROW(SurfaceLines(TriMesh{}), InvalidInput);
+}
+
 }  // namespace
 }  // namespace geomip

@@ -603,6 +603,9 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
   const std::size_t bytes = j["bytes"];
   EXPECT_EQ(bytes, fs::file_size(pack));
   EXPECT_LT(j["manifest_bytes"].get<std::size_t>(), 400u);
+  // One mesh: normal-mesh resampling of the framed steps by default; nearly every sample finds its crossing.
+  EXPECT_EQ(j["normal_mesh"]["steps"], 3);
+  EXPECT_GE(j["normal_mesh"]["moved"].get<double>(), 0.9 * j["normal_mesh"]["samples"].get<double>());
 
   r = geomip("decode --json '" + pack + "' -o '" + dir_ + "/full.obj'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -639,6 +642,17 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
     EXPECT_EQ(info_of(dir_ + name), obj_info) << name;
   }
   expect_bad_input("decode -q '" + pack + "' -o '" + dir_ + "/x.stl'", "x.stl");
+}
+
+// Normal-mesh resampling is for one mesh: asked for with a consistent set it is refused before any work,
+// and it is off by default there.
+TEST_F(CliPack, NormalMeshRefusedForSeveralMeshes) {
+  const std::string pack = dir_ + "/two.gip";
+  const Outcome r = geomip("convert -q '" + spot_ + "' '" + spot_ + "' --normal-mesh 2 --level 3 -o '" + pack + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("one mesh"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(pack));
+  expect_bad_input("convert -q '" + spot_ + "' --normal-mesh 9 --level 8 -o '" + pack + "'", "--normal-mesh");
 }
 
 // `geomip info PACK`: the chunk table as a reader receives it (cumulative sizes end at the file's size, in

@@ -75,10 +75,12 @@ class SearchSurface {
  public:
   explicit SearchSurface(const TriMesh& mesh) {
     triangles_.reserve(mesh.triangles.size());
-    for (const auto& t : mesh.triangles) {
+    for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+      const auto& t = mesh.triangles[f];
       if (triangle_area(mesh, t) > 0) {
         triangles_.emplace_back(to_point(mesh.positions[t[0]]), to_point(mesh.positions[t[1]]),
                                 to_point(mesh.positions[t[2]]));
+        ids_.push_back(f);
       }
     }
     tree_.insert(triangles_.cbegin(), triangles_.cend());
@@ -89,9 +91,14 @@ class SearchSurface {
   SearchSurface& operator=(const SearchSurface&) = delete;
 
   const Tree& tree() const { return tree_; }
+  /// The mesh's index of a primitive of the tree.
+  std::size_t triangle_of(TriangleIterator primitive) const {
+    return ids_[static_cast<std::size_t>(primitive - triangles_.cbegin())];
+  }
 
  private:
   std::vector<Triangle> triangles_;
+  std::vector<std::size_t> ids_;  ///< per entry of triangles_, its index in the mesh
   Tree tree_;
 };
 
@@ -330,19 +337,21 @@ std::vector<double> distances_to_surface(const TriMesh& surface, const std::vect
   return distances;
 }
 
-struct SurfaceLines::Impl {
-  explicit Impl(const TriMesh& mesh) : surface(mesh) {}
+struct SurfaceQuery::Impl {
+  explicit Impl(const TriMesh& m) : mesh(m), surface(mesh), normals(vertex_normals(mesh)) {}
+  TriMesh mesh;  // a copy: the query does not depend on the caller's mesh staying alive
   SearchSurface surface;
+  std::vector<Eigen::Vector3d> normals;
 };
 
-SurfaceLines::SurfaceLines(const TriMesh& surface) {
+SurfaceQuery::SurfaceQuery(const TriMesh& surface) {
   validate(surface, "surface");
   impl_ = std::make_unique<Impl>(surface);
 }
 
-SurfaceLines::~SurfaceLines() = default;
+SurfaceQuery::~SurfaceQuery() = default;
 
-std::optional<Eigen::Vector3d> SurfaceLines::crossing_near(const Eigen::Vector3d& origin,
+std::optional<Eigen::Vector3d> SurfaceQuery::crossing_near(const Eigen::Vector3d& origin,
                                                            const Eigen::Vector3d& direction,
                                                            const Eigen::Vector3d& hint, double radius) const {
   const double length = direction.norm();
@@ -380,6 +389,22 @@ std::optional<Eigen::Vector3d> SurfaceLines::crossing_near(const Eigen::Vector3d
     }
   }
   return best;
+}
+
+Eigen::Vector3d SurfaceQuery::normal_near(const Eigen::Vector3d& p) const {
+  const auto [closest, primitive] = impl_->surface.tree().closest_point_and_primitive(to_point(p));
+  const auto& t = impl_->mesh.triangles[impl_->surface.triangle_of(primitive)];
+  const Eigen::Vector3d& a = impl_->mesh.positions[t[0]];
+  const Eigen::Vector3d& b = impl_->mesh.positions[t[1]];
+  const Eigen::Vector3d& c = impl_->mesh.positions[t[2]];
+  const Eigen::Vector3d q(closest.x(), closest.y(), closest.z());
+  // Barycentric coordinates of q (on the triangle) from the sub-triangle areas.
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double area2 = n.squaredNorm();
+  const double wb = (q - a).cross(c - a).dot(n) / area2, wc = (b - a).cross(q - a).dot(n) / area2;
+  const Eigen::Vector3d sum = (1 - wb - wc) * impl_->normals[t[0]] + wb * impl_->normals[t[1]] +
+                              wc * impl_->normals[t[2]];
+  return sum.norm() > 0 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d(n.normalized());
 }
 
 }  // namespace geomip

@@ -97,23 +97,28 @@ SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh&
 /// \throw InvalidInput as measure_surface_distance() for a bad `surface`.
 std::vector<double> distances_to_surface(const TriMesh& surface, const std::vector<Eigen::Vector3d>& points);
 
-/// Line queries against one surface: its nonzero-area triangles in the same kind of AABB tree as
-/// measure_surface_distance(), built once. Queries are const and may run concurrently. Used by the encoder's
-/// normal-mesh resampling (codec/normal_mesh.h), which asks where a line along a predicted normal crosses the
-/// surface.
-class SurfaceLines {
+/// Line and closest-point queries against one surface: its nonzero-area triangles in the same kind of AABB
+/// tree as measure_surface_distance(), built once. Queries are const and may run concurrently. Used by the
+/// encoder's normal-mesh resampling (codec/normal_mesh.h), which asks where a line along a predicted normal
+/// crosses the surface, and then for the normals at the moved samples (the normal maps).
+class SurfaceQuery {
  public:
   /// \throw InvalidInput as measure_surface_distance() for a bad `surface` (named "surface").
-  explicit SurfaceLines(const TriMesh& surface);
-  ~SurfaceLines();
-  SurfaceLines(const SurfaceLines&) = delete;
-  SurfaceLines& operator=(const SurfaceLines&) = delete;
+  explicit SurfaceQuery(const TriMesh& surface);
+  ~SurfaceQuery();
+  SurfaceQuery(const SurfaceQuery&) = delete;
+  SurfaceQuery& operator=(const SurfaceQuery&) = delete;
 
   /// Of the points where the line {origin + t·direction} meets the surface, the one closest to `hint`,
   /// provided it lies within `radius` of `hint`; std::nullopt when there is none (or `direction` is zero or
   /// an argument is not finite). Where the line lies in a triangle's plane, the ends of its overlap count.
   std::optional<Eigen::Vector3d> crossing_near(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                                                const Eigen::Vector3d& hint, double radius) const;
+
+  /// The unit normal at the surface point closest to `p`: the area-weighted vertex normals (vertex_normals())
+  /// interpolated barycentrically in the closest triangle and renormalized (as resample_geometry()'s normal
+  /// maps); the triangle's own normal where that sum vanishes.
+  Eigen::Vector3d normal_near(const Eigen::Vector3d& p) const;
 
  private:
   struct Impl;

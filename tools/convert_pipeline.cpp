@@ -1,6 +1,7 @@
 #include "tools/convert_pipeline.h"
 
 #include "codec/normal_mesh.h"
+#include "codec/parallel.h"
 #include "gimage/hole_mask.h"
 #include "gimage/resample.h"
 #include "gimage/surface_distance.h"
@@ -23,11 +24,11 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 /// Moves the finest steps' samples of every patch onto the surface along their predicted normals.
 void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, const ConvertOptions& options,
                  ConvertResult& result) {
-  const SurfaceLines lines(surface);
+  const SurfaceQuery query(surface);
   const codec::SurfaceCrossing crossing = [&](const codec::Point3d& origin, const codec::Point3d& direction,
                                               const codec::Point3d& hint,
                                               double radius) -> std::optional<codec::Point3d> {
-    const auto hit = lines.crossing_near(Eigen::Vector3d(origin[0], origin[1], origin[2]),
+    const auto hit = query.crossing_near(Eigen::Vector3d(origin[0], origin[1], origin[2]),
                                          Eigen::Vector3d(direction[0], direction[1], direction[2]),
                                          Eigen::Vector3d(hint[0], hint[1], hint[2]), radius);
     if (!hit) return std::nullopt;
@@ -47,6 +48,31 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
   }
   if (result.normal_mesh_moved > 0)
     result.normal_mesh_mean_shift = shift_sum / static_cast<double>(result.normal_mesh_moved);
+
+  // The normal maps follow the moved samples: each interior texel takes the surface normal nearest the point
+  // the geometry image now puts at its (u,v) (bilinear in the geometry grid). Border texels keep theirs: the
+  // border samples do not move, and seam texels stay bit-identical across patches.
+  for (std::size_t p = 0; p < images.normals.size() && p < images.geometry.size(); ++p) {
+    const GeometryImage& geometry = images.geometry[p];
+    GeometryImage& normals = images.normals[p];
+    const int n = normals.size();
+    const double scale = static_cast<double>(geometry.size() - 1) / static_cast<double>(n - 1);
+    codec::parallel_for(n - 2, 0, [&](int row) {
+      const int b = row + 1;
+      for (int a = 1; a < n - 1; ++a) {
+        const double x = a * scale, y = b * scale;
+        const int i = std::min(static_cast<int>(x), geometry.size() - 2);
+        const int j = std::min(static_cast<int>(y), geometry.size() - 2);
+        const double fx = x - i, fy = y - j;
+        const Eigen::Vector3d point =
+            (1 - fy) * ((1 - fx) * geometry.sample(i, j).cast<double>() + fx * geometry.sample(i + 1, j).cast<double>()) +
+            fy * ((1 - fx) * geometry.sample(i, j + 1).cast<double>() + fx * geometry.sample(i + 1, j + 1).cast<double>());
+        const Eigen::Vector3d unit = query.normal_near(point);
+        float* texel = normals.at(a, b);
+        for (int c = 0; c < 3; ++c) texel[c] = static_cast<float>(unit[c]);
+      }
+    });
+  }
 }
 
 }  // namespace

@@ -311,9 +311,9 @@ TEST(SurfaceDistance, BadInputThrowsInvalidInput) {
   expect_invalid(flat, "nonzero area");
 }
 
-TEST(SurfaceLines, CrossingNearestTheHintWithinReach) {
+TEST(SurfaceQuery, CrossingNearestTheHintWithinReach) {
   const TriMesh unit_sphere = test::sphere(3);  // vertices on the unit sphere, flat faces inside it
-  const SurfaceLines lines(unit_sphere);
+  const SurfaceQuery lines(unit_sphere);
   const Eigen::Vector3d origin(0.01, 0.02, 0), direction(0, 0, 3);  // any length
   const auto top = lines.crossing_near(origin, direction, Eigen::Vector3d(0, 0, 0.9), 0.3);
   ASSERT_TRUE(top.has_value());
@@ -331,13 +331,24 @@ TEST(SurfaceLines, CrossingNearestTheHintWithinReach) {
   EXPECT_FALSE(lines.crossing_near(origin, direction, Eigen::Vector3d(0, 0, NAN), 0.3));
 }
 
-TEST(SurfaceLines, LineInATrianglesPlaneTakesTheOverlapsEnds) {
-  const SurfaceLines lines(square(4));
+TEST(SurfaceQuery, NormalNearIsTheInterpolatedVertexNormal) {
+  const SurfaceQuery on_sphere(test::sphere(3));  // vertex normals ≈ radial
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(0.3, -0.5, 0.1), Eigen::Vector3d(-1, -1, -1)})
+    EXPECT_GT(on_sphere.normal_near(p).dot(p.normalized()), 0.99) << p.transpose();
+  const SurfaceQuery on_square(square(4, some_rotation()));  // flat: every normal is the plane's
+  const Eigen::Vector3d plane_normal = some_rotation() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d n = on_square.normal_near(some_rotation() * Eigen::Vector3d(0.3, 0.6, 0.5));
+  EXPECT_NEAR(std::abs(n.dot(plane_normal)), 1.0, 1e-12);
+  EXPECT_NEAR(n.norm(), 1.0, 1e-12);
+}
+
+TEST(SurfaceQuery, LineInATrianglesPlaneTakesTheOverlapsEnds) {
+  const SurfaceQuery lines(square(4));
   const auto hit = lines.crossing_near(Eigen::Vector3d(-1, 0.5, 0), Eigen::Vector3d(1, 0, 0),
                                        Eigen::Vector3d(-0.1, 0.5, 0), 0.5);
   ASSERT_TRUE(hit.has_value());
   EXPECT_NEAR(hit->x(), 0.0, 1e-12);  // the square's edge x = 0 is the nearest point of the overlap
-  EXPECT_THROW(SurfaceLines(TriMesh{}), InvalidInput);
+  EXPECT_THROW(SurfaceQuery(TriMesh{}), InvalidInput);
 }
 
 }  // namespace

@@ -1,0 +1,215 @@
+// The web viewer (web/index.html?pack=URL): streams a .gip by HTTP Range requests — the 20-byte header, the
+// manifest, then the chunks coarse → fine in ranges that double in size — into the WASM decoder
+// (geomip.js), and redraws with the WebGL2 renderer (renderer.js) each time more complete chunks have
+// arrived: the model refines in place. Errors (a bad URL, an HTTP error, a file that is not a pack, a stream
+// cut short, a corrupt chunk) are one line on the page; the last good level stays on screen.
+//
+// URL parameters: pack=URL (required); morph=T (0..1, fixed morph time between model `from` and model `to`;
+// default: a slider, at 0), from=I, to=J (models, default 0 and 1); schedule=linear|wavelet (wavelet: 4
+// bands); stop=N or stop=P% (stop fetching after N bytes / P % of the file: a prefix, on purpose);
+// first=N (bytes of the first chunk range, default 16384).
+// For tests and scripts, window.geomipViewer holds the state: { phase: 'loading'|'done'|'error', bytes,
+// fileSize, level, models, message, draws }.
+import { createDecoder, GeomipError } from './geomip.js';
+import { Renderer } from './renderer.js';
+
+const params = new URLSearchParams(location.search);
+const canvas = document.getElementById('view');
+const statusLine = document.getElementById('status');
+const errorLine = document.getElementById('error');
+const slider = document.getElementById('morph');
+
+const state = window.geomipViewer = {
+  phase: 'loading', bytes: 0, fileSize: 0, level: -1, models: 0, message: '', draws: 0, decodes: 0,
+};
+const camera = { yaw: 0.6, pitch: 0.35, distance: 3.2, fovYDeg: 35 };
+const view = {
+  source: Number(params.get('from') ?? 0), target: Number(params.get('to') ?? 1),
+  t: Number(params.get('morph') ?? 0), schedule: params.get('schedule') === 'wavelet' ? 'wavelet' : 'linear',
+};
+const bands = view.schedule === 'wavelet' ? 4 : 1;
+slider.value = String(view.t);
+
+let renderer = null;
+const gl = canvas.getContext('webgl2', { antialias: true, preserveDrawingBuffer: true });
+if (!gl) fail('this browser has no WebGL2');
+else renderer = new Renderer(gl);
+
+function fail(message) {
+  state.phase = 'error';
+  state.message = message;
+  errorLine.textContent = message;
+  redraw();
+}
+
+function showStatus(name) {
+  const pct = state.fileSize ? ` (${(100 * state.bytes / state.fileSize).toFixed(1)} %)` : '';
+  const total = state.fileSize ? ` of ${state.fileSize.toLocaleString('en')}` : '';
+  const level = state.level >= 0 ? `, level ${state.level}` : '';
+  statusLine.textContent = `${name}${state.bytes.toLocaleString('en')}${total} bytes${pct}${level}`;
+}
+
+let frameQueued = false;
+function redraw() {
+  if (!renderer || frameQueued) return;
+  frameQueued = true;
+  requestAnimationFrame(() => {
+    frameQueued = false;
+    const dpr = window.devicePixelRatio || 1;
+    const width = Math.round(canvas.clientWidth * dpr), height = Math.round(canvas.clientHeight * dpr);
+    if (canvas.width !== width || canvas.height !== height) { canvas.width = width; canvas.height = height; }
+    renderer.draw({ ...view, camera, width, height });
+    ++state.draws;
+  });
+}
+
+// ---- orbit and zoom: mouse (drag, wheel) and touch (one finger drags, two pinch) --------------------------
+const pointers = new Map();
+canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); pointers.set(e.pointerId, e); });
+canvas.addEventListener('pointerup', (e) => pointers.delete(e.pointerId));
+canvas.addEventListener('pointercancel', (e) => pointers.delete(e.pointerId));
+canvas.addEventListener('pointermove', (e) => {
+  const last = pointers.get(e.pointerId);
+  if (!last) return;
+  if (pointers.size === 1) {
+    camera.yaw -= (e.clientX - last.clientX) * 0.01;
+    camera.pitch = Math.min(1.5, Math.max(-1.5, camera.pitch + (e.clientY - last.clientY) * 0.01));
+  } else if (pointers.size === 2) {
+    const other = [...pointers.values()].find((p) => p.pointerId !== e.pointerId);
+    const before = Math.hypot(last.clientX - other.clientX, last.clientY - other.clientY);
+    const after = Math.hypot(e.clientX - other.clientX, e.clientY - other.clientY);
+    if (before > 0 && after > 0) camera.distance = Math.min(20, Math.max(0.5, camera.distance * before / after));
+  }
+  pointers.set(e.pointerId, e);
+  redraw();
+});
+canvas.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  camera.distance = Math.min(20, Math.max(0.5, camera.distance * Math.exp(e.deltaY * 0.001)));
+  redraw();
+}, { passive: false });
+window.addEventListener('resize', redraw);
+slider.addEventListener('input', () => { view.t = Number(slider.value); redraw(); });
+
+// ---- streaming -----------------------------------------------------------------------------------------
+class StreamError extends Error {}
+
+/// GET `url` bytes [begin, end) (end = null: to the end), pushing the body into the decoder as it arrives.
+/// A server that ignores Range (200) sends the whole file: the bytes before `begin` are skipped and the
+/// rest is read to the end (one request in all). Returns true when the body was the whole rest of the file.
+async function fetchRange(url, decoder, begin, end, onBytes) {
+  let response;
+  try {
+    response = await fetch(url, { headers: { Range: `bytes=${begin}-${end === null ? '' : end - 1}` } });
+  } catch (e) {
+    throw new StreamError(`cannot fetch ${url}: ${e.message} (a bad URL, the server down, or no CORS headers)`);
+  }
+  if (response.status !== 206 && response.status !== 200)
+    throw new StreamError(`cannot fetch ${url}: HTTP ${response.status} ${response.statusText}`.trim());
+  const whole = response.status === 200;
+  let skip = whole ? begin : 0;
+  const reader = response.body.getReader();
+  for (;;) {
+    let chunk;
+    try {
+      chunk = await reader.read();
+    } catch (e) {
+      throw new StreamError(`the stream of ${url} broke off at ${decoder.size.toLocaleString('en')} bytes (${e.message})`);
+    }
+    if (chunk.done) break;
+    let bytes = chunk.value;
+    if (skip > 0) { const n = Math.min(skip, bytes.length); bytes = bytes.subarray(n); skip -= n; }
+    if (!whole && end !== null && decoder.size + bytes.length > end) bytes = bytes.subarray(0, end - decoder.size);
+    if (bytes.length > 0) { decoder.push(bytes); onBytes(); }
+    if (stopAt !== null && decoder.size >= stopAt) { reader.cancel(); break; }
+  }
+  return whole;
+}
+
+let stopAt = null;
+let lastDecodedChunks = -1;
+let lastDecodeTime = 0;
+
+/// Decodes and uploads when more complete chunks have arrived than at the last decode (at most every
+/// 100 ms unless `force`).
+function refine(decoder, layout, force) {
+  if (!layout) return;
+  let complete = 0;
+  while (complete < layout.chunks.length &&
+         layout.chunks[complete].offset + layout.chunks[complete].size <= decoder.size) ++complete;
+  if (complete === lastDecodedChunks) return;
+  const now = performance.now();
+  if (!force && now - lastDecodeTime < 100) return;
+  const scene = decoder.scene({ bands });
+  lastDecodeTime = performance.now();
+  lastDecodedChunks = complete;
+  ++state.decodes;
+  if (scene.models.length === 0) return;
+  renderer?.setModels(scene.models);
+  state.models = scene.models.length;
+  state.level = scene.models[0].detailLevel;
+  state.names = scene.models.map((m) => m.name);
+  if (scene.models.length > 1) slider.hidden = false;
+  redraw();
+  if (scene.status === 'corrupt')
+    throw new StreamError(`a chunk of the pack is corrupt (CRC) after ${scene.bytesUsed.toLocaleString('en')} bytes`);
+}
+
+async function stream(url) {
+  const decoder = await createDecoder();
+  const name = `${url.split('/').pop()}: `;
+  let layout = null;
+  const onBytes = () => {
+    state.bytes = decoder.size;
+    showStatus(name);
+    refine(decoder, layout, false);
+  };
+  try {
+    // header, then manifest (a server without Range sends everything at the first request)
+    let whole = await fetchRange(url, decoder, 0, 20, onBytes);
+    if (!whole && decoder.size >= 20) {
+      let needed;
+      try { needed = decoder.needed(); decoder.layout(); } catch (e) { if (!(e instanceof GeomipError)) throw e; }
+      if (needed > decoder.size) whole = await fetchRange(url, decoder, decoder.size, needed, onBytes);
+    }
+    try {
+      layout = decoder.layout();
+    } catch (e) {
+      if (!(e instanceof GeomipError)) throw e;
+      throw new StreamError(`${url} is not a geomip pack (${e.message.replace(/^geomip: /, '')})`);
+    }
+    if (!layout)
+      throw new StreamError(`${url} ended after ${decoder.size} bytes, inside the pack's header or manifest`);
+    state.fileSize = layout.fileSize;
+    const stop = params.get('stop');
+    if (stop) stopAt = stop.endsWith('%') ? Math.floor(layout.fileSize * parseFloat(stop) / 100) : Number(stop);
+    const limit = Math.min(layout.fileSize, stopAt ?? Infinity);
+    let span = Number(params.get('first') ?? 16384);
+    while (!whole && decoder.size < limit) {
+      const begin = decoder.size, end = Math.min(limit, begin + span);
+      whole = await fetchRange(url, decoder, begin, end, onBytes);
+      if (!whole && decoder.size < end)
+        throw new StreamError(`the stream of ${url} ended at ${decoder.size.toLocaleString('en')} of ` +
+                              `${layout.fileSize.toLocaleString('en')} bytes`);
+      span *= 2;
+    }
+    state.bytes = decoder.size;
+    if (decoder.size < layout.fileSize && stopAt === null)
+      throw new StreamError(`the stream of ${url} ended at ${decoder.size.toLocaleString('en')} of ` +
+                            `${layout.fileSize.toLocaleString('en')} bytes`);
+    refine(decoder, layout, true);
+    showStatus(name);
+    state.phase = 'done';
+    redraw();
+  } catch (e) {
+    state.bytes = decoder.size;
+    try { refine(decoder, layout, true); } catch (_) { /* the error below is the one to show */ }
+    showStatus(name);
+    if (e instanceof StreamError) fail(`${e.message}; showing ${state.level >= 0 ? `level ${state.level}` : 'nothing'}`);
+    else fail(`error: ${e.message}`);
+  }
+}
+
+const pack = params.get('pack');
+if (!pack) fail('no pack given: open index.html?pack=URL');
+else if (renderer) stream(new URL(pack, location.href).href);

@@ -7,9 +7,9 @@
 // URL parameters: pack=URL (required); morph=T (0..1, fixed morph time between model `from` and model `to`;
 // default: a slider, at 0), from=I, to=J (models, default 0 and 1); schedule=linear|wavelet (wavelet: 4
 // bands); stop=N or stop=P% (stop fetching after N bytes / P % of the file: a prefix, on purpose);
-// first=N (bytes of the first chunk range, default 16384).
+// first=N (bytes of the first chunk range, default 16384); hud=0 hides the text (for screenshots).
 // For tests and scripts, window.geomipViewer holds the state: { phase: 'loading'|'done'|'error', bytes,
-// fileSize, level, models, message, draws }.
+// fileSize, level, levels (each refinement: bytes, level), models, message, draws, requests }.
 import { createDecoder, GeomipError } from './geomip.js';
 import { Renderer } from './renderer.js';
 
@@ -20,8 +20,10 @@ const errorLine = document.getElementById('error');
 const slider = document.getElementById('morph');
 
 const state = window.geomipViewer = {
-  phase: 'loading', bytes: 0, fileSize: 0, level: -1, models: 0, message: '', draws: 0, decodes: 0,
+  phase: 'loading', bytes: 0, fileSize: 0, level: -1, levels: [], models: 0, message: '', draws: 0, decodes: 0,
+  requests: [],
 };
+if (params.get('hud') === '0') document.getElementById('hud').hidden = true;
 const camera = { yaw: 0.6, pitch: 0.35, distance: 3.2, fovYDeg: 35 };
 const view = {
   source: Number(params.get('from') ?? 0), target: Number(params.get('to') ?? 1),
@@ -107,6 +109,7 @@ async function fetchRange(url, decoder, begin, end, onBytes) {
   if (response.status !== 206 && response.status !== 200)
     throw new StreamError(`cannot fetch ${url}: HTTP ${response.status} ${response.statusText}`.trim());
   const whole = response.status === 200;
+  state.requests.push({ begin, end, status: response.status });
   let skip = whole ? begin : 0;
   const reader = response.body.getReader();
   for (;;) {
@@ -148,6 +151,7 @@ function refine(decoder, layout, force) {
   renderer?.setModels(scene.models);
   state.models = scene.models.length;
   state.level = scene.models[0].detailLevel;
+  state.levels.push({ bytes: decoder.size, level: state.level });
   state.names = scene.models.map((m) => m.name);
   if (scene.models.length > 1) slider.hidden = false;
   redraw();

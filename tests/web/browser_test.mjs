@@ -8,6 +8,7 @@
 //    pixels outside it, dilated by 2 px);
 //  - through nginx, cross-origin: every request was a Range request answered 206;
 //  - a morph at t = 0.5 differs from both ends (and the ends from each other);
+//  - the three.js example page (web/three/example.html) draws the loaded model;
 //  - a 404, an unreachable server, a file that is not a pack, a server killed mid-stream: phase 'error' with
 //    one line, and (killed mid-stream) the last good level still drawn.
 //   node browser_test.mjs NGINX_CONF OUT_DIR
@@ -15,6 +16,7 @@
 import { spawn, spawnSync } from 'node:child_process';
 import { mkdirSync, mkdtempSync, readFileSync, writeFileSync, rmSync } from 'node:fs';
 import net from 'node:net';
+import zlib from 'node:zlib';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -123,6 +125,38 @@ function differing(a, b) {
   for (let i = 0; i < a.px.length; i += 4)
     if (Math.abs(a.px[i] - b.px[i]) + Math.abs(a.px[i + 1] - b.px[i + 1]) + Math.abs(a.px[i + 2] - b.px[i + 2]) > 24) ++n;
   return n / (a.w * a.h);
+}
+
+/// A PNG (8-bit RGB or RGBA, not interlaced: what Chromium's screenshots are) as RGBA, top row first.
+function decodePng(png) {
+  let at = 8, w = 0, h = 0, channels = 0;
+  const idat = [];
+  while (at < png.length) {
+    const len = png.readUInt32BE(at), type = png.toString('latin1', at + 4, at + 8);
+    const data = png.subarray(at + 8, at + 8 + len);
+    if (type === 'IHDR') {
+      w = data.readUInt32BE(0); h = data.readUInt32BE(4);
+      if (data[8] !== 8 || data[12] !== 0 || ![2, 6].includes(data[9])) throw new Error('PNG: not 8-bit RGB(A)');
+      channels = data[9] === 6 ? 4 : 3;
+    } else if (type === 'IDAT') idat.push(data);
+    at += 12 + len;
+  }
+  const raw = zlib.inflateSync(Buffer.concat(idat));
+  const stride = w * channels, cur = new Uint8Array(stride), px = new Uint8Array(w * h * 4);
+  let prev = new Uint8Array(stride);
+  for (let y = 0; y < h; ++y) {
+    const f = raw[y * (stride + 1)], line = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
+    for (let i = 0; i < stride; ++i) {
+      const a = i >= channels ? cur[i - channels] : 0, b = prev[i], c = i >= channels ? prev[i - channels] : 0;
+      const pred = f === 1 ? a : f === 2 ? b : f === 3 ? (a + b) >> 1 :
+        f === 4 ? (Math.abs(b - c) <= Math.abs(a - c) && Math.abs(b - c) <= Math.abs(a + b - 2 * c) ? (Math.abs(a + b - 2 * c) < Math.abs(b - c) ? c : b) : a) : 0;
+      cur[i] = (line[i] + pred) & 255;
+    }
+    for (let x = 0; x < w; ++x)
+      for (let c = 0; c < 3; ++c) px[(y * w + x) * 4 + c] = cur[x * channels + c];
+    prev = Uint8Array.from(cur);
+  }
+  return { w, h, px };
 }
 
 /// The decoded mesh's projected silhouette: every grid triangle of model 0 (hole-masked quads left out),
@@ -279,7 +313,21 @@ try {
     check(d0 >= 0.005 && d1 >= 0.005 && ends >= 0.005,
           `t = 0.5 differs from t = 0 in ${(100 * d0).toFixed(2)} %, from t = 1 in ${(100 * d1).toFixed(2)} % of the pixels (ends: ${(100 * ends).toFixed(2)} %)`);
   }
-  // 5. errors: one line, the last good level kept
+  // 5. the three.js example (web/three/example.html, three from node_modules through nginx): a model drawn
+  {
+    const page = await browser.newPage();
+    await page.setViewport({ width: W, height: H, deviceScaleFactor: 1 });
+    page.on('pageerror', (e) => console.log(`page error: ${e.message}`));
+    await page.goto(`http://127.0.0.1:${nginx}/web/three/example.html?pack=${encodeURIComponent(`/${bunny}`)}`);
+    await page.waitForFunction(() => /8,923 of 8,923 bytes/.test(document.getElementById('info').textContent),
+                               { timeout: 60000, polling: 50 });
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    const shot = decodePng(Buffer.from(await page.screenshot({ path: path.join(outDir, 'three-example.png') })));
+    const drawn = count(drawnMask(shot)) / (shot.w * shot.h);
+    check(drawn >= 0.03, `three.js example: the loaded model covers ${(100 * drawn).toFixed(1)} % of the view`);
+    await page.close();
+  }
+  // 6. errors: one line, the last good level kept
   const errorCases = [
     ['a 404', `/tests/data/no-such-pack.gip`, /HTTP 404/, false],
     ['an unreachable server', `http://127.0.0.1:${await freePort()}/x.gip`, /cannot fetch/, false],

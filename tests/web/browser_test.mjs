@@ -7,7 +7,8 @@
 //    the same pack with the page's camera: ≥ 97 % of the silhouette's pixels drawn, ≤ 2 % of the drawn
 //    pixels outside it, dilated by 2 px);
 //  - through nginx, cross-origin: every request was a Range request answered 206;
-//  - a morph at t = 0.5 differs from both ends (and the ends from each other);
+//  - a morph at t = 0.5 differs from both ends (and the ends from each other); the wavelet schedule's
+//    midpoint differs from the linear one, its t = 0 does not;
 //  - the three.js example page (web/three/example.html) draws the loaded model;
 //  - a 404, an unreachable server, a file that is not a pack, a server killed mid-stream: phase 'error' with
 //    one line, and (killed mid-stream) the last good level still drawn.
@@ -312,6 +313,19 @@ try {
     const d0 = differing(images[1], images[0]), d1 = differing(images[1], images[2]), ends = differing(images[0], images[2]);
     check(d0 >= 0.005 && d1 >= 0.005 && ends >= 0.005,
           `t = 0.5 differs from t = 0 in ${(100 * d0).toFixed(2)} %, from t = 1 in ${(100 * d1).toFixed(2)} % of the pixels (ends: ${(100 * ends).toFixed(2)} %)`);
+    // the wavelet schedule (4 bands): its midpoint is not the linear one; its ends are the models themselves
+    const wavelet = [];
+    for (const t of [0, 0.5]) {
+      const page = await open(pageUrl(`/${horsePig}`, `&morph=${t}&schedule=wavelet`));
+      const s = await stateOf(page);
+      check(s.phase === 'done' && s.models === 2, `horse–pig, wavelet schedule, t = ${t}: phase ${s.phase}`);
+      wavelet.push(await canvasPixels(page));
+      await page.screenshot({ path: path.join(outDir, `morph-wavelet-${t}.png`) });
+      await page.close();
+    }
+    const w0 = differing(wavelet[0], images[0]), wl = differing(wavelet[1], images[1]);
+    check(w0 <= 0.002 && wl >= 0.002,
+          `wavelet schedule: t = 0 as linear t = 0 (${(100 * w0).toFixed(2)} % differ), t = 0.5 differs from linear t = 0.5 in ${(100 * wl).toFixed(2)} %`);
   }
   // 5. the three.js example (web/three/example.html, three from node_modules through nginx): a model drawn
   {

@@ -59,7 +59,9 @@ async function startNginx() {
     const conf = readFileSync(nginxConf, 'utf8').replaceAll('@PREFIX@', prefix).replaceAll('@PORT@', String(port))
         .replaceAll('@ROOT@', root);
     writeFileSync(path.join(prefix, 'nginx.conf'), conf);
-    const child = spawn('nginx', ['-p', prefix, '-c', path.join(prefix, 'nginx.conf'), '-g', 'daemon off;'],
+    // as root (CI), nginx's workers would switch to `nobody`, who may not read the checkout: stay root
+    const globals = `daemon off;${process.getuid?.() === 0 ? ' user root;' : ''}`;
+    const child = spawn('nginx', ['-p', prefix, '-c', path.join(prefix, 'nginx.conf'), '-g', globals],
                         { stdio: ['ignore', 'ignore', 'pipe'] });
     children.push(child);
     let stderr = '';
@@ -244,7 +246,8 @@ try {
   const killed = await startRangeServer('--die-after', String(Math.floor(bunnyBytes * 0.4)));
   browser = await puppeteer.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium', headless: true,
-    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', `--window-size=${W},${H}`],
+    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-dev-shm-usage',
+           `--window-size=${W},${H}`],
   });
   const pageUrl = (pack, extra = '') => `http://127.0.0.1:${nginx}/web/index.html?hud=0&pack=${encodeURIComponent(pack)}${extra}`;
   const area = W * H;

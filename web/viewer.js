@@ -1,15 +1,17 @@
 // The web viewer (web/index.html?pack=URL): streams a .gip by HTTP Range requests — the 20-byte header, the
 // manifest, then the chunks coarse → fine in ranges that double in size — into the WASM decoder
-// (geomip.js), and redraws with the WebGL2 renderer (renderer.js) each time more complete chunks have
-// arrived: the model refines in place. Errors (a bad URL, an HTTP error, a file that is not a pack, a stream
-// cut short, a corrupt chunk) are one line on the page; the last good level stays on screen.
+// (geomip.js; decoding on a worker, decode-worker.js), and redraws with the WebGL2 renderer (renderer.js)
+// each time more complete chunks have arrived: the model refines in place. Errors (a bad URL, an HTTP
+// error, a file that is not a pack, a stream cut short, a corrupt chunk) are one line on the page; the last
+// good level stays on screen.
 //
 // URL parameters: pack=URL (required); morph=T (0..1, fixed morph time between model `from` and model `to`;
 // default: a slider, at 0), from=I, to=J (models, default 0 and 1); schedule=linear|wavelet (wavelet: 4
 // bands); stop=N or stop=P% (stop fetching after N bytes / P % of the file: a prefix, on purpose);
 // first=N (bytes of the first chunk range, default 16384); hud=0 hides the text (for screenshots).
 // For tests and scripts, window.geomipViewer holds the state: { phase: 'loading'|'done'|'error', bytes,
-// fileSize, level, levels (each refinement: bytes, level), models, message, draws, requests }.
+// fileSize, level, levels (each refinement: bytes, level), models, message, draws, decodes, decodeMs (time
+// spent decoding), requests }.
 import { createDecoder, GeomipError } from './geomip.js';
 import { Renderer } from './renderer.js';
 
@@ -21,7 +23,7 @@ const slider = document.getElementById('morph');
 
 const state = window.geomipViewer = {
   phase: 'loading', bytes: 0, fileSize: 0, level: -1, levels: [], models: 0, message: '', draws: 0, decodes: 0,
-  requests: [],
+  decodeMs: 0, requests: [],
 };
 if (params.get('hud') === '0') document.getElementById('hud').hidden = true;
 const camera = { yaw: 0.6, pitch: 0.35, distance: 3.2, fovYDeg: 35 };
@@ -97,7 +99,7 @@ slider.addEventListener('input', () => { view.t = Number(slider.value); redraw()
 class StreamError extends Error {}
 
 /// GET `url` bytes [begin, end) (end = null: to the end), pushing the body into the decoder as it arrives.
-/// A server that ignores Range (200) sends the whole file: the bytes before `begin` are skipped and the
+/// `onBytes(bytes)` after each piece. A server that ignores Range (200) sends the whole file: the bytes before `begin` are skipped and the
 /// rest is read to the end (one request in all). Returns true when the body was the whole rest of the file.
 async function fetchRange(url, decoder, begin, end, onBytes) {
   let response;
@@ -123,50 +125,100 @@ async function fetchRange(url, decoder, begin, end, onBytes) {
     let bytes = chunk.value;
     if (skip > 0) { const n = Math.min(skip, bytes.length); bytes = bytes.subarray(n); skip -= n; }
     if (!whole && end !== null && decoder.size + bytes.length > end) bytes = bytes.subarray(0, end - decoder.size);
-    if (bytes.length > 0) { decoder.push(bytes); onBytes(); }
+    if (bytes.length > 0) { decoder.push(bytes); onBytes(bytes); }
     if (stopAt !== null && decoder.size >= stopAt) { reader.cancel(); break; }
   }
   return whole;
 }
 
 let stopAt = null;
-let lastDecodedChunks = -1;
-let lastDecodeTime = 0;
 
-/// Decodes and uploads when more complete chunks have arrived than at the last decode (at most every
-/// 100 ms unless `force`).
-function refine(decoder, layout, force) {
+/// Scene decodes off the main thread (decode-worker.js) when module workers are available, else on it.
+class SceneSource {
+  constructor(decoder) {
+    this.decoder = decoder;
+    this.pending = [];
+    try {
+      this.worker = new Worker(new URL('./decode-worker.js', import.meta.url), { type: 'module' });
+      this.worker.onmessage = ({ data }) => this.pending.shift()?.(data);
+      this.worker.onerror = () => {  // the worker could not start: decode here from now on
+        this.worker = null;
+        for (const resolve of this.pending.splice(0)) resolve(this.decodeHere());
+      };
+    } catch (_) {
+      this.worker = null;
+    }
+  }
+  push(bytes) { if (this.worker) this.worker.postMessage({ type: 'push', bytes: bytes.slice() }); }
+  decodeHere() {
+    const t0 = performance.now();
+    const scene = this.decoder.scene({ bands });
+    return { type: 'scene', scene, size: this.decoder.size, ms: performance.now() - t0 };
+  }
+  scene() {
+    if (!this.worker) return Promise.resolve(this.decodeHere());
+    return new Promise((resolve) => {
+      this.pending.push(resolve);
+      this.worker.postMessage({ type: 'scene', bands });
+    });
+  }
+}
+
+let requestedChunks = -1;
+let inFlight = null;
+let again = false;
+let corrupt = null;
+
+/// Starts a decode when more complete chunks have arrived than at the last one; one decode at a time (chunks
+/// that arrive meanwhile are decoded next). The result replaces the models on screen.
+function refine(source, layout) {
   if (!layout) return;
   let complete = 0;
   while (complete < layout.chunks.length &&
-         layout.chunks[complete].offset + layout.chunks[complete].size <= decoder.size) ++complete;
-  if (complete === lastDecodedChunks) return;
-  const now = performance.now();
-  if (!force && now - lastDecodeTime < 100) return;
-  const scene = decoder.scene({ bands });
-  lastDecodeTime = performance.now();
-  lastDecodedChunks = complete;
-  ++state.decodes;
-  if (scene.models.length === 0) return;
-  renderer?.setModels(scene.models);
-  state.models = scene.models.length;
-  state.level = scene.models[0].detailLevel;
-  state.levels.push({ bytes: decoder.size, level: state.level });
-  state.names = scene.models.map((m) => m.name);
-  if (scene.models.length > 1) slider.hidden = false;
-  redraw();
-  if (scene.status === 'corrupt')
-    throw new StreamError(`a chunk of the pack is corrupt (CRC) after ${scene.bytesUsed.toLocaleString('en')} bytes`);
+         layout.chunks[complete].offset + layout.chunks[complete].size <= source.decoder.size) ++complete;
+  if (complete === requestedChunks) return;
+  if (inFlight) { again = true; return; }
+  requestedChunks = complete;
+  inFlight = source.scene().then((result) => {
+    if (result.type === 'error') throw new Error(result.message);
+    const { scene, size, ms } = result;
+    state.decodeMs += ms;
+    ++state.decodes;
+    if (scene.models.length === 0) return;
+    renderer?.setModels(scene.models);
+    state.models = scene.models.length;
+    state.level = scene.models[0].detailLevel;
+    state.levels.push({ bytes: size, level: state.level });
+    state.names = scene.models.map((m) => m.name);
+    if (scene.models.length > 1) slider.hidden = false;
+    redraw();
+    if (scene.status === 'corrupt' && !corrupt)
+      corrupt = new StreamError(`a chunk of the pack is corrupt (CRC) after ${scene.bytesUsed.toLocaleString('en')} bytes`);
+  }).finally(() => {
+    inFlight = null;
+    if (again) { again = false; refine(source, layout); }
+  });
+}
+
+/// Waits until every byte received so far has been decoded and shown.
+async function settle(source, layout) {
+  refine(source, layout);
+  while (inFlight) {
+    await inFlight;
+    refine(source, layout);
+  }
 }
 
 async function stream(url) {
   const decoder = await createDecoder();
+  const source = new SceneSource(decoder);
   const name = `${url.split('/').pop()}: `;
   let layout = null;
-  const onBytes = () => {
+  const onBytes = (bytes) => {
+    source.push(bytes);
     state.bytes = decoder.size;
     showStatus(name);
-    refine(decoder, layout, false);
+    refine(source, layout);
   };
   try {
     // header, then manifest (a server without Range sends everything at the first request)
@@ -201,13 +253,14 @@ async function stream(url) {
     if (decoder.size < layout.fileSize && stopAt === null)
       throw new StreamError(`the stream of ${url} ended at ${decoder.size.toLocaleString('en')} of ` +
                             `${layout.fileSize.toLocaleString('en')} bytes`);
-    refine(decoder, layout, true);
+    await settle(source, layout);
+    if (corrupt) throw corrupt;
     showStatus(name);
     state.phase = 'done';
     redraw();
   } catch (e) {
     state.bytes = decoder.size;
-    try { refine(decoder, layout, true); } catch (_) { /* the error below is the one to show */ }
+    try { await settle(source, layout); } catch (_) { /* the error below is the one to show */ }
     showStatus(name);
     if (e instanceof StreamError) fail(`${e.message}; showing ${state.level >= 0 ? `level ${state.level}` : 'nothing'}`);
     else fail(`error: ${e.message}`);

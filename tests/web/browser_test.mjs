@@ -10,8 +10,8 @@
 //  - a morph at t = 0.5 differs from both ends (and the ends from each other); the wavelet schedule's
 //    midpoint differs from the linear one, its t = 0 does not;
 //  - the three.js example page (web/three/example.html) draws the loaded model;
-//  - a 404, an unreachable server, a file that is not a pack, a server killed mid-stream: phase 'error' with
-//    one line, and (killed mid-stream) the last good level still drawn.
+//  - a 404, an unreachable server, a file that is not a pack, a server killed mid-stream, a corrupt chunk:
+//    phase 'error' with one line, and (the last two) the last good level still drawn.
 //   node browser_test.mjs NGINX_CONF OUT_DIR
 // Screenshots go to OUT_DIR for people. Needs chromium, nginx, python3 and npm's puppeteer-core.
 import { spawn, spawnSync } from 'node:child_process';
@@ -81,9 +81,10 @@ async function startNginx() {
   throw new Error('nginx did not start');
 }
 
-function startRangeServer(...args) {
+function startRangeServer(...args) {  // serves the repository; '--root DIR' first serves DIR instead
+  const rootArgs = args[0] === '--root' ? args.splice(0, 2) : ['--root', root];
   return new Promise((resolve, reject) => {
-    const child = spawn('python3', [path.join(here, 'cors_range_server.py'), '--root', root, ...args],
+    const child = spawn('python3', [path.join(here, 'cors_range_server.py'), ...rootArgs, ...args],
                         { stdio: ['ignore', 'pipe', 'inherit'] });
     children.push(child);
     let out = '';
@@ -244,6 +245,12 @@ try {
   const stalled = await startRangeServer('--rate', '20000', '--stall-after', String(fivePercent), '--stall-seconds', '60');
   const throttled = await startRangeServer('--rate', '3000');
   const killed = await startRangeServer('--die-after', String(Math.floor(bunnyBytes * 0.4)));
+  // a copy of the bunny pack with one byte flipped at 60 % of the file (inside a chunk: its CRC fails)
+  const damaged = Buffer.from(readFileSync(path.join(root, bunny)));
+  damaged[Math.floor(bunnyBytes * 0.6)] ^= 0x5a;
+  mkdirSync(path.join(tmp, 'damaged'));
+  writeFileSync(path.join(tmp, 'damaged', 'bunny.gip'), damaged);
+  const damagedServer = await startRangeServer('--root', path.join(tmp, 'damaged'));
   browser = await puppeteer.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium', headless: true,
     args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-dev-shm-usage',
@@ -350,6 +357,7 @@ try {
     ['an unreachable server', `http://127.0.0.1:${await freePort()}/x.gip`, /cannot fetch/, false],
     ['a file that is not a pack', `/web/index.html`, /not a geomip pack/, false],
     ['a server killed mid-stream', `http://127.0.0.1:${killed}/${bunny}`, /ended at|broke off/, true],
+    ['a corrupt chunk', `http://127.0.0.1:${damagedServer}/bunny.gip`, /corrupt \(CRC\)/, true],
   ];
   for (const [what, pack, pattern, keeps] of errorCases) {
     // small ranges, so that complete responses arrive before the server dies (a browser may drop the

@@ -52,8 +52,12 @@ bool in_range(const std::vector<T>& v, int i) {
 
 extern "C" {
 
-EMSCRIPTEN_KEEPALIVE Decoder* gip_create() { return new Decoder(); }
-EMSCRIPTEN_KEEPALIVE void gip_destroy(Decoder* d) { delete d; }
+EMSCRIPTEN_KEEPALIVE Decoder* gip_create() {
+  return new Decoder();
+}
+EMSCRIPTEN_KEEPALIVE void gip_destroy(Decoder* d) {
+  delete d;
+}
 
 /// Room for n more bytes at the end of the received bytes; write them there, then gip_commit(n). Null when
 /// n would take the total past 2 GiB (a pack's chunk sizes are 31-bit, but no browser stream needs more).
@@ -68,7 +72,9 @@ EMSCRIPTEN_KEEPALIVE void gip_commit(Decoder* d, std::uint32_t reserved, std::ui
   if (d == nullptr || n > reserved || reserved > d->bytes.size()) return;
   d->bytes.resize(d->bytes.size() - reserved + n);
 }
-EMSCRIPTEN_KEEPALIVE double gip_size(const Decoder* d) { return d ? static_cast<double>(d->bytes.size()) : 0; }
+EMSCRIPTEN_KEEPALIVE double gip_size(const Decoder* d) {
+  return d ? static_cast<double>(d->bytes.size()) : 0;
+}
 
 EMSCRIPTEN_KEEPALIVE const char* gip_status_message(int status) {
   if (status < 0 || status >= geomip::codec::kStatusCount) return "unknown status";
@@ -109,12 +115,18 @@ EMSCRIPTEN_KEEPALIVE double gip_chunk(const Decoder* d, int c, int f) {
   if (d == nullptr || d->info_status != Status::kOk || !in_range(d->info.chunks, c)) return -1;
   const auto& chunk = d->info.chunks[static_cast<std::size_t>(c)];
   switch (f) {
-    case 0: return chunk.model;
-    case 1: return static_cast<double>(chunk.kind);
-    case 2: return chunk.pass;
-    case 3: return static_cast<double>(chunk.offset);
-    case 4: return chunk.size;
-    default: return -1;
+    case 0:
+      return chunk.model;
+    case 1:
+      return static_cast<double>(chunk.kind);
+    case 2:
+      return chunk.pass;
+    case 3:
+      return static_cast<double>(chunk.offset);
+    case 4:
+      return chunk.size;
+    default:
+      return -1;
   }
 }
 
@@ -152,13 +164,20 @@ EMSCRIPTEN_KEEPALIVE int gip_model_field(const Decoder* d, int m, int f) {
   const auto* model = model_at(d, m);
   if (model == nullptr) return -1;
   switch (f) {
-    case 0: return static_cast<int>(model->geometry.size());
-    case 1: return model->geometry.empty() ? -1 : model->geometry[0].level;
-    case 2: return model->normals.empty() ? -1 : model->normals[0].level;
-    case 3: return model->hole_mask.empty() ? -1 : model->hole_mask_level;
-    case 4: return model->detail_level;
-    case 5: return static_cast<int>(model->geometry_passes);
-    default: return -1;
+    case 0:
+      return static_cast<int>(model->geometry.size());
+    case 1:
+      return model->geometry.empty() ? -1 : model->geometry[0].level;
+    case 2:
+      return model->normals.empty() ? -1 : model->normals[0].level;
+    case 3:
+      return model->hole_mask.empty() ? -1 : model->hole_mask_level;
+    case 4:
+      return model->detail_level;
+    case 5:
+      return static_cast<int>(model->geometry_passes);
+    default:
+      return -1;
   }
 }
 /// Patch p's grid of model m: (2^level+1)² xyz floats, row-major (codec::Grid3). what: 0 geometry,
@@ -200,7 +219,9 @@ EMSCRIPTEN_KEEPALIVE int gip_decode_scene(Decoder* d, int bands, int align) {
 EMSCRIPTEN_KEEPALIVE double gip_scene_bytes_used(const Decoder* d) {
   return d ? static_cast<double>(d->scene_bytes_used) : 0;
 }
-EMSCRIPTEN_KEEPALIVE int gip_scene_count(const Decoder* d) { return d ? static_cast<int>(d->scene.size()) : 0; }
+EMSCRIPTEN_KEEPALIVE int gip_scene_count(const Decoder* d) {
+  return d ? static_cast<int>(d->scene.size()) : 0;
+}
 EMSCRIPTEN_KEEPALIVE const char* gip_scene_name(const Decoder* d, int m) {
   const auto* s = scene_at(d, m);
   return s ? s->name.c_str() : "";
@@ -211,16 +232,26 @@ EMSCRIPTEN_KEEPALIVE int gip_scene_field(const Decoder* d, int m, int f) {
   const auto* s = scene_at(d, m);
   if (s == nullptr) return -1;
   switch (f) {
-    case 0: return s->level;
-    case 1: return s->num_patches;
-    case 2: return s->bands;
-    case 3: return s->normals.empty() ? -1 : s->normal_level;
-    case 4: return s->holes.empty() ? -1 : s->hole_level;
-    case 5: return s->detail_level;
-    case 6: return static_cast<int>(s->positions.size());
-    case 7: return static_cast<int>(s->normals.size());
-    case 8: return static_cast<int>(s->holes.size());
-    default: return -1;
+    case 0:
+      return s->level;
+    case 1:
+      return s->num_patches;
+    case 2:
+      return s->bands;
+    case 3:
+      return s->normals.empty() ? -1 : s->normal_level;
+    case 4:
+      return s->holes.empty() ? -1 : s->hole_level;
+    case 5:
+      return s->detail_level;
+    case 6:
+      return static_cast<int>(s->positions.size());
+    case 7:
+      return static_cast<int>(s->normals.size());
+    case 8:
+      return static_cast<int>(s->holes.size());
+    default:
+      return -1;
   }
 }
 /// what: 0 positions, 1 normals (floats); 2 holes (bytes, as a float* cast: read it as Uint8).
@@ -228,10 +259,14 @@ EMSCRIPTEN_KEEPALIVE const void* gip_scene_data(const Decoder* d, int m, int wha
   const auto* s = scene_at(d, m);
   if (s == nullptr) return nullptr;
   switch (what) {
-    case 0: return s->positions.empty() ? nullptr : s->positions.data();
-    case 1: return s->normals.empty() ? nullptr : s->normals.data();
-    case 2: return s->holes.empty() ? nullptr : s->holes.data();
-    default: return nullptr;
+    case 0:
+      return s->positions.empty() ? nullptr : s->positions.data();
+    case 1:
+      return s->normals.empty() ? nullptr : s->normals.data();
+    case 2:
+      return s->holes.empty() ? nullptr : s->holes.data();
+    default:
+      return nullptr;
   }
 }
 

@@ -11,7 +11,7 @@
 // first=N (bytes of the first chunk range, default 16384); hud=0 hides the text (for screenshots).
 // For tests and scripts, window.geomipViewer holds the state: { phase: 'loading'|'done'|'error', bytes,
 // fileSize, level, levels (each refinement: bytes, level), models, message, draws, decodes, decodeMs (time
-// spent decoding), requests }.
+// spent decoding), requests, camera }.
 import { createDecoder, GeomipError } from './geomip.js';
 import { Renderer } from './renderer.js';
 
@@ -26,7 +26,7 @@ const state = window.geomipViewer = {
   decodeMs: 0, requests: [],
 };
 if (params.get('hud') === '0') document.getElementById('hud').hidden = true;
-const camera = { yaw: 0.6, pitch: 0.35, distance: 3.2, fovYDeg: 35 };
+const camera = state.camera = { yaw: 0.6, pitch: 0.35, distance: 3.2, fovYDeg: 35 };
 const view = {
   source: Number(params.get('from') ?? 0), target: Number(params.get('to') ?? 1),
   t: Number(params.get('morph') ?? 0), schedule: params.get('schedule') === 'wavelet' ? 'wavelet' : 'linear',

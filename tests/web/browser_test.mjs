@@ -9,6 +9,7 @@
 //  - through nginx, cross-origin: every request was a Range request answered 206;
 //  - a morph at t = 0.5 differs from both ends (and the ends from each other); the wavelet schedule's
 //    midpoint differs from the linear one, its t = 0 does not;
+//  - a mouse drag turns the model, the wheel and a two-finger pinch (touch events) zoom out and in;
 //  - the three.js example page (web/three/example.html) draws the loaded model;
 //  - a 404, an unreachable server, a file that is not a pack, a server killed mid-stream, a corrupt chunk:
 //    phase 'error' with one line, and (the last two) the last good level still drawn.
@@ -337,7 +338,39 @@ try {
     check(w0 <= 0.002 && wl >= 0.002,
           `wavelet schedule: t = 0 as linear t = 0 (${(100 * w0).toFixed(2)} % differ), t = 0.5 differs from linear t = 0.5 in ${(100 * wl).toFixed(2)} %`);
   }
-  // 5. the three.js example (web/three/example.html, three from node_modules through nginx): a model drawn
+  // 5. orbit and zoom: a mouse drag turns the model, the wheel zooms out, a two-finger pinch zooms in
+  {
+    const page = await open(pageUrl(`/${bunny}`));
+    const camera = () => page.evaluate(() => ({ ...window.geomipViewer.camera, draws: window.geomipViewer.draws }));
+    const frame = async (before) => {  // the next drawn frame's pixels
+      await page.waitForFunction((n) => window.geomipViewer.draws > n, { timeout: 10000, polling: 20 }, before.draws);
+      return canvasPixels(page);
+    };
+    const c0 = await camera(), img0 = await canvasPixels(page);
+    await page.mouse.move(W / 2, H / 2);
+    await page.mouse.down();
+    await page.mouse.move(W / 2 + 120, H / 2 + 30, { steps: 6 });
+    await page.mouse.up();
+    const img1 = await frame(c0), c1 = await camera();
+    check(Math.abs(c1.yaw - c0.yaw) > 0.5 && differing(img0, img1) >= 0.01,
+          `mouse drag: yaw ${c0.yaw.toFixed(2)} → ${c1.yaw.toFixed(2)}, ${(100 * differing(img0, img1)).toFixed(1)} % of the pixels changed`);
+    await page.mouse.wheel({ deltaY: 400 });
+    const img2 = await frame(c1), c2 = await camera();
+    const cover = (img) => count(drawnMask(img)) / area;
+    check(c2.distance > c1.distance && cover(img2) < cover(img1),
+          `wheel: distance ${c1.distance.toFixed(2)} → ${c2.distance.toFixed(2)}, coverage ${(100 * cover(img1)).toFixed(1)} → ${(100 * cover(img2)).toFixed(1)} %`);
+    const cdp = await page.createCDPSession();
+    const touch = (type, points) => cdp.send('Input.dispatchTouchEvent', {
+      type, touchPoints: points.map(([x, y], id) => ({ x, y, id, radiusX: 1, radiusY: 1, force: 1 })) });
+    await touch('touchStart', [[W / 2 - 40, H / 2], [W / 2 + 40, H / 2]]);
+    for (let k = 1; k <= 6; ++k) await touch('touchMove', [[W / 2 - 40 - 20 * k, H / 2], [W / 2 + 40 + 20 * k, H / 2]]);
+    await touch('touchEnd', []);
+    const img3 = await frame(c2), c3 = await camera();
+    check(c3.distance < c2.distance && cover(img3) > cover(img2),
+          `two-finger pinch: distance ${c2.distance.toFixed(2)} → ${c3.distance.toFixed(2)}, coverage ${(100 * cover(img2)).toFixed(1)} → ${(100 * cover(img3)).toFixed(1)} %`);
+    await page.close();
+  }
+  // 6. the three.js example (web/three/example.html, three from node_modules through nginx): a model drawn
   {
     const page = await browser.newPage();
     await page.setViewport({ width: W, height: H, deviceScaleFactor: 1 });
@@ -351,7 +384,7 @@ try {
     check(drawn >= 0.03, `three.js example: the loaded model covers ${(100 * drawn).toFixed(1)} % of the view`);
     await page.close();
   }
-  // 6. errors: one line, the last good level kept
+  // 7. errors: one line, the last good level kept
   const errorCases = [
     ['a 404', `/tests/data/no-such-pack.gip`, /HTTP 404/, false],
     ['an unreachable server', `http://127.0.0.1:${await freePort()}/x.gip`, /cannot fetch/, false],

@@ -1,6 +1,7 @@
 # The module graph, checked on the source's include lines (house style: data flows one way).
 #
 #   mesh/ ─► param/ ─► gimage/ ─► codec/ ─► morph/ ─► stream_viewer/
+#                                                     └► wasm/ (the WASM decoder's C API; web/ is JS)
 #                                   baselines/ (beside codec/)            tools/ wires them (not the viewer)
 #
 # Each module may include its own headers and those of the modules listed for it below, nothing else of
@@ -15,7 +16,7 @@ if(NOT GEOMIP_ROOT)
   endif()
 endif()
 
-set(_geomip_modules mesh param gimage codec baselines morph stream_viewer tools)
+set(_geomip_modules mesh param gimage codec baselines morph stream_viewer tools wasm)
 set(_geomip_allowed_mesh mesh)
 set(_geomip_allowed_param mesh param)
 set(_geomip_allowed_gimage mesh param gimage)
@@ -24,6 +25,7 @@ set(_geomip_allowed_baselines mesh codec baselines)
 set(_geomip_allowed_morph codec morph)
 set(_geomip_allowed_stream_viewer codec morph stream_viewer)
 set(_geomip_allowed_tools mesh param gimage codec baselines morph tools)
+set(_geomip_allowed_wasm codec morph wasm)
 
 set(_geomip_violations "")
 foreach(module IN LISTS _geomip_modules)

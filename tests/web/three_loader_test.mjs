@@ -1,0 +1,104 @@
+// web/three/GeomipLoader.js under node against the native decoder: a pack served by a throttled local HTTP
+// server (512-byte writes) loads into a three.js BufferGeometry that refines in place — at least 3
+// refinements, the first before all bytes are in — and at the first refinement and at the end its vertex
+// count and every position equal the native codec::decode_pack grids of the same byte prefix bit for bit
+// (pack_prefix_hashes --dump); the index holds two triangles per quad outside the hole mask, all in range.
+//   node three_loader_test.mjs NATIVE_TOOL PACK:MODEL...
+import { execFileSync } from 'node:child_process';
+import { readFileSync } from 'node:fs';
+import http from 'node:http';
+import { GeomipLoader } from '../../web/three/GeomipLoader.js';
+
+const [nativeTool, ...specs] = process.argv.slice(2);
+let failures = 0;
+const check = (ok, what) => { console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`); if (!ok) ++failures; };
+
+/// Model `m` of the native decode of the first `bytes` bytes: { patches, level, holeLevel, geometry
+/// (Uint32Array of the float bits, patch by patch), holes (per patch Uint8Array) }.
+function native(pack, bytes, m) {
+  const dump = execFileSync(nativeTool, [pack, '--dump', String(bytes)], { maxBuffer: 1 << 28 });
+  const w = new Uint32Array(dump.buffer, dump.byteOffset, dump.length / 4);
+  let at = 4;
+  for (let k = 0; k < w[3]; ++k) {
+    const [patches, level, normalLevel, holeLevel] = [w[at], w[at + 1] | 0, w[at + 2] | 0, w[at + 3] | 0];
+    at += 6;
+    const per = ((1 << level) + 1) ** 2 * 3, nper = normalLevel >= 0 ? ((1 << normalLevel) + 1) ** 2 * 3 : 0;
+    const hper = holeLevel >= 0 ? 1 << (2 * holeLevel) : 0;
+    const geometry = new Uint32Array(patches * per), holes = [];
+    for (let p = 0; p < patches; ++p) {
+      geometry.set(w.subarray(at, at + per), p * per);
+      at += per + nper;
+      holes.push(Uint8Array.from(w.subarray(at, at + hper)));
+      at += hper;
+    }
+    if (k === m) return { patches, level, holeLevel, geometry, holes };
+  }
+  throw new Error(`no model ${m} at ${bytes} bytes`);
+}
+
+function checkAgainstNative(label, pack, bytes, m, positions, index) {
+  const n = native(pack, bytes, m);
+  const size = (1 << n.level) + 1;
+  const bits = new Uint32Array(positions.buffer, positions.byteOffset, positions.length);
+  let same = bits.length === n.geometry.length;
+  for (let i = 0; same && i < bits.length; ++i) same = bits[i] === n.geometry[i];
+  check(same, `${label}: ${positions.length / 3} vertices (native: ${n.patches} × ${size}²), positions bit-identical to native at ${bytes} bytes`);
+  let quads = 0;
+  const res = n.holeLevel >= 0 ? 1 << n.holeLevel : 0;
+  for (let p = 0; p < n.patches; ++p)
+    for (let j = 0; j + 1 < size; ++j)
+      for (let i = 0; i + 1 < size; ++i) {
+        const masked = res && n.holes[p][Math.min(res - 1, Math.floor((j + 0.5) / (size - 1) * res)) * res +
+                                         Math.min(res - 1, Math.floor((i + 0.5) / (size - 1) * res))];
+        if (!masked) ++quads;
+      }
+  const inRange = index.every((v) => v < positions.length / 3);
+  check(index.length === quads * 6 && inRange,
+        `${label}: ${index.length / 3} triangles = 2 × ${quads} quads outside the hole mask, indices in range`);
+}
+
+for (const spec of specs) {
+  const [pack, modelText] = spec.split(':');
+  const model = Number(modelText ?? 0);
+  const bytes = readFileSync(pack);
+  const server = http.createServer(async (req, res) => {
+    res.writeHead(200, { 'Content-Type': 'application/octet-stream', 'Content-Length': bytes.length });
+    for (let at = 0; at < bytes.length; at += 512) {
+      res.write(bytes.subarray(at, Math.min(bytes.length, at + 512)));
+      await new Promise((r) => setTimeout(r, 15));
+    }
+    res.end();
+  });
+  await new Promise((r) => server.listen(0, '127.0.0.1', r));
+  const url = `http://127.0.0.1:${server.address().port}/pack.gip`;
+  const loader = new GeomipLoader();
+  loader.model = model;
+  loader.minInterval = 0;
+  const refinements = [];
+  const done = new Promise((resolve, reject) => {
+    loader.load(url, (geometry) => {
+      const record = (e) => {
+        refinements.push({ bytes: e.bytes, positions: geometry.getAttribute('position').array.slice(),
+                           index: geometry.getIndex().array.slice() });
+        if (e.done) resolve(geometry);
+      };
+      record({ ...geometry.userData.geomip });
+      geometry.addEventListener('refine', (e) => { if (e.bytes !== refinements.at(-1).bytes || e.done) record(e); });
+    }, undefined, reject);
+  });
+  const geometry = await done;
+  server.close();
+  const label = `${pack} model ${model}`;
+  check(refinements.length >= 3 && refinements[0].bytes < bytes.length && refinements.at(-1).bytes === bytes.length,
+        `${label}: ${refinements.length} refinements, at ${refinements.slice(0, 4).map((r) => r.bytes).join(', ')}, …, ${refinements.at(-1).bytes} bytes`);
+  const first = refinements[0];
+  checkAgainstNative(`${label} first level`, pack, first.bytes, model, first.positions, first.index);
+  checkAgainstNative(`${label} complete`, pack, bytes.length, model, geometry.getAttribute('position').array,
+                     geometry.getIndex().array);
+  const normal = geometry.getAttribute('normal').array;
+  let unit = 0;
+  for (let i = 0; i < normal.length; i += 3) if (Math.abs(Math.hypot(normal[i], normal[i + 1], normal[i + 2]) - 1) < 0.01) ++unit;
+  check(unit === normal.length / 3, `${label}: ${unit} of ${normal.length / 3} normals of unit length`);
+}
+console.log(failures === 0 ? 'three_loader_test: all checks passed' : `three_loader_test: ${failures} check(s) failed`);
+process.exit(failures === 0 ? 0 : 1);

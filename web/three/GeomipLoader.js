@@ -1,0 +1,147 @@
+// GeomipLoader — a three.js loader for .gip packs that yields a BufferGeometry which refines in place as the
+// bytes arrive.
+//
+//   import { GeomipLoader } from './GeomipLoader.js';
+//   new GeomipLoader().load(url, (geometry) => scene.add(new THREE.Mesh(geometry, material)),
+//                           (progress) => {}, (error) => {});
+//
+// onLoad(geometry) is called once, as soon as the first level of detail has arrived; from then on the same
+// geometry's `position` and `normal` attributes are overwritten with each finer level (needsUpdate set) and
+// the geometry dispatches a 'refine' event ({ type: 'refine', bytes, total, level, done }); its
+// `userData.geomip` holds the same fields. Vertices: every grid sample of every patch of the model
+// ((2^level+1)² per patch, patch by patch, row-major: the geometry-image order of web/geomip.js's decode()),
+// positions in the model's units, normals from the pack's normal maps (nearest sample) or, without them,
+// three's computeVertexNormals(). Triangles: two per grid quad, quads of the hole mask left out; seams are
+// shared positions (bit-identical samples), so the surface has no cracks. Options: `model` (index in a
+// consistent pack, default 0), `minInterval` (ms between decodes while streaming, default 100).
+// The bytes are read by one streamed GET (fetch); parse(arrayBuffer) decodes bytes already in memory.
+import { BufferAttribute, BufferGeometry, Loader } from 'three';
+import { createDecoder } from '../geomip.js';
+
+export class GeomipLoader extends Loader {
+  constructor(manager) {
+    super(manager);
+    this.model = 0;
+    this.minInterval = 100;
+    this.decoderOptions = {};  // passed to createDecoder (coreUrl, wasmBinary)
+  }
+
+  load(url, onLoad, onProgress, onError) {
+    const resolved = this.manager.resolveURL(this.path + url);
+    this.manager.itemStart(resolved);
+    this.stream_(resolved, onLoad, onProgress)
+        .catch((e) => { if (onError) onError(e); else console.error(e); this.manager.itemError(resolved); })
+        .finally(() => this.manager.itemEnd(resolved));
+  }
+
+  loadAsync(url, onProgress) {  // resolves with the geometry at the first level of detail
+    return new Promise((resolve, reject) => this.load(url, resolve, onProgress, reject));
+  }
+
+  /// The geometry of bytes already in memory (an ArrayBuffer or Uint8Array holding a pack or a prefix).
+  async parse(bytes) {
+    const decoder = await createDecoder(this.decoderOptions);
+    decoder.push(bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes));
+    const geometry = new BufferGeometry();
+    if (!update(geometry, decoder.decode(), this.model, decoder.size, decoder.size, true))
+      throw new Error('GeomipLoader: these bytes hold no level of detail yet');
+    decoder.dispose();
+    return geometry;
+  }
+
+  async stream_(url, onLoad, onProgress) {
+    const response = await fetch(url, { headers: this.requestHeader, credentials: this.withCredentials ? 'include' : 'same-origin' });
+    if (!response.ok) throw new Error(`GeomipLoader: ${url}: HTTP ${response.status}`);
+    const total = Number(response.headers.get('Content-Length') ?? 0);
+    const decoder = await createDecoder(this.decoderOptions);
+    const geometry = new BufferGeometry();
+    let loaded = false, lastDecode = -Infinity;
+    const refine = (done) => {
+      const now = performance.now();
+      if (!done && now - lastDecode < this.minInterval) return;
+      lastDecode = now;
+      const result = decoder.decode();
+      if (result.status === 'corrupt' || result.status === 'unsupported-version')
+        throw new Error(`GeomipLoader: ${url}: ${result.message}`);
+      if (!update(geometry, result, this.model, decoder.size, total || decoder.size, done)) return;
+      if (!loaded) { loaded = true; onLoad(geometry); }
+      geometry.dispatchEvent({ type: 'refine', ...geometry.userData.geomip });
+    };
+    const reader = response.body.getReader();
+    for (;;) {
+      const { done, value } = await reader.read();
+      if (done) break;
+      decoder.push(value);
+      if (onProgress) onProgress({ loaded: decoder.size, total });
+      refine(false);
+    }
+    refine(true);  // the last bytes, always decoded
+    decoder.dispose();
+    if (!loaded) throw new Error(`GeomipLoader: ${url}: no level of detail in ${decoder.size} bytes`);
+  }
+}
+
+/// Writes model `m` of a decode() result into `geometry`; false when it has no model yet.
+function update(geometry, result, m, bytes, total, done) {
+  const model = result.models[m];
+  if (!model || model.geometryPasses === 0) return false;
+  const size = (1 << model.level) + 1, per = size * size;
+  const count = model.numPatches * per;
+  let position = geometry.getAttribute('position');
+  if (!position || position.count !== count) {
+    position = new BufferAttribute(new Float32Array(count * 3), 3);
+    geometry.setAttribute('position', position);
+    geometry.setAttribute('normal', new BufferAttribute(new Float32Array(count * 3), 3));
+    geometry.userData.holeKey = null;
+  }
+  for (let p = 0; p < model.numPatches; ++p) position.array.set(model.geometry[p], p * per * 3);
+  position.needsUpdate = true;
+
+  // triangles: rebuilt only when the hole mask changes (the coarse mask of the manifest, then the fine one)
+  const holeKey = `${model.holeMaskLevel}:${model.holeMask.map((h) => h.reduce((a, b) => a + b, 0)).join(',')}`;
+  if (geometry.userData.holeKey !== holeKey) {
+    geometry.setIndex(new BufferAttribute(gridIndex(model, size), 1));
+    geometry.userData.holeKey = holeKey;
+  }
+
+  const normal = geometry.getAttribute('normal');
+  if (model.normals.length === model.numPatches) {
+    const nsize = (1 << model.normalLevel) + 1;
+    for (let p = 0; p < model.numPatches; ++p)
+      for (let j = 0; j < size; ++j)
+        for (let i = 0; i < size; ++i) {
+          const ni = Math.round(i * (nsize - 1) / (size - 1)), nj = Math.round(j * (nsize - 1) / (size - 1));
+          const src = (nj * nsize + ni) * 3, dst = (p * per + j * size + i) * 3;
+          normal.array[dst] = model.normals[p][src];
+          normal.array[dst + 1] = model.normals[p][src + 1];
+          normal.array[dst + 2] = model.normals[p][src + 2];
+        }
+    normal.needsUpdate = true;
+  } else {
+    geometry.computeVertexNormals();
+  }
+  geometry.computeBoundingBox();
+  geometry.computeBoundingSphere();
+  geometry.userData.geomip = { bytes, total, level: model.detailLevel, done, name: model.name };
+  return true;
+}
+
+/// Two triangles per grid quad, patch by patch, leaving out the quads whose hole-mask cell is set (the
+/// quad's centre in the mask's grid, as the viewers do).
+function gridIndex(model, size) {
+  const res = model.holeMaskLevel >= 0 ? 1 << model.holeMaskLevel : 0;
+  const per = size * size;
+  const out = [];
+  for (let p = 0; p < model.numPatches; ++p)
+    for (let j = 0; j + 1 < size; ++j)
+      for (let i = 0; i + 1 < size; ++i) {
+        if (res) {
+          const qi = Math.min(res - 1, Math.floor((i + 0.5) / (size - 1) * res));
+          const qj = Math.min(res - 1, Math.floor((j + 0.5) / (size - 1) * res));
+          if (model.holeMask[p][qj * res + qi]) continue;
+        }
+        const a = p * per + j * size + i;
+        out.push(a, a + 1, a + size, a + 1, a + size + 1, a + size);
+      }
+  return new Uint32Array(out);
+}

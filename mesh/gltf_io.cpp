@@ -12,9 +12,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <ostream>
+#include <string>
+#include <unordered_map>
+#include <vector>
 
 namespace geomip {
 namespace {
@@ -272,6 +277,36 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
     throw IoError("write_gltf: writing the glTF stream failed");
 }
 
+namespace {
+
+/// Merges vertices at bit-identical positions into the first of them (glTF splits a vertex wherever one of
+/// its attributes changes — texture seams, hard edges — and geomip reads positions only).
+void weld_identical_positions(TriMesh& mesh) {
+  struct KeyHash {
+    std::size_t operator()(const std::array<std::uint64_t, 3>& k) const {
+      return std::hash<std::uint64_t>()(k[0] * 0x9e3779b97f4a7c15ull ^ (k[1] + 0x632be59bd9b4e019ull) * 31 ^ k[2]);
+    }
+  };
+  std::unordered_map<std::array<std::uint64_t, 3>, int, KeyHash> first;
+  first.reserve(mesh.positions.size());
+  std::vector<int> to(mesh.positions.size());
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(mesh.positions.size());
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    std::array<std::uint64_t, 3> key{};
+    for (int c = 0; c < 3; ++c) std::memcpy(&key[c], &mesh.positions[v][c], sizeof(double));
+    const auto [it, inserted] = first.try_emplace(key, static_cast<int>(kept.size()));
+    if (inserted) kept.push_back(mesh.positions[v]);
+    to[v] = it->second;
+  }
+  if (kept.size() == mesh.positions.size()) return;
+  for (auto& t : mesh.triangles)
+    for (int& v : t) v = to[static_cast<std::size_t>(v)];
+  mesh.positions = std::move(kept);
+}
+
+}  // namespace
+
 TriMesh read_gltf_from_memory(std::string_view bytes, const std::string& name, const std::string& base_dir) {
   if (bytes.size() > std::numeric_limits<unsigned int>::max()) throw InvalidInput(name + ": too large for glTF (4 GiB)");
   tinygltf::TinyGLTF gltf;
@@ -304,6 +339,7 @@ TriMesh read_gltf_from_memory(std::string_view bytes, const std::string& name, c
     }
   }
   if (out.triangles.empty()) throw InvalidInput(name + ": no triangles in the glTF file's scene");
+  weld_identical_positions(out);
   return out;
 }
 

@@ -4,7 +4,9 @@
 // Output: one mesh, one triangle primitive: POSITION (float VEC3, with the min/max the specification
 // requires), optional NORMAL (float VEC3, unit length) and TEXCOORD_0 (float VEC2), 32-bit indices.
 // Input: every triangle primitive (mode TRIANGLES, indexed or not) of every mesh reachable from the default
-// scene (all nodes when the file has no scene), node transforms applied, merged into one TriMesh. Accessors
+// scene (all nodes when the file has no scene), node transforms applied, merged into one TriMesh, vertices at
+// bit-identical positions merged into one (glTF splits a vertex wherever an attribute changes — texture
+// seams, hard edges — and geomip reads positions only). Accessors
 // are checked against their buffers before a byte is read; sparse accessors, strips and fans are refused.
 #pragma once
 

@@ -2,6 +2,7 @@
 // only they had arrived) and writes each model as a mesh.
 #include "codec/pack.h"
 #include "mesh/errors.h"
+#include "mesh/gltf_io.h"
 #include "mesh/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
@@ -115,17 +116,27 @@ int run_decode(const DecodeArgs& args) {
   }
   nlohmann::json j_models = nlohmann::json::array();
   for (std::size_t m = 0; m < decoded.models.size(); ++m) {
-    const TriMesh mesh = decoded_mesh(decoded.models[m], args.level);
-    write_file_atomically(paths[m], [&](std::ostream& o) { write_mesh(mesh, o, format); });
+    // glTF carries per-patch texture coordinates and the normal maps' normals (seams not welded); the
+    // other formats get the welded mesh.
+    const bool gltf = format == MeshFormat::kGltf || format == MeshFormat::kGlb;
+    const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level) : TexturedMesh{};
+    const TriMesh mesh = gltf ? TriMesh{} : decoded_mesh(decoded.models[m], args.level);
+    const TriMesh& written = gltf ? textured.mesh : mesh;
+    write_file_atomically(paths[m], [&](std::ostream& o) {
+      if (gltf)
+        write_gltf(textured.mesh, textured.attributes, o, {.binary = format == MeshFormat::kGlb});
+      else
+        write_mesh(mesh, o, format);
+    });
     j_models.push_back({{"name", decoded.models[m].name},
                         {"mesh", paths[m]},
-                        {"vertices", mesh.num_vertices()},
-                        {"faces", mesh.num_triangles()},
+                        {"vertices", written.num_vertices()},
+                        {"faces", written.num_triangles()},
                         {"detail_level", decoded.models[m].detail_level},
                         {"geometry_passes", decoded.models[m].geometry_passes}});
     if (!args.quiet && !args.json) {
       std::printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",
-                  decoded.models[m].name.c_str(), paths[m].c_str(), mesh.num_triangles(),
+                  decoded.models[m].name.c_str(), paths[m].c_str(), written.num_triangles(),
                   args.level < 0 ? grid_level : args.level, decoded.models[m].detail_level,
                   decoded.models[m].geometry_passes);
     }

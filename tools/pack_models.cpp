@@ -3,6 +3,8 @@
 #include "gimage/uniform_remesh.h"
 #include "mesh/errors.h"
 
+#include <algorithm>
+
 namespace geomip::tools {
 
 codec::PackModelInput pack_model_input(const std::string& name, const GeometryImages& images,
@@ -18,7 +20,16 @@ codec::PackModelInput pack_model_input(const std::string& name, const GeometryIm
   return input;
 }
 
-TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
+namespace {
+
+/// Where an output vertex of decoded_mesh() comes from: patch p, sample (i, j) of the level-`level` grid.
+struct GridSample {
+  int patch, i, j;
+};
+
+/// decoded_mesh() with `weld` choosing whether seams are welded (the model's seams) or not (every patch its
+/// own vertices); `origin`, if given, receives each output vertex's first grid sample.
+TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld, std::vector<GridSample>* origin) {
   if (model.geometry.empty()) throw InvalidInput("decoded_mesh: the model has no patches");
   const int grid_level = model.geometry.front().level;
   if (level < 0) level = grid_level;
@@ -27,23 +38,31 @@ TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
                        std::to_string(grid_level) + "]");
   }
   std::vector<SideLink> adjacency;
-  for (const codec::PatchSeam& s : model.seams)
-    adjacency.push_back({s.patch, s.side, s.other_patch, s.other_side, s.reversed});
+  if (weld) {
+    for (const codec::PatchSeam& s : model.seams)
+      adjacency.push_back({s.patch, s.side, s.other_patch, s.other_side, s.reversed});
+  }
   UniformRemeshResult remesh = uniform_remesh_connectivity(model.geometry.size(), adjacency, level);
 
   const int stride = 1 << (grid_level - level);
   const int n = (1 << level) + 1;
   const int grid_n = (1 << grid_level) + 1;
+  std::vector<GridSample> first(remesh.mesh.positions.size(), GridSample{-1, 0, 0});
   for (std::size_t p = 0; p < model.geometry.size(); ++p) {
     const codec::Grid3& grid = model.geometry[p];
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
         const float* v = grid.values.data() + 3 * (static_cast<std::size_t>(j * stride) * grid_n + i * stride);
-        remesh.mesh.positions[remesh.grid_vertex[p][static_cast<std::size_t>(j) * n + i]] = {v[0], v[1], v[2]};
+        const int id = remesh.grid_vertex[p][static_cast<std::size_t>(j) * n + i];
+        remesh.mesh.positions[id] = {v[0], v[1], v[2]};
+        if (first[id].patch < 0) first[id] = {static_cast<int>(p), i, j};
       }
     }
   }
-  if (model.hole_mask.empty()) return std::move(remesh.mesh);
+  if (model.hole_mask.empty()) {
+    if (origin) *origin = std::move(first);
+    return std::move(remesh.mesh);
+  }
 
   // Quad q of patch p at this level → triangles 2q, 2q+1 (uniform_remesh_connectivity's order).
   // A quad of this level is left out when every mask quad it overlaps is masked (a finer mask), or when the
@@ -54,6 +73,7 @@ TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
   const int span = mask_level >= level ? 1 << (mask_level - level) : 1;
   const int shrink = mask_level >= level ? 0 : level - mask_level;
   TriMesh out;
+  if (origin) origin->clear();
   std::vector<int> new_id(remesh.mesh.positions.size(), -1);
   for (std::size_t p = 0; p < model.geometry.size(); ++p) {
     const std::vector<std::uint8_t>& mask = model.hole_mask[p];
@@ -72,6 +92,7 @@ TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
             if (new_id[v] < 0) {
               new_id[v] = static_cast<int>(out.positions.size());
               out.positions.push_back(remesh.mesh.positions[v]);
+              if (origin) origin->push_back(first[v]);
             }
             v = new_id[v];
           }
@@ -81,6 +102,52 @@ TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
     }
   }
   return out;
+}
+
+}  // namespace
+
+TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
+  return decoded_mesh_impl(model, level, /*weld=*/true, nullptr);
+}
+
+TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level) {
+  std::vector<GridSample> origin;
+  TexturedMesh result;
+  result.mesh = decoded_mesh_impl(model, level, /*weld=*/false, &origin);
+  const int grid_level = model.geometry.front().level;
+  if (level < 0) level = grid_level;
+  const double intervals = static_cast<double>(1 << level);
+  const bool has_normal_maps = model.normals.size() == model.geometry.size() &&
+                               std::all_of(model.normals.begin(), model.normals.end(),
+                                           [&](const codec::Grid3& g) {
+                                             // A map still all zero: its passes have not arrived yet.
+                                             return g.level >= level &&
+                                                    std::any_of(g.values.begin(), g.values.end(),
+                                                                [](float x) { return x != 0; });
+                                           });
+  const std::vector<Eigen::Vector3d> geometry_normals =
+      has_normal_maps ? std::vector<Eigen::Vector3d>() : vertex_normals(result.mesh);
+  result.attributes.uv.reserve(origin.size());
+  result.attributes.normals.reserve(origin.size());
+  for (std::size_t v = 0; v < origin.size(); ++v) {
+    const GridSample& s = origin[v];
+    result.attributes.uv.emplace_back(static_cast<float>(s.i / intervals), static_cast<float>(s.j / intervals));
+    Eigen::Vector3d n;
+    if (has_normal_maps) {
+      const codec::Grid3& map = model.normals[static_cast<std::size_t>(s.patch)];
+      const int stride = 1 << (map.level - level);
+      const float* t = map.values.data() + 3 * (static_cast<std::size_t>(s.j * stride) * map.size() + s.i * stride);
+      n = Eigen::Vector3d(t[0], t[1], t[2]);
+    } else {
+      n = geometry_normals[v];
+    }
+    // Decoded normal-map texels are not exactly unit (quantized); a zero one (a prefix before the normal
+    // maps arrive) falls back to +z rather than NaN.
+    const double length = n.norm();
+    result.attributes.normals.push_back(length > 0 ? Eigen::Vector3f((n / length).cast<float>())
+                                                   : Eigen::Vector3f(0, 0, 1));
+  }
+  return result;
 }
 
 }  // namespace geomip::tools

@@ -4,6 +4,7 @@
 #include "codec/pack.h"
 #include "gimage/hole_mask.h"
 #include "gimage/resample.h"
+#include "mesh/gltf_io.h"
 #include "mesh/mesh.h"
 
 #include <string>
@@ -22,5 +23,19 @@ codec::PackModelInput pack_model_input(const std::string& name, const GeometryIm
 /// grid quads it covers are masked) and unreferenced vertices dropped.
 /// \throw InvalidInput for a level outside [0, grid level] or a model without patches.
 TriMesh decoded_mesh(const codec::DecodedModel& model, int level = -1);
+
+/// A mesh with per-vertex attributes for texture-mapped formats (glTF).
+struct TexturedMesh {
+  TriMesh mesh;
+  MeshAttributes attributes;  ///< normals and uv, one per vertex of `mesh`
+};
+
+/// decoded_mesh()'s surface for formats with texture coordinates: the same triangles in the same order, but
+/// seams not welded — every patch has its own vertices, so each carries its patch's (u,v) = (i, j) / 2^level
+/// (TEXCOORD_0) — and unit normals from the decoded normal maps at those (u,v) (the mesh's area-weighted
+/// vertex normals when the model has no normal maps; +z where a texel is still zero). Vertices on a seam
+/// appear once per patch with bit-identical positions (the codec keeps seam samples identical), so the
+/// surface does not crack.
+TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level = -1);
 
 }  // namespace geomip::tools

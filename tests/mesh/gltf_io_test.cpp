@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <sstream>
 
 namespace geomip {
@@ -34,6 +35,29 @@ TEST(GltfIo, RoundTripIsExactInFloatForGlbAndJson) {
     ASSERT_EQ(back.triangles, torus.triangles);
     for (std::size_t v = 0; v < torus.positions.size(); ++v) EXPECT_EQ(back.positions[v], torus.positions[v]) << v;
   }
+}
+
+// glTF splits vertices at texture seams; geomip reads positions only, so a torus written with every
+// triangle's corners duplicated (a "triangle soup", as per-face attributes force) reads back welded: the same
+// vertices and topology as the torus itself.
+TEST(GltfIo, VerticesAtIdenticalPositionsAreMergedOnInput) {
+  const TriMesh torus = float_rounded(test::torus(12, 7));
+  TriMesh soup;
+  MeshAttributes uv_per_corner;
+  for (const auto& t : torus.triangles) {
+    std::array<int, 3> corners{};
+    for (int k = 0; k < 3; ++k) {
+      corners[k] = static_cast<int>(soup.positions.size());
+      soup.positions.push_back(torus.positions[t[k]]);
+      uv_per_corner.uv.emplace_back(0.5f * k, 0.25f);
+    }
+    soup.triangles.push_back(corners);
+  }
+  const TriMesh back = read_gltf_from_memory(to_gltf(soup, uv_per_corner, true), "soup", "");
+  ASSERT_EQ(back.positions.size(), torus.positions.size());
+  ASSERT_EQ(back.triangles.size(), torus.triangles.size());
+  for (std::size_t f = 0; f < torus.triangles.size(); ++f)
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(back.positions[back.triangles[f][k]], torus.positions[torus.triangles[f][k]]);
 }
 
 TEST(GltfIo, JsonCarriesAttributesAndBoundsTheSpecificationRequires) {

@@ -1,8 +1,10 @@
 // glTF written by geomip opened by others (issue 17): `geomip decode PACK -o x.glb` and `-o x.obj` of the same
-// pack; three.js's GLTFLoader (npm three, under node) reads the GLB into one mesh whose vertex and triangle
-// counts equal the OBJ's and whose positions equal the OBJ's within its printed precision, with a unit
-// NORMAL per vertex; `assimp info` (Debian assimp-utils) counts the same vertices and faces; and the GLB read
-// back as input (`geomip info --json`) gives the same counts and topology as the OBJ.
+// pack. The GLB is the OBJ's surface with per-patch texture coordinates: the same triangles in the same order,
+// seam vertices once per patch (so each has its patch's (u,v)). three.js's GLTFLoader (npm three, under node)
+// reads one mesh whose every triangle corner lies within 1e-5 of the OBJ's, a unit NORMAL and a TEXCOORD_0
+// in [0,1]² per vertex; `assimp info` (Debian assimp-utils) counts the GLB's vertices and the OBJ's faces; and
+// the GLB read back as input (`geomip info --json`, which merges vertices at identical positions) gives the
+// same counts and topology as the OBJ.
 //   node gltf_interop_test.mjs GEOMIP_BINARY ONE_MODEL_PACK TWO_MODEL_PACK
 import { execFileSync } from 'node:child_process';
 import { mkdirSync, mkdtempSync, readdirSync, readFileSync, rmSync } from 'node:fs';
@@ -28,7 +30,8 @@ try {
   for (const [name, glb, obj] of pairs) {
     const objText = readFileSync(obj, 'utf8').split('\n');
     const objPositions = objText.filter((l) => l.startsWith('v ')).map((l) => l.split(/\s+/).slice(1, 4).map(Number));
-    const objFaces = objText.filter((l) => l.startsWith('f ')).length;
+    const objTriangles = objText.filter((l) => l.startsWith('f ')).map((l) => l.split(/\s+/).slice(1, 4).map((w) => parseInt(w, 10) - 1));
+    const objFaces = objTriangles.length;
 
     const bytes = readFileSync(glb);
     const gltf = await new Promise((resolve, reject) =>
@@ -36,22 +39,29 @@ try {
     const meshes = [];
     gltf.scene.traverse((o) => { if (o.isMesh) meshes.push(o); });
     const g = meshes[0]?.geometry;
-    const position = g?.getAttribute('position'), normal = g?.getAttribute('normal');
+    const position = g?.getAttribute('position'), normal = g?.getAttribute('normal'), uv = g?.getAttribute('uv');
     const triangles = g?.index ? g.index.count / 3 : 0;
-    check(meshes.length === 1 && position.count === objPositions.length && triangles === objFaces,
-          `${name}: GLTFLoader reads ${meshes.length} mesh, ${position?.count} vertices, ${triangles} triangles (OBJ: ${objPositions.length}, ${objFaces})`);
+    check(meshes.length === 1 && position.count >= objPositions.length && triangles === objFaces,
+          `${name}: GLTFLoader reads ${meshes.length} mesh, ${position?.count} vertices (OBJ: ${objPositions.length} welded), ${triangles} triangles (OBJ: ${objFaces})`);
     let worst = 0;
-    for (let i = 0; i < Math.min(position.count, objPositions.length); ++i)
-      for (let c = 0; c < 3; ++c) worst = Math.max(worst, Math.abs(position.array[3 * i + c] - objPositions[i][c]));
-    check(worst <= 1e-5, `${name}: GLB positions equal the OBJ's (largest difference ${worst.toExponential(2)})`);
+    for (let t = 0; t < Math.min(triangles, objFaces); ++t)
+      for (let k = 0; k < 3; ++k) {
+        const v = g.index.array[3 * t + k], o = objPositions[objTriangles[t][k]];
+        for (let c = 0; c < 3; ++c) worst = Math.max(worst, Math.abs(position.array[3 * v + c] - o[c]));
+      }
+    check(worst <= 1e-5, `${name}: every GLB triangle corner equals the OBJ's (largest difference ${worst.toExponential(2)})`);
     let unit = 0;
     for (let i = 0; normal && i < normal.count; ++i)
       if (Math.abs(Math.hypot(normal.getX(i), normal.getY(i), normal.getZ(i)) - 1) < 1e-3) ++unit;
-    check(normal && unit === normal.count, `${name}: ${unit} unit normals of ${position.count} vertices`);
+    check(normal && unit === position.count, `${name}: ${unit} unit normals of ${position.count} vertices`);
+    let inSquare = 0;
+    for (let i = 0; uv && i < uv.count; ++i)
+      if (uv.getX(i) >= 0 && uv.getX(i) <= 1 && uv.getY(i) >= 0 && uv.getY(i) <= 1) ++inSquare;
+    check(uv && inSquare === position.count, `${name}: ${inSquare} TEXCOORD_0 in [0,1]² of ${position.count} vertices`);
 
     const assimp = execFileSync('assimp', ['info', glb], { encoding: 'utf8' });
     const field = (k) => Number((assimp.match(new RegExp(`^${k}:\\s+(\\d+)`, 'm')) ?? [])[1]);
-    check(field('Vertices') === objPositions.length && field('Faces') === objFaces,
+    check(field('Vertices') === position.count && field('Faces') === objFaces,
           `${name}: assimp info: ${field('Vertices')} vertices, ${field('Faces')} faces`);
 
     const info = (file) => JSON.parse(execFileSync(geomip, ['info', file, '--json'], { encoding: 'utf8' }));

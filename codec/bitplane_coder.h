@@ -67,6 +67,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -152,6 +153,41 @@ struct BitplaneDecodeResult {
 /// before decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got
 /// (scratch for the hook).
 using DecodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view)>;
+
+/// Incremental decoding (a class because its state is reused): the decoder keeps its significance lists,
+/// contexts, range-decoder states and its place inside the plane it stopped in, and each update() continues
+/// from there, so every byte is decoded once however the stream arrives. After any sequence of updates
+/// whose last one got `segments` and `partial_tail`, result and reconstruct() are bit for bit those of
+/// decode_bitplanes() on the same arguments (for streams of the encoder; after a kCorrupt the decoder stops
+/// and may hold more than a one-shot decode of a later prefix would).
+class BitplaneDecoder {
+ public:
+  BitplaneDecoder();
+  ~BitplaneDecoder();
+  BitplaneDecoder(BitplaneDecoder&&) noexcept;
+  BitplaneDecoder& operator=(BitplaneDecoder&&) noexcept;
+
+  /// Starts over. kInvalidArgument (and nothing to decode) on the errors of decode_bitplanes().
+  Status reset(const BitplaneLayout& layout, int top_bitplane, std::vector<std::vector<std::uint8_t>> coded,
+               int max_threads = 0, DecodeHook before_plane = {});
+  /// Continues with a longer prefix of the stream: `segments` start with the complete segments of the
+  /// previous call (same contents; the memory may have moved), `partial_tail` is a prefix of the next one
+  /// and extends the previous call's tail when that segment is still the one in progress. Returns as
+  /// decode_bitplanes(); kCorrupt is sticky. Cost: the symbols of the new bytes (plus the hooks reached).
+  Status update(std::span<const std::span<const std::uint8_t>> segments,
+                std::span<const std::uint8_t> partial_tail, BitplaneDecodeResult& result);
+  /// The reconstruction of what was decoded (as decode_bitplanes()' `out`).
+  void reconstruct(std::vector<PatchCoefficients>& out) const;
+  /// Per patch, a counter that grows whenever an update() may have changed that patch's coefficients (joint
+  /// planes and hooks change every patch): a patch whose counter did not change between two reconstruct()
+  /// calls has the same coefficients.
+  std::vector<std::uint64_t> patch_versions() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
 Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,

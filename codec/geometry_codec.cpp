@@ -616,35 +616,77 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   return result;
 }
 
-Status decode_geometry(const GeometryCodecHeader& header,
-                       std::span<const std::span<const std::uint8_t>> segments,
-                       std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,
-                       const GeometryDecodeOptions& options) {
-  out = DecodedGeometry{};
+struct GeometryDecoder::State {
+  GeometryCodecHeader header;
+  GeometryDecodeOptions options;
+  Ownership own;
+  FrameField ff;
+  BitplaneDecoder bits;
+  BitplaneDecodeResult last;
+  // result() cache: the grids of the last call, valid while the coefficients and the drop are the same.
+  std::vector<std::uint64_t> versions;
+  int cached_drop = -1;
+  DecodedGeometry cached;
+};
+
+GeometryDecoder::GeometryDecoder() = default;
+GeometryDecoder::~GeometryDecoder() = default;
+GeometryDecoder::GeometryDecoder(GeometryDecoder&&) noexcept = default;
+GeometryDecoder& GeometryDecoder::operator=(GeometryDecoder&&) noexcept = default;
+
+Status GeometryDecoder::reset(const GeometryCodecHeader& header, const GeometryDecodeOptions& options) {
+  s_.reset();
   if (!header_ok(header) || options.drop_finest_steps < 0) return Status::kInvalidArgument;
+  auto st = std::make_unique<State>();
+  st->header = header;
+  st->options = options;
+  st->own = seam_ownership(header.level, header.num_patches, header.seams);
+  st->ff = make_frame_field(header, st->own);
+  State* raw = st.get();
+  const DecodeHook hook = [raw](int plane, std::vector<PatchCoefficients>& view) {
+    raw->ff.compute(plane, view);
+  };
+  const Status s = st->bits.reset(make_layout(header), header.top_bitplane, st->own.coded, options.max_threads,
+                                  hook);
+  if (s != Status::kOk) return s;
+  s_ = std::move(st);
+  return Status::kOk;
+}
+
+Status GeometryDecoder::update(std::span<const std::span<const std::uint8_t>> segments,
+                               std::span<const std::uint8_t> partial_tail) {
+  if (!s_) return Status::kInvalidArgument;
+  return s_->bits.update(segments, partial_tail, s_->last);
+}
+
+void GeometryDecoder::result(DecodedGeometry& out, int drop_finest_steps) {
+  out = DecodedGeometry{};
+  if (!s_) return;
+  State& st = *s_;
+  const GeometryCodecHeader& header = st.header;
   const int level = header.level, np = header.num_patches, steps = header.steps;
   const std::size_t size = static_cast<std::size_t>(grid_size(level)), samples = size * size;
-  const Ownership own = seam_ownership(level, np, header.seams);
+  const int drop = std::min(drop_finest_steps < 0 ? st.options.drop_finest_steps : drop_finest_steps, steps);
+  std::vector<std::uint64_t> versions = st.bits.patch_versions();
+  if (versions == st.versions && drop == st.cached_drop) {
+    out = st.cached;
+    return;
+  }
   std::vector<PatchCoefficients> coefs;
-  BitplaneDecodeResult r;
-  FrameField ff = make_frame_field(header, own);
-  const DecodeHook hook = [&](int plane, std::vector<PatchCoefficients>& view) { ff.compute(plane, view); };
-  const Status status = decode_bitplanes(make_layout(header), header.top_bitplane, own.coded, segments,
-                                         partial_tail, coefs, r, options.max_threads, hook);
-  out.segments_complete = r.segments_complete;
-  out.partial = r.partial;
-  if (coefs.size() != static_cast<std::size_t>(np)) return status == Status::kOk ? Status::kCorrupt : status;
-  ff.to_xyz(coefs);
+  st.bits.reconstruct(coefs);
+  const Ownership& own = st.own;
+  out.segments_complete = st.last.segments_complete;
+  out.partial = st.last.partial;
+  st.ff.to_xyz(coefs);
   for (const auto& [copy, owner] : own.copies) {
     for (int c = 0; c < 3; ++c)
       coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
   }
   // Per patch (in parallel): drop the finest details, find the finest step with a non-zero detail, inverse
   // transform, dequantize.
-  const int drop = std::min(options.drop_finest_steps, steps);
   std::vector<int> finest(static_cast<std::size_t>(np), steps + 1);  // steps + 1: none
   out.patches.resize(static_cast<std::size_t>(np));
-  parallel_for(np, options.max_threads, [&](int p) {
+  parallel_for(np, st.options.max_threads, [&](int p) {
     Grid3& g = out.patches[static_cast<std::size_t>(p)];
     g.level = level;
     g.values.resize(3 * samples);
@@ -692,6 +734,20 @@ Status decode_geometry(const GeometryCodecHeader& header,
   });
   const int finest_step = *std::min_element(finest.begin(), finest.end());
   out.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
+  st.versions = std::move(versions);
+  st.cached_drop = drop;
+  st.cached = out;
+}
+
+Status decode_geometry(const GeometryCodecHeader& header,
+                       std::span<const std::span<const std::uint8_t>> segments,
+                       std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,
+                       const GeometryDecodeOptions& options) {
+  out = DecodedGeometry{};
+  GeometryDecoder decoder;
+  if (decoder.reset(header, options) != Status::kOk) return Status::kInvalidArgument;
+  const Status status = decoder.update(segments, partial_tail);
+  decoder.result(out);
   return status;
 }
 

@@ -21,6 +21,20 @@ struct Pillow {
   std::vector<codec::PatchSeam> seams;
 };
 
+/// A smooth unit vector field for normal-map tests: each sample's normalized position ((0, 0, 1) at the
+/// origin). The normal maps of the golden packs are made this way.
+inline std::vector<codec::Grid3> position_normals(const std::vector<codec::Grid3>& patches) {
+  std::vector<codec::Grid3> normals = patches;
+  for (codec::Grid3& g : normals) {
+    for (std::size_t k = 0; k < g.values.size(); k += 3) {
+      float* v = g.values.data() + k;
+      const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (int c = 0; c < 3; ++c) v[c] = len > 0 ? v[c] / len : (c == 2 ? 1.f : 0.f);
+    }
+  }
+  return normals;
+}
+
 /// The pillow sampled on (2^level+1)² grids, with `scale` applied to every coordinate.
 inline Pillow make_pillow(int level, double scale = 1.0) {
   Pillow p;

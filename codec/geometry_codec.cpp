@@ -258,11 +258,24 @@ struct FrameField {
   std::vector<int> start;                                         // start plane of step k at [k − 1]
   std::vector<std::vector<std::array<std::int64_t, 3>>> normals;  // [patch][grid index]
   std::vector<std::uint8_t> ready;                                // [k − 1]: normals of step k computed
+  // Frames built so far (an incremental decoder reconstructs many times from the same normals).
+  mutable std::vector<std::vector<Frame>> frames;          // [patch][grid index]
+  mutable std::vector<std::vector<std::uint8_t>> built;    // [patch][grid index]: frames[...] is valid
 
-  /// The frame at a framed position (built when needed: only non-zero coefficients need one).
-  Frame frame(std::size_t p, int idx) const {
-    const auto& n = normals[p][static_cast<std::size_t>(idx)];
-    return make_frame(n[0], n[1], n[2]);
+  /// The frame at a framed position (built when first needed: only non-zero coefficients need one; the
+  /// normal of a position never changes once its step is ready).
+  const Frame& frame(std::size_t p, int idx) const {
+    const auto i = static_cast<std::size_t>(idx);
+    if (built[p].empty()) {  // first frame of this patch
+      frames[p].resize(normals[p].size());
+      built[p].assign(normals[p].size(), 0);
+    }
+    if (!built[p][i]) {
+      const auto& n = normals[p][i];
+      frames[p][i] = make_frame(n[0], n[1], n[2]);
+      built[p][i] = 1;
+    }
+    return frames[p][i];
   }
 
   /// Calls f(i, j, index) for every detail position of step k.
@@ -286,7 +299,7 @@ struct FrameField {
           for (int r = 0; r < 3; ++r)
             w[r] = coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)];
           if (w[0] == 0 && w[1] == 0 && w[2] == 0) return;
-          const Frame f = frame(p, idx);
+          const Frame& f = frame(p, idx);
           w[1] *= std::int64_t{1} << tangential_shift;
           w[2] *= std::int64_t{1} << tangential_shift;
           for (int c = 0; c < 3; ++c) {
@@ -376,7 +389,7 @@ struct FrameField {
           for (int c = 0; c < 3; ++c)
             d[c] = coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)];
           if (d[0] == 0 && d[1] == 0 && d[2] == 0) return;
-          const Frame f = frame(p, idx);
+          const Frame& f = frame(p, idx);
           for (int r = 0; r < 3; ++r) {
             const std::int64_t v = static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r)]) * d[0] +
                                    static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r + 1)]) * d[1] +
@@ -404,6 +417,8 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
     const std::size_t size = static_cast<std::size_t>(grid_size(h.level));
     ff.normals.assign(static_cast<std::size_t>(h.num_patches),
                       std::vector<std::array<std::int64_t, 3>>(size * size));
+    ff.frames.resize(static_cast<std::size_t>(h.num_patches));
+    ff.built.resize(static_cast<std::size_t>(h.num_patches));
   }
   return ff;
 }

@@ -41,6 +41,7 @@ struct Options {
   int width = 1280, height = 720;
   std::string screenshot, first_screenshot;
   bool bench = false, checker = false, wireframe = false;
+  bool decode_each_prefix = false;
   std::uint64_t limit_rate = 0;
   double timeout = 120;
   float yaw = 0.6f, pitch = 0.35f, distance = 3.2f;
@@ -161,7 +162,9 @@ int run(const Options& opt) {
     Renderer renderer;
     Offscreen target(opt.width, opt.height);
     PackSource source(opt.source, FetchOptions{.limit_rate = opt.limit_rate},
-                      morph::DecodeSettings{.bands = wavelet ? opt.bands : 1, .align = !opt.no_align});
+                      morph::DecodeSettings{.bands = wavelet ? opt.bands : 1,
+                                            .align = !opt.no_align,
+                                            .incremental = !opt.decode_each_prefix});
     Ui ui;
     ui.settings.width = opt.width;
     ui.settings.height = opt.height;
@@ -303,6 +306,12 @@ int run(const Options& opt) {
                   << " models, level " << (ui.settings.level < 0 ? ui.max_level : ui.settings.level) << ", "
                   << (opt.morph || opt.animate ? (wavelet ? "wavelet morph" : "linear morph") : "no morph") << ": "
                   << bench_ms / frames_after_load << " ms/frame over " << frames_after_load << " frames\n";
+      if (opt.bench) {
+        const PackSource::DecodeStats d = source.decode_stats();
+        std::cout << "geomip-view: decode " << (opt.decode_each_prefix ? "(every prefix from scratch)" : "(incremental)")
+                  << ": " << d.updates << " updates, " << d.thread_cpu_ms << " ms CPU of the decode thread, "
+                  << d.wall_ms << " ms wall\n";
+      }
     }
     // Exactly one line for whatever went wrong.
     std::string err = source.error();
@@ -377,7 +386,10 @@ int main(int argc, char** argv) {
   app.add_option("--screenshot", opt.screenshot, "headless: write the last frame as PNG");
   app.add_option("--first-screenshot", opt.first_screenshot,
                  "write the first frame that shows a model (streaming: the coarsest level) as PNG");
-  app.add_flag("--bench", opt.bench, "headless: print ms/frame");
+  app.add_flag("--bench", opt.bench, "headless: print ms/frame and the decoding's time");
+  app.add_flag("--decode-each-prefix", opt.decode_each_prefix,
+               "for measurements: decode every received prefix from scratch (the viewer before incremental "
+               "decoding) instead of each byte once");
   app.add_flag("--checker", opt.checker, "checkerboard texture in parameter space");
   app.add_flag("--wireframe", opt.wireframe, "wireframe");
   app.add_option("--limit-rate", opt.limit_rate, "download (or read) at most this many bytes per second");

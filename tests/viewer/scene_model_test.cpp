@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "tests/viewer/viewer_fixtures.h"
 
@@ -182,6 +183,33 @@ TEST(DecodeScene, AlignedModelsMorphWithoutCollapsing) {
     } else {
       EXPECT_GT(worst, 0.1f) << "unaligned: the mid-morph is far from either pose";
       EXPECT_LT(extent(all), 0.95f) << "unaligned: the mid-morph shrinks";
+    }
+  }
+}
+
+// The streaming viewer's decoder (morph::SceneDecoder, each byte decoded once, the bands of the wavelet morph
+// from one decode) gives, after every update, exactly what a one-shot decode_scene of that prefix gives.
+TEST(SceneDecoder, StreamEqualsOneShotDecodeOfEveryPrefix) {
+  const auto bytes = codec::write_pack({testing::pack_input(5, 0), testing::pack_input(5, 1)});
+  for (int bands : {1, 3}) {
+    morph::SceneDecoder decoder(morph::DecodeSettings{.bands = bands});
+    for (std::size_t n = 0; n <= bytes.size(); n += 1 + n / 7) {
+      codec::Status status = codec::Status::kOk, one_status = codec::Status::kOk;
+      std::size_t used = 0, one_used = 0;
+      const auto models = decoder.update({bytes.data(), n}, status, used);
+      const auto one = morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands}, one_status, one_used);
+      EXPECT_EQ(status, one_status) << n;
+      EXPECT_EQ(used, one_used) << n;
+      ASSERT_EQ(models.size(), one.size()) << n;
+      for (std::size_t m = 0; m < models.size(); ++m) {
+        EXPECT_EQ(models[m].bands, bands);
+        EXPECT_EQ(models[m].detail_level, one[m].detail_level) << n;
+        ASSERT_EQ(models[m].positions.size(), one[m].positions.size());
+        EXPECT_EQ(std::memcmp(models[m].positions.data(), one[m].positions.data(),
+                              models[m].positions.size() * sizeof(float)), 0)
+            << n << " bytes, model " << m << ", " << bands << " bands";
+        EXPECT_EQ(models[m].normals, one[m].normals) << n;
+      }
     }
   }
 }

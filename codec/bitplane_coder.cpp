@@ -1118,8 +1118,10 @@ Status BitplaneDecoder::update(std::span<const std::span<const std::uint8_t>> se
 }
 
 void BitplaneDecoder::reconstruct(std::vector<PatchCoefficients>& out) const {
-  out.clear();
-  if (!s_) return;
+  if (!s_) {
+    out.clear();
+    return;
+  }
   const State& st = *s_;
   const std::size_t size = (std::size_t{1} << st.layout.level) + 1, samples = size * size;
   const int np = st.layout.num_patches;

@@ -642,6 +642,7 @@ struct GeometryDecoder::State {
   std::vector<std::uint64_t> versions;
   int cached_drop = -1;
   DecodedGeometry cached;
+  std::vector<PatchCoefficients> scratch;  // coefficients of the last result()
 };
 
 GeometryDecoder::GeometryDecoder() = default;
@@ -687,11 +688,14 @@ void GeometryDecoder::result(DecodedGeometry& out, int drop_finest_steps) {
     out = st.cached;
     return;
   }
-  std::vector<PatchCoefficients> coefs;
+  std::vector<PatchCoefficients>& coefs = st.scratch;  // reused: no allocation per call
   st.bits.reconstruct(coefs);
   const Ownership& own = st.own;
-  out.segments_complete = st.last.segments_complete;
-  out.partial = st.last.partial;
+  // The grids are built in the cache (its buffers are reused from call to call), then copied out.
+  DecodedGeometry& res = st.cached;
+  st.cached_drop = -1;  // invalid until complete
+  res.segments_complete = st.last.segments_complete;
+  res.partial = st.last.partial;
   st.ff.to_xyz(coefs);
   for (const auto& [copy, owner] : own.copies) {
     for (int c = 0; c < 3; ++c)
@@ -700,9 +704,9 @@ void GeometryDecoder::result(DecodedGeometry& out, int drop_finest_steps) {
   // Per patch (in parallel): drop the finest details, find the finest step with a non-zero detail, inverse
   // transform, dequantize.
   std::vector<int> finest(static_cast<std::size_t>(np), steps + 1);  // steps + 1: none
-  out.patches.resize(static_cast<std::size_t>(np));
+  res.patches.resize(static_cast<std::size_t>(np));
   parallel_for(np, st.options.max_threads, [&](int p) {
-    Grid3& g = out.patches[static_cast<std::size_t>(p)];
+    Grid3& g = res.patches[static_cast<std::size_t>(p)];
     g.level = level;
     g.values.resize(3 * samples);
     for (int c = 0; c < 3; ++c) {
@@ -748,10 +752,10 @@ void GeometryDecoder::result(DecodedGeometry& out, int drop_finest_steps) {
     }
   });
   const int finest_step = *std::min_element(finest.begin(), finest.end());
-  out.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
+  res.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
   st.versions = std::move(versions);
   st.cached_drop = drop;
-  st.cached = out;
+  out = st.cached;
 }
 
 Status decode_geometry(const GeometryCodecHeader& header,

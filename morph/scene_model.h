@@ -82,8 +82,8 @@ Similarity best_alignment(const SceneModel& model, const SceneModel& reference);
 void apply_similarity(const Similarity& xf, SceneModel& model);
 
 struct DecodeSettings {
-  /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 decodes B times with
-  /// drop_finest_steps = 0 … B−1).
+  /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 reconstructs one decode B times,
+  /// with drop_finest_steps = 0 … B−1).
   int bands = 1;
   /// Align models 1, 2, … to model 0 (best_alignment) so that morphs between them do not rotate or shrink.
   bool align = true;

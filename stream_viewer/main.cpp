@@ -45,6 +45,7 @@ struct Options {
   std::uint64_t limit_rate = 0;
   double timeout = 120;
   float yaw = 0.6f, pitch = 0.35f, distance = 3.2f;
+  bool distance_given = false;  // --distance: no automatic framing
 };
 
 struct Ui {
@@ -53,6 +54,7 @@ struct Ui {
   bool animate = false;
   float anim = 0;  // position in [0, models) when animating
   bool dragging = false;
+  bool camera_moved = false;  // the user dragged or zoomed: the camera is no longer framed automatically
   double last_x = 0, last_y = 0;
   int max_level = 0;
 };
@@ -104,6 +106,7 @@ void mouse_button(GLFWwindow* w, int button, int action, int) {
 void cursor_pos(GLFWwindow* w, double x, double y) {
   auto* ui = static_cast<Ui*>(glfwGetWindowUserPointer(w));
   if (!ui->dragging) return;
+  ui->camera_moved = true;
   ui->settings.camera.yaw -= static_cast<float>(x - ui->last_x) * 0.01f;
   ui->settings.camera.pitch = std::clamp(ui->settings.camera.pitch + static_cast<float>(y - ui->last_y) * 0.01f,
                                          -1.5f, 1.5f);
@@ -113,8 +116,24 @@ void cursor_pos(GLFWwindow* w, double x, double y) {
 
 void scroll(GLFWwindow* w, double, double dy) {
   auto* ui = static_cast<Ui*>(glfwGetWindowUserPointer(w));
+  ui->camera_moved = true;
   ui->settings.camera.distance = std::clamp(ui->settings.camera.distance * std::pow(0.9f, static_cast<float>(dy)),
                                             0.3f, 20.0f);
+}
+
+/// The xyz samples of the scene models' first layers (the geometry itself, or the coarse base of a banded
+/// model).
+std::vector<float> base_layers(const std::vector<morph::SceneModel>& models) {
+  std::vector<float> xyz;
+  for (const morph::SceneModel& m : models) {
+    const std::size_t per = 3u * static_cast<std::size_t>(m.size()) * static_cast<std::size_t>(m.size());
+    for (int p = 0; p < m.num_patches; ++p) {
+      const auto first =
+          m.positions.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(p) * m.bands * per);
+      xyz.insert(xyz.end(), first, first + static_cast<std::ptrdiff_t>(per));
+    }
+  }
+  return xyz;
 }
 
 /// Options that can only be checked once the manifest is known: "" or one line for exit code 2.
@@ -214,6 +233,11 @@ int run(const Options& opt) {
         total = u->total;
         detail = u->models[0].detail_level;
         ui.max_level = renderer.model_level(std::clamp(opt.model, 0, renderer.model_count() - 1));
+        // Frame all models together (~70 % of the height for the largest; they are aligned to the first, so a
+        // morph keeps one camera) until the user moves the camera or gave --distance.
+        if (!opt.distance_given && !ui.camera_moved)
+          ui.settings.camera.distance = framing_distance(ui.settings.camera, base_layers(u->models),
+                                                         ui.settings.width, ui.settings.height);
         std::cout << "geomip-view: showing " << shown_bytes << " of " << total << " bytes, detail level " << detail
                   << "/" << ui.max_level << "\n";
       }
@@ -396,9 +420,11 @@ int main(int argc, char** argv) {
   app.add_option("--timeout", opt.timeout, "headless: seconds to wait for the pack")->check(non_negative("seconds"));
   app.add_option("--yaw", opt.yaw, "camera yaw (radians)");
   app.add_option("--pitch", opt.pitch, "camera pitch (radians)");
-  app.add_option("--distance", opt.distance, "camera distance (normalized units)");
+  app.add_option("--distance", opt.distance,
+                 "camera distance (normalized units); default: the models fill about 70 % of the frame height");
   try {
     app.parse(argc, argv);
+    opt.distance_given = app.count("--distance") > 0;
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

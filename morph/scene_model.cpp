@@ -255,6 +255,13 @@ void apply_similarity(const Similarity& xf, SceneModel& model) {
   for (std::size_t k = 0; k + 2 < model.normals.size(); k += 3) rotate(&model.normals[k], 1.0);
 }
 
+Similarity up_rotation(char up) {
+  Similarity xf;
+  if (up == 'z') xf.rotation = {1, 0, 0, 0, 0, 1, 0, -1, 0};  // −90° about x: +z → +y, +y → −z
+  if (up == 'x') xf.rotation = {0, -1, 0, 1, 0, 0, 0, 0, 1};  // +90° about z: +x → +y, +y → −x
+  return xf;
+}
+
 std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
                                      codec::Status& status, std::size_t& bytes_used) {
   return SceneDecoder(settings).update(bytes, status, bytes_used);

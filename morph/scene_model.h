@@ -81,6 +81,10 @@ Similarity best_alignment(const SceneModel& model, const SceneModel& reference);
 /// normals rotated by R.
 void apply_similarity(const Similarity& xf, SceneModel& model);
 
+/// The rotation that turns the model's axis `up` ('x', 'y' or 'z'; anything else: identity) into +y, the
+/// viewer's up (a right-handed rotation by 90° about the third axis: z-up data such as the horse stands up).
+Similarity up_rotation(char up);
+
 struct DecodeSettings {
   /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 reconstructs one decode B times,
   /// with drop_finest_steps = 0 … B−1).

@@ -187,6 +187,21 @@ TEST(DecodeScene, AlignedModelsMorphWithoutCollapsing) {
   }
 }
 
+// --up: the chosen axis becomes +y (a rotation: lengths and handedness kept).
+TEST(UpRotation, TurnsTheUpAxisIntoPlusY) {
+  for (char up : {'x', 'y', 'z'}) {
+    const auto r = morph::up_rotation(up).rotation;
+    const int a = up - 'x';
+    // Column a of R is R·e_a: it must be +y.
+    EXPECT_EQ(r[static_cast<std::size_t>(a)], 0.0) << up;
+    EXPECT_EQ(r[static_cast<std::size_t>(3 + a)], 1.0) << up;
+    EXPECT_EQ(r[static_cast<std::size_t>(6 + a)], 0.0) << up;
+    const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                       r[2] * (r[3] * r[7] - r[4] * r[6]);
+    EXPECT_EQ(det, 1.0) << up;
+  }
+}
+
 // The streaming viewer's decoder (morph::SceneDecoder, each byte decoded once, the bands of the wavelet morph
 // from one decode) gives, after every update, exactly what a one-shot decode_scene of that prefix gives.
 TEST(SceneDecoder, StreamEqualsOneShotDecodeOfEveryPrefix) {

@@ -411,9 +411,9 @@ class PlaneCoder {
   struct Frame {
     std::uint16_t x, y;
     std::uint8_t l;
-    std::int8_t last;       // quadrant of the child processed last (−1: none yet)
-    std::uint8_t remaining; // active children not yet processed
-    bool any;               // a processed child was significant
+    std::int8_t last;        // quadrant of the child processed last (−1: none yet)
+    std::uint8_t remaining;  // active children not yet processed
+    bool any;                // a processed child was significant
   };
   struct Cursor {
     int plane = -1;
@@ -548,7 +548,8 @@ class PlaneCoder {
             int q = f.last + 1;
             for (;; ++q) {
               const int cx = 2 * f.x + (q & 1), cy = 2 * f.y + (q >> 1);
-              if (cx < band.lw[cl] && cy < band.lh[cl] && (band.state[band.node(cl, cx, cy)] & kActive)) break;
+              if (cx < band.lw[cl] && cy < band.lh[cl] && (band.state[band.node(cl, cx, cy)] & kActive))
+                break;
             }
             f.last = static_cast<std::int8_t>(q);
             --f.remaining;
@@ -830,12 +831,12 @@ struct StreamPart {
 
 /// Where one coder is: the plane in progress and what happened in the last update.
 struct CoderRun {
-  std::size_t next = 0;     ///< segment index of the plane in progress (or the next to start)
-  bool started = false;     ///< plane `next` was started (the coder's cursor is inside it)
-  std::size_t seen = 0;     ///< bytes of plane `next` given to the coder so far
-  bool partial = false;     ///< the last update stopped inside a present, incomplete part
+  std::size_t next = 0;  ///< segment index of the plane in progress (or the next to start)
+  bool started = false;  ///< plane `next` was started (the coder's cursor is inside it)
+  std::size_t seen = 0;  ///< bytes of plane `next` given to the coder so far
+  bool partial = false;  ///< the last update stopped inside a present, incomplete part
   bool corrupt = false;
-  std::exception_ptr error;  ///< anything else (allocation failure): rethrown by the caller's thread
+  std::exception_ptr error;   ///< anything else (allocation failure): rethrown by the caller's thread
   std::uint64_t version = 0;  ///< grows whenever the coder may have decoded something
 };
 
@@ -978,8 +979,8 @@ Status BitplaneDecoder::reset(const BitplaneLayout& layout, int top_bitplane,
                               std::vector<std::vector<std::uint8_t>> coded, int max_threads,
                               DecodeHook before_plane) {
   s_.reset();
-  if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) || top_bitplane < 0 ||
-      top_bitplane > 64) {
+  if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) ||
+      top_bitplane < 0 || top_bitplane > 64) {
     return Status::kInvalidArgument;
   }
   const std::size_t size = (std::size_t{1} << layout.level) + 1, samples = size * size;
@@ -1084,9 +1085,8 @@ Status BitplaneDecoder::update(std::span<const std::span<const std::uint8_t>> se
       }
       parallel_for(np, st.max_threads, [&](int c) {
         CoderRun& run = st.runs[static_cast<std::size_t>(c)];
-        advance(st.coders[static_cast<std::size_t>(c)], run, st.top, end, [&](std::size_t t) {
-          return st.splits[t - st.joint_planes].part(c);
-        });
+        advance(st.coders[static_cast<std::size_t>(c)], run, st.top, end,
+                [&](std::size_t t) { return st.splits[t - st.joint_planes].part(c); });
       });
       done = planes;
       for (const CoderRun& r : st.runs) {

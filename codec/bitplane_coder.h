@@ -50,10 +50,10 @@
 // the interleave a function of the sizes alone: byte k of stream p is placed at (k + ½)/size_p, merged by
 // that time. So the decoder takes the streams apart before decoding and runs the patches in parallel, and
 // a byte prefix of a segment holds the same fraction of every patch's plane — close to the order of one
-// joint coder. Per-patch coders from the first plane (separate contexts, sizes, flushes) and patch-major order
-// both cost surface PSNR at low rates; the joint start (geometry_codec: joint until 2 KB) and the interleave
-// remove both (figures: docs/measurements.md).
-// Version 1 (independent_patches false): one stream for all patches throughout; still decoded.
+// joint coder. Per-patch coders from the first plane (separate contexts, sizes, flushes) and patch-major
+// order both cost surface PSNR at low rates; the joint start (geometry_codec: joint until 2 KB) and the
+// interleave remove both (figures: docs/measurements.md). Version 1 (independent_patches false): one stream
+// for all patches throughout; still decoded.
 //
 // Decoding reconstructs each significant coefficient at the middle of its remaining uncertainty interval
 // (known bits down to plane q: |c| ∈ [known, known + 2^q), reconstructed as known + 2^(q−1)); insignificant

@@ -166,7 +166,9 @@ class Reader {
     return true;
   }
   /// Varint of at most 5 bytes (values < 2^35), canonical (no trailing zero byte).
-  bool varint(std::uint64_t& v) { return detail::read_varint(bytes_, pos_, v, 5, true) == detail::VarintRead::kOk; }
+  bool varint(std::uint64_t& v) {
+    return detail::read_varint(bytes_, pos_, v, 5, true) == detail::VarintRead::kOk;
+  }
   bool small_int(int& out, std::uint64_t max) {
     std::uint64_t v;
     if (!varint(v) || v > max) return false;
@@ -259,8 +261,8 @@ struct FrameField {
   std::vector<std::vector<std::array<std::int64_t, 3>>> normals;  // [patch][grid index]
   std::vector<std::uint8_t> ready;                                // [k − 1]: normals of step k computed
   // Frames built so far (an incremental decoder reconstructs many times from the same normals).
-  mutable std::vector<std::vector<Frame>> frames;          // [patch][grid index]
-  mutable std::vector<std::vector<std::uint8_t>> built;    // [patch][grid index]: frames[...] is valid
+  mutable std::vector<std::vector<Frame>> frames;        // [patch][grid index]
+  mutable std::vector<std::vector<std::uint8_t>> built;  // [patch][grid index]: frames[...] is valid
 
   /// The frame at a framed position (built when first needed: only non-zero coefficients need one; the
   /// normal of a position never changes once its step is ready).
@@ -662,8 +664,8 @@ Status GeometryDecoder::reset(const GeometryCodecHeader& header, const GeometryD
   const DecodeHook hook = [raw](int plane, std::vector<PatchCoefficients>& view) {
     raw->ff.compute(plane, view);
   };
-  const Status s = st->bits.reset(make_layout(header), header.top_bitplane, st->own.coded, options.max_threads,
-                                  hook);
+  const Status s =
+      st->bits.reset(make_layout(header), header.top_bitplane, st->own.coded, options.max_threads, hook);
   if (s != Status::kOk) return s;
   s_ = std::move(st);
   return Status::kOk;

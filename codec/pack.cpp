@@ -518,7 +518,8 @@ struct PackDecoder::State {
   void reset_stream(Model& m, std::size_t index, bool geometry) {
     const PackModelInfo& mi = info.models[index];
     if (geometry)
-      m.geometry.reset(mi.geometry, {.drop_finest_steps = options.drop_finest_steps, .max_threads = options.max_threads});
+      m.geometry.reset(mi.geometry,
+                       {.drop_finest_steps = options.drop_finest_steps, .max_threads = options.max_threads});
     else
       m.normals.reset(mi.normals, {.max_threads = options.max_threads});
   }
@@ -644,7 +645,8 @@ PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
       model.detail_level = decoded.detail_level;
       const bool any_normals =
           !sm.normal_chunks.empty() ||
-          (st.tail_chunk >= 0 && st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].model == static_cast<int>(m) &&
+          (st.tail_chunk >= 0 &&
+           st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].model == static_cast<int>(m) &&
            st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].kind == ChunkKind::kNormals);
       if (sm.with_normals && any_normals) {
         if (sm.normals_status != Status::kOk) result.status = Status::kCorrupt;

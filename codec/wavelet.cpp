@@ -43,7 +43,8 @@ void pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int sign) {
     std::vector<Taps> all(static_cast<std::size_t>(num_odds));
     for (int t = 0; t < num_odds; ++t) all[static_cast<std::size_t>(t)] = taps(t, num_evens, cubic);
     const std::ptrdiff_t step = 2 * static_cast<std::ptrdiff_t>(s);
-    const bool interior = cubic && num_evens >= 4;  // then taps(t) for 0 < t < num_odds − 1 are (−1, 9, 9, −1)
+    const bool interior =
+        cubic && num_evens >= 4;  // then taps(t) for 0 < t < num_odds − 1 are (−1, 9, 9, −1)
     for (int j = 0; j < size; j += s) {
       std::int32_t* row = g + static_cast<std::ptrdiff_t>(j) * size;
       int t = 0;

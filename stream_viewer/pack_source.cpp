@@ -17,7 +17,8 @@ double thread_cpu_ms() {
 
 }  // namespace
 
-PackSource::PackSource(const std::string& source, FetchOptions fetch, morph::DecodeSettings decode) : decode_(decode) {
+PackSource::PackSource(const std::string& source, FetchOptions fetch, morph::DecodeSettings decode)
+    : decode_(decode) {
   fetcher_ = std::make_unique<Fetcher>(source, fetch, [this] { wake_.notify_all(); });
   decoder_ = std::thread([this] { decode_loop(); });
 }
@@ -88,7 +89,8 @@ void PackSource::decode_chunks() {
         const std::uint64_t received = fetcher_->received();
         if (!info) info = fetcher_->info();
         std::size_t c = next_chunk;
-        while (info && c < info->chunks.size() && info->chunks[c].offset + info->chunks[c].size <= received) ++c;
+        while (info && c < info->chunks.size() && info->chunks[c].offset + info->chunks[c].size <= received)
+          ++c;
         if (info && c > next_chunk && decode_error_.empty()) {
           next_chunk = c;
           end = info->chunks[c - 1].offset + info->chunks[c - 1].size;
@@ -111,7 +113,8 @@ void PackSource::decode_chunks() {
       const double cpu0 = thread_cpu_ms();
       models = scene.update({fetcher_->data(), static_cast<std::size_t>(end)}, status, used);
       const double cpu = thread_cpu_ms() - cpu0;
-      const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      const double wall =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       std::lock_guard<std::mutex> lock(mutex_);
       decode_stats_.updates += 1;
       decode_stats_.thread_cpu_ms += cpu;
@@ -120,12 +123,14 @@ void PackSource::decode_chunks() {
       err = std::string("decode failed: ") + e.what();
     }
     if (status == codec::Status::kCorrupt || status == codec::Status::kUnsupportedVersion)
-      err = "decode stopped at byte " + std::to_string(used) + ": " + std::string(codec::status_message(status));
+      err = "decode stopped at byte " + std::to_string(used) + ": " +
+            std::string(codec::status_message(status));
     std::lock_guard<std::mutex> lock(mutex_);
     if (!err.empty() && decode_error_.empty()) decode_error_ = err;  // later chunks are not decoded
     decoded_end_ = end;
     // bytes_used: what the shown models really come from (less than `end` when a chunk failed its CRC)
-    if (!models.empty()) pending_ = SourceUpdate{std::move(models), std::min<std::uint64_t>(used, end), fetcher_->total()};
+    if (!models.empty())
+      pending_ = SourceUpdate{std::move(models), std::min<std::uint64_t>(used, end), fetcher_->total()};
   }
 }
 

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "codec/pack.h"
-#include "stream_viewer/fetcher.h"
 #include "morph/scene_model.h"
+#include "stream_viewer/fetcher.h"
 
 namespace geomip::viewer {
 

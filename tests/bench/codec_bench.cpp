@@ -12,7 +12,8 @@
 // Draco's in-process decode of that full mesh (14-bit positions, compression level 10, best of the same
 // repetitions) and geomip's full decode as a ratio to it.
 //
-// For instruction counts (valgrind --tool=callgrind, repeatable on a shared machine), one decode on one thread:
+// For instruction counts (valgrind --tool=callgrind, repeatable on a shared machine), one decode on one
+// thread:
 //   codec_bench --decode-once FILE.gip full|increments|shown
 // (full: decode_pack; increments: 64 PackDecoder updates, models at the end; shown: models after each).
 //
@@ -41,8 +42,8 @@
 #include <thread>
 #include <vector>
 
-#include "codec/geometry_codec.h"
 #include "baselines/draco_baseline.h"
+#include "codec/geometry_codec.h"
 #include "codec/pack.h"
 #include "gimage/exr_io.h"
 #include "gimage/surface_distance.h"
@@ -285,7 +286,8 @@ double best_ms(int reps, F&& f) {
   for (int k = 0; k < reps; ++k) {
     const auto t0 = std::chrono::steady_clock::now();
     f();
-    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    best = std::min(best,
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   return best;
 }
@@ -297,7 +299,8 @@ int stream_report(const std::string& path, const char* mesh_path) {
   const int reps = std::getenv("CODEC_DECODE_REPS") ? std::atoi(std::getenv("CODEC_DECODE_REPS")) : 10;
   constexpr int kIncrements = 64;
   std::vector<std::size_t> cuts;
-  for (int k = 1; k <= kIncrements; ++k) cuts.push_back(pack.size() * static_cast<std::size_t>(k) / kIncrements);
+  for (int k = 1; k <= kIncrements; ++k)
+    cuts.push_back(pack.size() * static_cast<std::size_t>(k) / kIncrements);
   std::printf("%s: %zu bytes, %u hardware threads, best of %d\n", path.c_str(), pack.size(),
               std::thread::hardware_concurrency(), reps);
   for (int threads : {1, 0}) {
@@ -317,7 +320,8 @@ int stream_report(const std::string& path, const char* mesh_path) {
       benchmark::DoNotOptimize(decoder.result());
     });
     const double prefixes = best_ms(std::max(1, reps / 5), [&] {
-      for (std::size_t n : cuts) benchmark::DoNotOptimize(decode_pack(pack, {.max_bytes = n, .max_threads = threads}));
+      for (std::size_t n : cuts)
+        benchmark::DoNotOptimize(decode_pack(pack, {.max_bytes = n, .max_threads = threads}));
     });
     std::printf("  %-9s full decode %7.2f ms (%s, detail level %d)\n", threads == 1 ? "1 thread" : "threads",
                 full, std::string(status_message(r.status)).c_str(),
@@ -354,7 +358,8 @@ int decode_once(const std::string& path, const std::string& mode) {
   }
   PackDecoder decoder(options);
   for (int k = 1; k <= 64; ++k) {
-    decoder.update(std::span<const std::uint8_t>(pack.data(), pack.size() * static_cast<std::size_t>(k) / 64));
+    decoder.update(
+        std::span<const std::uint8_t>(pack.data(), pack.size() * static_cast<std::size_t>(k) / 64));
     if (mode == "shown") benchmark::DoNotOptimize(decoder.result());
   }
   benchmark::DoNotOptimize(decoder.result());

@@ -21,7 +21,8 @@ namespace {
 
 /// A pillow with deterministic noise (so that the bottom bit-planes are large), optionally with normal maps
 /// and with `extra_patches` more patches (copies of the pillow's, scaled, not glued: P = 2 + extra_patches).
-PackModelInput noisy_pillow(int level, const std::string& name, bool normals, int extra_patches, unsigned seed) {
+PackModelInput noisy_pillow(int level, const std::string& name, bool normals, int extra_patches,
+                            unsigned seed) {
   test::Pillow p = test::make_pillow(level, 1.0);
   PackModelInput m;
   m.name = name;
@@ -198,9 +199,11 @@ TEST(IncrementalDecode, CrcFailureAfterAPartialChunkEqualsOneShotDecode) {
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   const ChunkInfo& chunk = info.chunks[info.chunks.size() / 2];
   ASSERT_GT(chunk.size, 8u);
-  pack[static_cast<std::size_t>(chunk.offset + chunk.size - 1)] ^= 0x40;  // its last byte: the prefix is intact
+  pack[static_cast<std::size_t>(chunk.offset + chunk.size - 1)] ^=
+      0x40;  // its last byte: the prefix is intact
   const std::vector<std::size_t> cuts = {static_cast<std::size_t>(chunk.offset + chunk.size / 2),
-                                         static_cast<std::size_t>(chunk.offset + chunk.size + 3), pack.size()};
+                                         static_cast<std::size_t>(chunk.offset + chunk.size + 3),
+                                         pack.size()};
   check_split(pack, cuts, {}, "flipped last byte of chunk");
   PackDecoder decoder;
   for (std::size_t n : cuts) decoder.update(std::span<const std::uint8_t>(pack.data(), n));

@@ -1,6 +1,6 @@
 // A closed two-patch test surface for codec tests: a "pillow" over [−1,1]², the top patch z = h(x, y), the
-// bottom patch z = −h with its (i, j) transposed so both are oriented outward; h = 0 on the square's border, so
-// the four sides are glued (reversed), and seam samples are bit-identical in both patches.
+// bottom patch z = −h with its (i, j) transposed so both are oriented outward; h = 0 on the square's border,
+// so the four sides are glued (reversed), and seam samples are bit-identical in both patches.
 #pragma once
 
 #include "codec/geometry_codec.h"
@@ -68,10 +68,18 @@ inline Pillow make_pillow(int level, double scale = 1.0) {
 inline void side_sample(int level, int side, int k, int& i, int& j) {
   const int last = 1 << level;
   switch (side) {
-    case 0: i = k, j = 0; break;
-    case 1: i = last, j = k; break;
-    case 2: i = last - k, j = last; break;
-    default: i = 0, j = last - k; break;
+    case 0:
+      i = k, j = 0;
+      break;
+    case 1:
+      i = last, j = k;
+      break;
+    case 2:
+      i = last - k, j = last;
+      break;
+    default:
+      i = 0, j = last - k;
+      break;
   }
 }
 

@@ -8,8 +8,8 @@
 // fuzzer's time on them would leave it at ~25 inputs/s instead of a thousand and more. The check is here, in
 // the harness: it reads the same manifest the decoder reads, with read_pack_info(), and changes nothing in
 // codec/.
-#include "tests/fuzz/fuzz_bounds.h"
 #include "codec/pack.h"
+#include "tests/fuzz/fuzz_bounds.h"
 
 #include <algorithm>
 #include <cstddef>

@@ -129,7 +129,7 @@ TEST(Alignment, RecoversAKnownSimilarity) {
     EXPECT_NEAR(det, 1.0, 1e-9);
   }
   EXPECT_THROW(morph::best_alignment(morph::make_scene_model(testing::decoded_model(4, 1)),
-                              morph::make_scene_model(testing::decoded_model(3, 1))),
+                                     morph::make_scene_model(testing::decoded_model(3, 1))),
                std::invalid_argument);
 }
 
@@ -164,7 +164,8 @@ TEST(DecodeScene, AlignedModelsMorphWithoutCollapsing) {
   for (bool align : {true, false}) {
     codec::Status status;
     std::size_t used = 0;
-    const auto models = morph::decode_scene(bytes, morph::DecodeSettings{.bands = 1, .align = align}, status, used);
+    const auto models =
+        morph::decode_scene(bytes, morph::DecodeSettings{.bands = 1, .align = align}, status, used);
     ASSERT_EQ(models.size(), 2u);
     const auto mid = morph::evaluate_morph(models[0], models[1], 0.5f, morph::MorphSchedule::kLinear);
     std::vector<float> all;
@@ -212,7 +213,8 @@ TEST(SceneDecoder, StreamEqualsOneShotDecodeOfEveryPrefix) {
       codec::Status status = codec::Status::kOk, one_status = codec::Status::kOk;
       std::size_t used = 0, one_used = 0;
       const auto models = decoder.update({bytes.data(), n}, status, used);
-      const auto one = morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands}, one_status, one_used);
+      const auto one =
+          morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands}, one_status, one_used);
       EXPECT_EQ(status, one_status) << n;
       EXPECT_EQ(used, one_used) << n;
       ASSERT_EQ(models.size(), one.size()) << n;
@@ -221,7 +223,8 @@ TEST(SceneDecoder, StreamEqualsOneShotDecodeOfEveryPrefix) {
         EXPECT_EQ(models[m].detail_level, one[m].detail_level) << n;
         ASSERT_EQ(models[m].positions.size(), one[m].positions.size());
         EXPECT_EQ(std::memcmp(models[m].positions.data(), one[m].positions.data(),
-                              models[m].positions.size() * sizeof(float)), 0)
+                              models[m].positions.size() * sizeof(float)),
+                  0)
             << n << " bytes, model " << m << ", " << bands << " bands";
         EXPECT_EQ(models[m].normals, one[m].normals) << n;
       }
@@ -229,9 +232,9 @@ TEST(SceneDecoder, StreamEqualsOneShotDecodeOfEveryPrefix) {
   }
 }
 
-// What the streaming viewer does with every prefix that arrives: morph::decode_scene never throws on a prefix, and
-// gives either nothing (no geometry pass of model 0 yet) or both models at the pack's level, finite, with
-// more bytes never giving fewer models.
+// What the streaming viewer does with every prefix that arrives: morph::decode_scene never throws on a
+// prefix, and gives either nothing (no geometry pass of model 0 yet) or both models at the pack's level,
+// finite, with more bytes never giving fewer models.
 TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
   const auto bytes = codec::write_pack({testing::pack_input(4, 0), testing::pack_input(4, 1)});
   bool seen_models = false;
@@ -240,7 +243,8 @@ TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
     std::size_t used = 0;
     std::vector<morph::SceneModel> models;
     for (int bands : {1, 3}) {
-      ASSERT_NO_THROW(models = morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands}, status, used))
+      ASSERT_NO_THROW(models = morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands},
+                                                   status, used))
           << n << " bytes";
       EXPECT_LE(used, n);
       if (models.empty()) {

@@ -120,6 +120,24 @@ class ArithmeticDecoder {
   /// True once the decoder has needed a byte beyond the end of its span. Symbols decoded while this was
   /// false are the encoded ones (prefix property, see the file comment).
   bool exhausted() const { return exhausted_; }
+  /// Bytes of the span consumed so far.
+  std::size_t position() const { return pos_; }
+
+  /// Continues over `bytes`, a longer (or equal) prefix of the same stream than the span so far (it may live
+  /// elsewhere in memory: only its contents must extend the old ones). The zero bytes that stood in for the
+  /// missing ones are replaced by the real ones that have now arrived, so a decoder that stopped at the first
+  /// symbol after exhausted() became true continues exactly as if it had had all the bytes from the start
+  /// (incremental decoding). Call it only while the decoder stopped there (no symbol decoded while
+  /// exhausted()).
+  void extend(std::span<const std::uint8_t> bytes) {
+    bytes_ = bytes;
+    // The missing_ zero bytes sit in the low bytes of code_, the first missing one highest.
+    while (missing_ > 0 && pos_ < bytes_.size()) {
+      --missing_;
+      code_ += static_cast<std::uint32_t>(bytes_[pos_++]) << (8 * missing_);
+    }
+    exhausted_ = missing_ > 0;
+  }
 
  private:
   static constexpr std::uint32_t kTop = 1u << 24;
@@ -132,6 +150,7 @@ class ArithmeticDecoder {
   std::uint32_t next_byte() {
     if (pos_ < bytes_.size()) return bytes_[pos_++];
     exhausted_ = true;
+    ++missing_;  // only meaningful (≤ 4) while the caller stops at exhaustion; see extend()
     return 0;
   }
 
@@ -139,6 +158,7 @@ class ArithmeticDecoder {
   std::size_t pos_ = 0;
   std::uint32_t code_ = 0;
   std::uint32_t range_ = 0xFFFFFFFFu;
+  std::uint32_t missing_ = 0;  ///< zero bytes read past the span since it was last extended
   bool exhausted_ = false;
 };
 

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cstdlib>
 #include <exception>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -61,7 +62,8 @@ constexpr std::uint64_t kMaxStreamBytes = std::uint64_t{1} << 30;
 
 class Interleaver {
  public:
-  explicit Interleaver(std::span<const std::uint64_t> sizes) : sizes_(sizes), taken_(sizes.size(), 0) {}
+  explicit Interleaver(std::span<const std::uint64_t> sizes)
+      : sizes_(sizes.begin(), sizes.end()), taken_(sizes.size(), 0) {}
   /// The stream the next byte belongs to, or −1 when all are exhausted.
   int next() {
     int best = -1;
@@ -79,11 +81,10 @@ class Interleaver {
   }
 
  private:
-  std::span<const std::uint64_t> sizes_;
+  std::vector<std::uint64_t> sizes_;
   std::vector<std::uint64_t> taken_;
 };
 
-struct Stop {};     // the partial tail is exhausted
 struct Corrupt {};  // bytes that no encoder writes
 
 bool layout_ok(const BitplaneLayout& layout) {
@@ -209,11 +210,10 @@ class PlaneCoder {
   /// per symbol).
   void set_decoder(std::span<const std::uint8_t> bytes) { dec_ = ArithmeticDecoder(bytes); }
 
-  /// One weighted bit-plane: sorting pass over every band, then refinement pass over every band.
-  /// kCheck: the stream may be a byte prefix; stop (throw Stop) before the first symbol that needs a byte
-  /// past it.
-  template <bool kCheck>
+  /// Encoder: one weighted bit-plane, sorting pass over every band, then refinement pass over every band.
+  /// (The decoder walks the same decisions in resume().)
   void code_plane(int b) {
+    static_assert(!kDecode, "the decoder uses start_plane() and resume()");
     for (Band* band : mine_) band->refine_count = band->lsp.size();
     for (Band* bp : mine_) {
       Band& band = *bp;
@@ -223,40 +223,19 @@ class PlaneCoder {
       // lis is swapped only after the loop; process() appends to lis_next only.
       for (std::size_t n = 0; n < band.lis.size(); ++n) {
         const std::uint32_t packed = band.lis[n];
-        process<kCheck>(band, static_cast<int>(packed >> 28), static_cast<int>((packed >> 14) & 0x3FFF),
-                        static_cast<int>(packed & 0x3FFF), p, false);
+        process(band, static_cast<int>(packed >> 28), static_cast<int>((packed >> 14) & 0x3FFF),
+                static_cast<int>(packed & 0x3FFF), p, false);
       }
       std::swap(band.lis, band.lis_next);
     }
     for (Band* bp : mine_) {
       const int p = b - bp->offset;
       if (p < 0) continue;
-      refine<kCheck>(*bp, p);
+      refine(*bp, p);
     }
   }
 
  private:
-  template <bool kCheck>
-  int sym(int bit, Context& ctx) {
-    if constexpr (kDecode) {
-      if (kCheck && dec_.exhausted()) throw Stop{};
-      return dec_.decode(ctx);
-    } else {
-      enc_->encode(bit, ctx);
-      return bit;
-    }
-  }
-  template <bool kCheck>
-  int raw(int bit) {
-    if constexpr (kDecode) {
-      if (kCheck && dec_.exhausted()) throw Stop{};
-      return dec_.decode_bypass();
-    } else {
-      enc_->encode_bypass(bit);
-      return bit;
-    }
-  }
-
   int node_context(const Band& band, int l, int x, int y) const {
     const std::uint8_t* st = band.state.data() + band.lbase[l];
     const int w = band.lw[l], h = band.lh[l];
@@ -276,30 +255,26 @@ class PlaneCoder {
     return ((((band.cls * 3 + band.kcls) * 4 + std::min(l, 3)) * 3 + nbr) * 2) + par;
   }
 
-  std::int32_t coef(const Band& band, std::uint32_t index, int c) const {
-    return (*coefs_)[band.patch][c][index];
+  std::uint32_t magnitude(const Band& band, std::uint32_t index, int c) const {
+    const std::int32_t v = (*coefs_)[band.patch][c][index];
+    return static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v);
   }
 
-  /// Tests node (l, x, y) of `band` at plain plane p (known significant when `inferred`); splits it if
-  /// significant.
-  template <bool kCheck>
+  /// Encoder: tests node (l, x, y) of `band` at plain plane p (known significant when `inferred`); splits it
+  /// if significant.
   void process(Band& band, int l, int x, int y, int p, bool inferred) {
     const std::size_t idx = band.node(l, x, y);
-    int bit = 1;
     if (!inferred) {
-      if constexpr (!kDecode) bit = band.msb[idx] >= p;
-      bit = sym<kCheck>(bit, node_ctx_[node_context(band, l, x, y)]);
+      const int bit = band.msb[idx] >= p;
+      enc_->encode(bit, node_ctx_[node_context(band, l, x, y)]);
       if (!bit) {
         band.lis_next.push_back(pack(l, x, y));
         return;
       }
-      if constexpr (kDecode) {
-        if (p > kMaxCoefficientPlane) throw Corrupt{};
-      }
     }
     band.state[idx] |= kSig;
     if (l == 0) {
-      new_sample<kCheck>(band, x, y, p);
+      new_sample(band, x, y, p);
       return;
     }
     // Children at level l − 1; the last active one is significant for sure when no sibling was.
@@ -319,74 +294,44 @@ class PlaneCoder {
     for (int i = 0; i < count; ++i) {
       const int cx = children[i][0], cy = children[i][1];
       const bool infer = (i == count - 1) && !any;
-      process<kCheck>(band, cl, cx, cy, p, infer);
+      process(band, cl, cx, cy, p, infer);
       any = any || (band.state[band.node(cl, cx, cy)] & kSig);
     }
   }
 
-  template <bool kCheck>
   void new_sample(Band& band, int x, int y, int p) {
     const std::uint32_t index = band.grid_index(x, y, size_);
     band.lsp.push_back(Sample{index, {0, 0, 0}, {0, 0, 0}, 0});
-    const std::size_t at = band.lsp.size() - 1;  // band.lsp is not resized below: a reference is safe
-    Sample& s = band.lsp[at];
     bool any = false;
     for (int c = 0; c < 3; ++c) {
-      int bit = 1, negative = 0;
-      if constexpr (!kDecode) {
-        const std::int32_t v = coef(band, index, c);
-        const std::uint32_t m = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v);
-        bit = (m >> p) & 1;
-        negative = v < 0;
-      }
-      if (c < 2 || any) bit = sym<kCheck>(bit, chan_ctx_[(band.cls * 3 + c) * 2 + any]);
+      const int bit = (magnitude(band, index, c) >> p) & 1;
+      if (c < 2 || any) enc_->encode(bit, chan_ctx_[(band.cls * 3 + c) * 2 + any]);
       if (bit) {
-        negative = raw<kCheck>(negative);
-        s.mag[c] = 1u << p;
-        s.q[c] = static_cast<std::uint8_t>(p);
-        s.flags |= static_cast<std::uint8_t>((1 << c) | (negative << (3 + c)));
+        enc_->encode_bypass((*coefs_)[band.patch][c][index] < 0);
+        band.lsp.back().flags |= static_cast<std::uint8_t>(1 << c);
         any = true;
       }
     }
   }
 
-  template <bool kCheck>
   void refine(Band& band, int p) {
-    if constexpr (kDecode && !kCheck) {
-      refine_fast(band, p);
-      return;
-    }
     for (std::size_t n = 0; n < band.refine_count; ++n) {
       Sample& s = band.lsp[n];
       for (int c = 0; c < 3; ++c) {
-        int bit = 0, negative = 0;
-        if constexpr (!kDecode) {
-          const std::int32_t v = coef(band, s.index, c);
-          const std::uint32_t m = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v);
-          bit = (m >> p) & 1;
-          negative = v < 0;
-        }
+        const std::uint32_t m = magnitude(band, s.index, c);
+        const int bit = (m >> p) & 1;
         if (s.flags & (1 << c)) {
           // Only the first refinement bit (just the leading one known) is context coded; see the header.
-          std::uint32_t known;
-          if constexpr (kDecode) {
-            known = s.mag[c] >> (p + 1);
+          if ((m >> (p + 1)) == 1) {
+            enc_->encode(bit, ref_ctx_[band.cls]);
           } else {
-            const std::int32_t v = coef(band, s.index, c);
-            known = static_cast<std::uint32_t>(v < 0 ? -static_cast<std::int64_t>(v) : v) >> (p + 1);
-          }
-          bit = known == 1 ? sym<kCheck>(bit, ref_ctx_[band.cls]) : raw<kCheck>(bit);
-          if constexpr (kDecode) {
-            s.mag[c] |= static_cast<std::uint32_t>(bit) << p;
-            s.q[c] = static_cast<std::uint8_t>(p);
+            enc_->encode_bypass(bit);
           }
         } else {
-          bit = sym<kCheck>(bit, late_ctx_[band.cls * 3 + c]);
+          enc_->encode(bit, late_ctx_[band.cls * 3 + c]);
           if (bit) {
-            negative = raw<kCheck>(negative);
-            s.mag[c] = 1u << p;
-            s.q[c] = static_cast<std::uint8_t>(p);
-            s.flags |= static_cast<std::uint8_t>((1 << c) | (negative << (3 + c)));
+            enc_->encode_bypass((*coefs_)[band.patch][c][s.index] < 0);
+            s.flags |= static_cast<std::uint8_t>(1 << c);
           }
         }
       }
@@ -395,13 +340,14 @@ class PlaneCoder {
 
   /// The decoder's refinement pass over complete segments: the same decisions as refine(), with the range
   /// decoder's state in locals (stores through Sample would otherwise force it back to memory per symbol).
-  void refine_fast(Band& band, int p) {
+  /// Starts at sample `first`.
+  void refine_fast(Band& band, int p, std::size_t first = 0) {
     ArithmeticDecoder d = dec_;
     Sample* lsp = band.lsp.data();
     const std::size_t count = band.refine_count;
     Context* ref = &ref_ctx_[band.cls];
     Context* late = &late_ctx_[band.cls * 3];
-    for (std::size_t n = 0; n < count; ++n) {
+    for (std::size_t n = first; n < count; ++n) {
       Sample& s = lsp[n];
       std::uint32_t flags = s.flags;
       for (int c = 0; c < 3; ++c) {
@@ -422,6 +368,255 @@ class PlaneCoder {
     dec_ = d;
   }
 
+  // ---- the decoder's resumable traversal (incremental decoding) ----
+  //
+  // The same decisions as code_plane(), process(), new_sample() and refine(), in the same order, but as a
+  // loop over an explicit cursor instead of a recursion: when the bytes of a partial stream run out, the
+  // decoder stops before the symbol that needs them and keeps its place (the cursor), and resume() goes on
+  // from there once extend() gave it more bytes. So every byte is decoded once however the stream arrives.
+ public:
+  /// Byte position of the range decoder in the current plane's stream.
+  std::size_t position() const { return dec_.position(); }
+  /// Starts plane `b` (the next resume() decodes it from its beginning).
+  void start_plane(int b) {
+    cur_ = Cursor{};
+    cur_.plane = b;
+  }
+  /// Gives the decoder a longer prefix of the current plane's stream (the same bytes first).
+  void extend(std::span<const std::uint8_t> bytes) { dec_.extend(bytes); }
+  /// Decodes on in the current plane. kCheck: the stream may be a byte prefix; stop before the first symbol
+  /// that needs a byte past it. Returns true when the plane is finished. Throws Corrupt.
+  template <bool kCheck>
+  bool resume() {
+    Cursor& k = cur_;
+    if (k.pass == 0) {
+      for (Band* band : mine_) band->refine_count = band->lsp.size();
+      k.pass = 1;
+    }
+    if (k.pass == 1) {
+      if (!sort_pass<kCheck>()) return false;
+      k.pass = 2, k.band = 0, k.n = 0, k.c = 0, k.sub = 0;
+    }
+    if (k.pass == 2) {
+      if (!refine_pass<kCheck>()) return false;
+      k.pass = 3;
+    }
+    return true;
+  }
+  /// The plane being decoded is finished (or none was started).
+  bool plane_done() const { return cur_.pass == 3 || cur_.plane < 0; }
+
+ private:
+  enum : std::uint8_t { kBandStart, kLisEntry, kTest, kChannel, kSign, kNext };
+  struct Frame {
+    std::uint16_t x, y;
+    std::uint8_t l;
+    std::int8_t last;        // quadrant of the child processed last (−1: none yet)
+    std::uint8_t remaining;  // active children not yet processed
+    bool any;                // a processed child was significant
+  };
+  struct Cursor {
+    int plane = -1;
+    int pass = 0;  // 0 not started, 1 sorting, 2 refinement, 3 done
+    std::size_t band = 0, n = 0;
+    std::uint8_t pc = kBandStart;
+    int depth = 0;
+    Frame stack[kMaxQuadLevels];
+    int l = 0, x = 0, y = 0;
+    bool inferred = false, any = false;
+    int c = 0, sub = 0;
+  };
+
+  template <bool kCheck>
+  bool sort_pass() {
+    Cursor& k = cur_;
+    ArithmeticDecoder d = dec_;
+    const int b = k.plane;
+    for (; k.band < mine_.size(); ++k.band, k.pc = kBandStart) {
+      Band& band = *mine_[k.band];
+      const int p = b - band.offset;
+      if (k.pc == kBandStart) {
+        if (p < 0 || band.lis.empty() || (band.start >= 0 && b > band.start)) continue;
+        band.lis_next.clear();
+        k.n = 0;
+        k.pc = kLisEntry;
+      }
+      for (bool band_done = false; !band_done;) {
+        switch (k.pc) {
+          case kLisEntry: {
+            if (k.n == band.lis.size()) {
+              band_done = true;
+              break;
+            }
+            const std::uint32_t packed = band.lis[k.n];
+            k.l = static_cast<int>(packed >> 28);
+            k.x = static_cast<int>((packed >> 14) & 0x3FFF);
+            k.y = static_cast<int>(packed & 0x3FFF);
+            k.inferred = false;
+            k.depth = 0;
+            k.pc = kTest;
+            break;
+          }
+          case kTest: {
+            if (!k.inferred) {
+              if (kCheck && d.exhausted()) {
+                dec_ = d;
+                return false;
+              }
+              if (!d.decode(node_ctx_[node_context(band, k.l, k.x, k.y)])) {
+                band.lis_next.push_back(pack(k.l, k.x, k.y));
+                k.pc = kNext;
+                break;
+              }
+              if (p > kMaxCoefficientPlane) throw Corrupt{};
+            }
+            band.state[band.node(k.l, k.x, k.y)] |= kSig;
+            if (k.l == 0) {
+              band.lsp.push_back(Sample{band.grid_index(k.x, k.y, size_), {0, 0, 0}, {0, 0, 0}, 0});
+              k.c = 0;
+              k.any = false;
+              k.pc = kChannel;
+              break;
+            }
+            Frame& f = k.stack[k.depth++];
+            f.x = static_cast<std::uint16_t>(k.x);
+            f.y = static_cast<std::uint16_t>(k.y);
+            f.l = static_cast<std::uint8_t>(k.l);
+            f.last = -1;
+            f.any = false;
+            f.remaining = 0;
+            const int cl = k.l - 1;
+            for (int q = 0; q < 4; ++q) {
+              const int cx = 2 * k.x + (q & 1), cy = 2 * k.y + (q >> 1);
+              if (cx < band.lw[cl] && cy < band.lh[cl] && (band.state[band.node(cl, cx, cy)] & kActive))
+                ++f.remaining;
+            }
+            k.pc = kNext;
+            break;
+          }
+          case kChannel: {
+            if (k.c == 3) {
+              k.pc = kNext;
+              break;
+            }
+            int bit = 1;
+            if (k.c < 2 || k.any) {
+              if (kCheck && d.exhausted()) {
+                dec_ = d;
+                return false;
+              }
+              bit = d.decode(chan_ctx_[(band.cls * 3 + k.c) * 2 + k.any]);
+            }
+            if (bit) {
+              k.pc = kSign;
+            } else {
+              ++k.c;
+            }
+            break;
+          }
+          case kSign: {
+            if (kCheck && d.exhausted()) {
+              dec_ = d;
+              return false;
+            }
+            const int negative = d.decode_bypass();
+            Sample& sm = band.lsp.back();
+            sm.mag[k.c] = 1u << p;
+            sm.q[k.c] = static_cast<std::uint8_t>(p);
+            sm.flags |= static_cast<std::uint8_t>((1 << k.c) | (negative << (3 + k.c)));
+            k.any = true;
+            ++k.c;
+            k.pc = kChannel;
+            break;
+          }
+          default: {  // kNext: the node or sample in hand is finished; go to the next one
+            if (k.depth == 0) {
+              ++k.n;
+              k.pc = kLisEntry;
+              break;
+            }
+            Frame& f = k.stack[k.depth - 1];
+            const int cl = f.l - 1;
+            if (f.last >= 0) {
+              const int lx = 2 * f.x + (f.last & 1), ly = 2 * f.y + (f.last >> 1);
+              f.any = f.any || (band.state[band.node(cl, lx, ly)] & kSig);
+            }
+            if (f.remaining == 0) {
+              --k.depth;
+              break;
+            }
+            int q = f.last + 1;
+            for (;; ++q) {
+              const int cx = 2 * f.x + (q & 1), cy = 2 * f.y + (q >> 1);
+              if (cx < band.lw[cl] && cy < band.lh[cl] && (band.state[band.node(cl, cx, cy)] & kActive))
+                break;
+            }
+            f.last = static_cast<std::int8_t>(q);
+            --f.remaining;
+            k.l = cl;
+            k.x = 2 * f.x + (q & 1);
+            k.y = 2 * f.y + (q >> 1);
+            k.inferred = f.remaining == 0 && !f.any;
+            k.pc = kTest;
+            break;
+          }
+        }
+      }
+      std::swap(band.lis, band.lis_next);
+    }
+    dec_ = d;
+    return true;
+  }
+
+  template <bool kCheck>
+  bool refine_pass() {
+    Cursor& k = cur_;
+    const int b = k.plane;
+    for (; k.band < mine_.size(); ++k.band, k.n = 0) {
+      Band& band = *mine_[k.band];
+      const int p = b - band.offset;
+      if (p < 0) continue;
+      ArithmeticDecoder d = dec_;
+      Context* ref = &ref_ctx_[band.cls];
+      Context* late = &late_ctx_[band.cls * 3];
+      for (; k.n < band.refine_count; ++k.n, k.c = 0) {
+        if (!kCheck && k.c == 0 && k.sub == 0) break;  // sample boundary: the fast loop takes over
+        Sample& sm = band.lsp[k.n];
+        for (; k.c < 3; ++k.c) {
+          if (k.sub == 0) {
+            if (kCheck && d.exhausted()) {
+              dec_ = d;
+              return false;
+            }
+            if (sm.flags & (1u << k.c)) {
+              const std::uint32_t known = sm.mag[k.c] >> (p + 1);
+              const int bit = known == 1 ? d.decode(*ref) : d.decode_bypass();
+              sm.mag[k.c] |= static_cast<std::uint32_t>(bit) << p;
+              sm.q[k.c] = static_cast<std::uint8_t>(p);
+            } else if (d.decode(late[k.c])) {
+              k.sub = 1;
+            }
+          }
+          if (k.sub == 1) {
+            if (kCheck && d.exhausted()) {
+              dec_ = d;
+              return false;
+            }
+            const std::uint32_t negative = static_cast<std::uint32_t>(d.decode_bypass());
+            sm.mag[k.c] = 1u << p;
+            sm.q[k.c] = static_cast<std::uint8_t>(p);
+            sm.flags = static_cast<std::uint8_t>(sm.flags | (1u << k.c) | (negative << (3 + k.c)));
+            k.sub = 0;
+          }
+        }
+      }
+      dec_ = d;
+      if (!kCheck) refine_fast(band, p, k.n);
+    }
+    return true;
+  }
+
+  Cursor cur_;
   int size_;
   std::vector<Band>& bands_;  // all bands (parents are looked up here; they belong to the same patch)
   std::vector<Band*> mine_;   // the bands this coder codes, in coding order
@@ -582,7 +777,7 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
     run_hook(plane);
     ArithmeticEncoder enc;
     joint.set_encoder(&enc);
-    joint.template code_plane<false>(plane);
+    joint.code_plane(plane);
     result.segments.push_back(enc.finish());
     joint_total += result.segments.back().size();
     if (layout.independent_patches) ++result.joint_segments;
@@ -603,7 +798,7 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
     for (auto& coder : coders) {
       ArithmeticEncoder enc;
       coder.set_encoder(&enc);
-      coder.template code_plane<false>(plane);
+      coder.code_plane(plane);
       streams.push_back(enc.finish());
     }
     std::vector<std::uint8_t> segment;
@@ -634,113 +829,156 @@ struct StreamPart {
   bool present = false;  ///< false: nothing of this plane arrived for this coder
 };
 
-struct CoderOutcome {
-  std::size_t planes_complete = 0;
-  bool partial = false;
+/// Where one coder is: the plane in progress and what happened in the last update.
+struct CoderRun {
+  std::size_t next = 0;  ///< segment index of the plane in progress (or the next to start)
+  bool started = false;  ///< plane `next` was started (the coder's cursor is inside it)
+  std::size_t seen = 0;  ///< bytes of plane `next` given to the coder so far
+  bool partial = false;  ///< the last update stopped inside a present, incomplete part
   bool corrupt = false;
-  std::exception_ptr error;  ///< anything else (allocation failure): rethrown by the caller's thread
+  std::exception_ptr error;   ///< anything else (allocation failure): rethrown by the caller's thread
+  std::uint64_t version = 0;  ///< grows whenever the coder may have decoded something
 };
 
-/// Decodes the planes of one coder; parts[i] is its stream of plane `first` + i (planes after the first
-/// absent or incomplete one are not decoded).
-void decode_planes(PlaneCoder<true>& coder, int top_bitplane, std::size_t first,
-                   const std::vector<StreamPart>& parts, CoderOutcome& outcome) {
+/// Decodes the planes of one coder from run.next on, while < end and bytes are there (part(t): its stream of
+/// segment t), resuming inside a plane it stopped in before.
+template <typename PartFn>
+void advance(PlaneCoder<true>& coder, CoderRun& run, int top_bitplane, std::size_t end, const PartFn& part) {
+  run.partial = false;
   try {
-    for (std::size_t t = 0; t < parts.size(); ++t) {
-      const StreamPart& part = parts[t];
-      if (!part.present) break;
-      const int b = top_bitplane - static_cast<int>(first + t);
-      coder.set_decoder(part.bytes);
-      if (part.complete) {
-        coder.code_plane<false>(b);
-        ++outcome.planes_complete;
+    while (run.next < end) {
+      const StreamPart sp = part(run.next);
+      if (!sp.present) break;
+      if (!run.started) {
+        coder.set_decoder(sp.bytes);
+        coder.start_plane(top_bitplane - static_cast<int>(run.next));
+        run.started = true;
+        run.seen = sp.bytes.size();
+        ++run.version;
       } else {
-        outcome.partial = true;
-        try {
-          coder.code_plane<true>(b);
-        } catch (const Stop&) {
-        }
+        coder.extend(sp.bytes);
+        if (sp.bytes.size() != run.seen || sp.complete) ++run.version;
+        run.seen = sp.bytes.size();
+      }
+      if (!sp.complete) {
+        run.partial = true;
+        coder.resume<true>();
         break;
       }
+      coder.resume<false>();
+      ++run.next;
+      run.started = false;
     }
   } catch (const Corrupt&) {
-    outcome.corrupt = true;
+    run.corrupt = true;
   } catch (...) {
-    outcome.error = std::current_exception();
+    run.error = std::current_exception();
   }
 }
 
-/// Splits a segment (or a byte prefix of one, `complete` = false) into its per-patch streams, copied into
-/// `buffers`. Returns false when the sizes do not add up to a complete segment's bytes, when a prefix holds
-/// more bytes than they announce, or when a varint is malformed.
-bool split_segment(std::span<const std::uint8_t> seg, bool complete, int np,
-                   std::vector<std::vector<std::uint8_t>>& buffers, std::vector<StreamPart>& parts) {
-  parts.assign(static_cast<std::size_t>(np), StreamPart{});
-  buffers.resize(static_cast<std::size_t>(np));
-  std::size_t pos = 0;
-  std::vector<std::uint64_t> sizes;
-  std::uint64_t total = 0;
-  for (int p = 0; p < np; ++p) {
-    std::uint64_t v = 0;
-    const detail::VarintRead read = detail::read_varint(seg, pos, v, 5, false);
-    if (read == detail::VarintRead::kTruncated) return !complete;  // a prefix ending inside the sizes: nothing arrived
-    if (read != detail::VarintRead::kOk) return false;
-    if (v > kMaxStreamBytes) return false;
-    sizes.push_back(v);
-    total += v;
-  }
-  const std::uint64_t arrived = seg.size() - pos;
-  if (complete ? arrived != total : arrived > total) return false;
-  for (int p = 0; p < np; ++p) {
-    buffers[static_cast<std::size_t>(p)].clear();
-    buffers[static_cast<std::size_t>(p)].reserve(
-        static_cast<std::size_t>(sizes[static_cast<std::size_t>(p)]));
-  }
-  if (np == 2) {
-    // The same merge as Interleaver, incrementally: d = (2·a + 1)·s1 − (2·b + 1)·s0 after a bytes of
-    // stream 0 and b of stream 1; stream 0 is next while d ≤ 0 (ties to the lower index) or stream 1 is
-    // exhausted.
-    const std::uint64_t s0 = sizes[0], s1 = sizes[1];
-    auto& out0 = buffers[0];
-    auto& out1 = buffers[1];
-    out0.resize(static_cast<std::size_t>(s0));
-    out1.resize(static_cast<std::size_t>(s1));
-    std::size_t a = 0, b = 0;
-    std::int64_t d = static_cast<std::int64_t>(s1) - static_cast<std::int64_t>(s0);
-    const std::uint8_t* in = seg.data() + pos;
-    for (std::uint64_t j = 0; j < arrived; ++j) {
-      if (a < s0 && (d <= 0 || b >= s1)) {
-        out0[a++] = in[j];
-        d += 2 * static_cast<std::int64_t>(s1);
-      } else {
-        out1[b++] = in[j];
-        d -= 2 * static_cast<std::int64_t>(s0);
+/// The per-patch streams of one segment after the joint ones, taken apart as its bytes arrive: the varint
+/// byte sizes of the P streams first, then every byte goes to the stream the interleave gives it (the same
+/// merge as Interleaver).
+class SegmentSplit {
+ public:
+  /// Takes apart the new bytes of `seg`, a longer prefix of the same segment than before (`complete`: the
+  /// whole segment). Returns false when the sizes do not add up to a complete segment's bytes, when a prefix
+  /// holds more bytes than they announce, or when a varint is malformed.
+  bool feed(std::span<const std::uint8_t> seg, bool complete, int np) {
+    if (sizes_.size() < static_cast<std::size_t>(np)) {
+      std::size_t pos = 0;
+      std::vector<std::uint64_t> sizes;
+      for (int p = 0; p < np; ++p) {
+        std::uint64_t v = 0;
+        const detail::VarintRead read = detail::read_varint(seg, pos, v, 5, false);
+        if (read == detail::VarintRead::kTruncated) return !complete;  // nothing of the streams arrived yet
+        if (read != detail::VarintRead::kOk || v > kMaxStreamBytes) return false;
+        sizes.push_back(v);
+      }
+      sizes_ = std::move(sizes);
+      consumed_ = header_end_ = pos;
+      streams_.assign(static_cast<std::size_t>(np), {});
+      order_.emplace(sizes_);
+      d_ = static_cast<std::int64_t>(np == 2 ? sizes_[1] : 0) - static_cast<std::int64_t>(sizes_[0]);
+      for (std::uint64_t v : sizes_) total_ += v;
+    }
+    const std::uint64_t arrived = seg.size() - header_end_;
+    if (complete ? arrived != total_ : arrived > total_) return false;
+    const std::uint8_t* in = seg.data();
+    if (np == 2) {
+      // d = (2·a + 1)·s1 − (2·b + 1)·s0 after a bytes of stream 0 and b of stream 1; stream 0 is next while
+      // d ≤ 0 (ties to the lower index) or stream 1 is exhausted.
+      const std::uint64_t s0 = sizes_[0], s1 = sizes_[1];
+      auto& out0 = streams_[0];
+      auto& out1 = streams_[1];
+      for (std::size_t j = consumed_; j < seg.size(); ++j) {
+        if (out0.size() < s0 && (d_ <= 0 || out1.size() >= s1)) {
+          out0.push_back(in[j]);
+          d_ += 2 * static_cast<std::int64_t>(s1);
+        } else {
+          out1.push_back(in[j]);
+          d_ -= 2 * static_cast<std::int64_t>(s0);
+        }
+      }
+    } else {
+      for (std::size_t j = consumed_; j < seg.size(); ++j) {
+        streams_[static_cast<std::size_t>(order_->next())].push_back(in[j]);
       }
     }
-    out0.resize(a);
-    out1.resize(b);
-  } else {
-    Interleaver order(sizes);
-    for (std::uint64_t j = 0; j < arrived; ++j) {
-      buffers[static_cast<std::size_t>(order.next())].push_back(seg[pos++]);
-    }
+    consumed_ = seg.size();
+    return true;
   }
-  for (int p = 0; p < np; ++p) {
-    const auto& buf = buffers[static_cast<std::size_t>(p)];
-    const bool whole = buf.size() == sizes[static_cast<std::size_t>(p)];
-    parts[static_cast<std::size_t>(p)] = {std::span<const std::uint8_t>(buf), whole, whole || !buf.empty()};
+  bool has_sizes() const { return !sizes_.empty(); }
+  /// Stream p so far.
+  StreamPart part(int p) const {
+    if (sizes_.empty()) return {};
+    const auto& buf = streams_[static_cast<std::size_t>(p)];
+    const bool whole = buf.size() == sizes_[static_cast<std::size_t>(p)];
+    return {std::span<const std::uint8_t>(buf), whole, whole || !buf.empty()};
   }
-  return true;
-}
+
+ private:
+  std::vector<std::uint64_t> sizes_;
+  std::optional<Interleaver> order_;  // P > 2
+  std::uint64_t total_ = 0;
+  std::size_t header_end_ = 0, consumed_ = 0;
+  std::int64_t d_ = 0;
+  std::vector<std::vector<std::uint8_t>> streams_;
+};
 
 }  // namespace
 
-Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
-                        const std::vector<std::vector<std::uint8_t>>& coded,
-                        std::span<const std::span<const std::uint8_t>> segments,
-                        std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
-                        BitplaneDecodeResult& result, int max_threads, const DecodeHook& before_plane) {
-  result = {};
+struct BitplaneDecoder::State {
+  BitplaneLayout layout;
+  int top = 0;
+  std::size_t planes = 0, joint_planes = 0;  // joint_planes: segments of the joint coder
+  int max_threads = 0;
+  DecodeHook before_plane;
+  std::vector<std::vector<std::uint8_t>> coded;
+  std::vector<Band> bands;  // never resized after the coders point into it
+  std::unique_ptr<PlaneCoder<true>> joint;
+  CoderRun joint_run;
+  std::vector<PlaneCoder<true>> coders;  // per patch, made at the fork
+  std::vector<CoderRun> runs;
+  std::vector<SegmentSplit> splits;  // [segment − joint_planes]
+  std::vector<std::size_t> cuts;     // segment indices where a range ends: joint_planes, hooks, planes
+  std::vector<int> hooks;
+  std::size_t range_start = 0;  // the range in progress starts here (its hooks have run)
+  bool hooks_run = false;       // the hooks at range_start ran
+  bool corrupt = false;
+  std::uint64_t hook_version = 0;
+  BitplaneDecodeResult last;
+};
+
+BitplaneDecoder::BitplaneDecoder() = default;
+BitplaneDecoder::~BitplaneDecoder() = default;
+BitplaneDecoder::BitplaneDecoder(BitplaneDecoder&&) noexcept = default;
+BitplaneDecoder& BitplaneDecoder::operator=(BitplaneDecoder&&) noexcept = default;
+
+Status BitplaneDecoder::reset(const BitplaneLayout& layout, int top_bitplane,
+                              std::vector<std::vector<std::uint8_t>> coded, int max_threads,
+                              DecodeHook before_plane) {
+  s_.reset();
   if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) ||
       top_bitplane < 0 || top_bitplane > 64) {
     return Status::kInvalidArgument;
@@ -749,119 +987,173 @@ Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
   for (const auto& m : coded) {
     if (m.size() != samples) return Status::kInvalidArgument;
   }
-  out.assign(static_cast<std::size_t>(layout.num_patches), PatchCoefficients{});
-  const std::size_t planes = static_cast<std::size_t>(top_bitplane) + 1;
+  auto st = std::make_unique<State>();
+  st->layout = layout;
+  st->top = top_bitplane;
+  st->planes = static_cast<std::size_t>(top_bitplane) + 1;
+  st->joint_planes = layout.independent_patches
+                         ? std::min(st->planes, static_cast<std::size_t>(layout.joint_segments))
+                         : st->planes;
+  st->max_threads = max_threads;
+  st->before_plane = std::move(before_plane);
+  st->coded = std::move(coded);
+  st->bands = make_bands(layout, st->coded, -1, max_threads);
+  st->joint = std::make_unique<PlaneCoder<true>>(layout, st->bands, -1, nullptr);
+  st->hooks = hook_planes(layout, top_bitplane);
+  st->cuts = {st->joint_planes, st->planes};
+  for (int h : st->hooks) st->cuts.push_back(static_cast<std::size_t>(top_bitplane - h));
+  std::sort(st->cuts.begin(), st->cuts.end());
+  st->cuts.erase(std::unique(st->cuts.begin(), st->cuts.end()), st->cuts.end());
+  st->runs.resize(static_cast<std::size_t>(layout.num_patches));
+  s_ = std::move(st);
+  return Status::kOk;
+}
+
+Status BitplaneDecoder::update(std::span<const std::span<const std::uint8_t>> segments,
+                               std::span<const std::uint8_t> partial_tail, BitplaneDecodeResult& result) {
+  result = {};
+  if (!s_) return Status::kInvalidArgument;
+  State& st = *s_;
+  if (st.corrupt) {
+    result = st.last;
+    return Status::kCorrupt;
+  }
+  const int np = st.layout.num_patches;
+  const std::size_t planes = st.planes;
   Status status = Status::kOk;
   if (segments.size() > planes || (segments.size() == planes && !partial_tail.empty())) {
     status = Status::kCorrupt;  // decode what fits, then report
   }
-  // Planes [0, joint) are one joint stream; planes [joint, arrived) one stream per patch.
-  const int np = layout.num_patches;
   const std::size_t arrived =
       std::min(segments.size(), planes) + (segments.size() < planes && !partial_tail.empty());
-  const std::size_t joint = layout.independent_patches
-                                ? std::min(arrived, static_cast<std::size_t>(layout.joint_segments))
-                                : arrived;
   const auto segment = [&](std::size_t t) { return t < segments.size() ? segments[t] : partial_tail; };
-  std::vector<StreamPart> joint_parts(joint);
-  for (std::size_t t = 0; t < joint; ++t) joint_parts[t] = {segment(t), t < segments.size(), true};
-  std::vector<std::vector<StreamPart>> parts(static_cast<std::size_t>(np));
-  std::vector<std::vector<std::vector<std::uint8_t>>> buffers(arrived - joint);  // [plane − joint][patch]
-  std::vector<StreamPart> split;
-  for (std::size_t t = joint; t < arrived; ++t) {
-    if (!split_segment(segment(t), t < segments.size(), np, buffers[t - joint], split)) {
-      status = Status::kCorrupt;  // sizes that do not fit: decode the planes before this one
-      break;
+
+  // Per-patch segments: take apart what arrived (in order; a segment whose sizes do not fit ends the
+  // decodable ones and the stream is corrupt).
+  std::size_t decodable = std::min(arrived, st.joint_planes);
+  if (arrived > st.joint_planes) {
+    decodable = st.joint_planes;
+    for (std::size_t t = st.joint_planes; t < arrived; ++t) {
+      const std::size_t i = t - st.joint_planes;
+      if (st.splits.size() <= i) st.splits.emplace_back();
+      if (!st.splits[i].feed(segment(t), t < segments.size(), np)) {
+        status = Status::kCorrupt;
+        st.corrupt = true;  // later bytes cannot repair a segment whose sizes do not fit
+        break;
+      }
+      decodable = t + 1;
     }
-    for (int p = 0; p < np; ++p)
-      parts[static_cast<std::size_t>(p)].push_back(split[static_cast<std::size_t>(p)]);
   }
 
-  std::vector<Band> bands = make_bands(layout, coded, -1, max_threads);
-  // Hooks of deferred steps: before segment top − plane. The segments are decoded in ranges between hooks
-  // (and the fork to per-patch coders); a hook runs only when every plane above it was decoded completely.
-  const std::vector<int> hooks = hook_planes(layout, top_bitplane);
-  // Segments that can be decoded: the joint ones and the per-patch ones before a segment that did not split.
-  const std::size_t decodable = joint + parts[0].size();
-  std::vector<std::size_t> cuts = {0, joint, decodable};
-  for (int h : hooks) cuts.push_back(static_cast<std::size_t>(top_bitplane - h));
-  std::sort(cuts.begin(), cuts.end());
-  cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-  const auto view = [&] {
-    std::vector<PatchCoefficients> v(static_cast<std::size_t>(np));
-    parallel_for(np, max_threads, [&](int c) {
-      auto& patch = v[static_cast<std::size_t>(c)];
-      for (auto& ch : patch) ch.assign(samples, 0);
-      for (const auto& band : bands) {
-        if (band.patch == c) reconstruct_band(band, patch);
-      }
-    });
-    return v;
-  };
-  CoderOutcome joint_outcome;
-  PlaneCoder<true> joint_coder(layout, bands, -1, nullptr);
-  std::vector<CoderOutcome> outcomes(static_cast<std::size_t>(np));
-  std::vector<PlaneCoder<true>> coders;  // per patch, made at the fork
-  bool fork = false;
-  for (std::size_t r = 0; r + 1 < cuts.size(); ++r) {
-    const std::size_t a = cuts[r], b = cuts[r + 1];
-    if (a >= decodable) break;
-    for (int h : hooks) {
-      if (static_cast<std::size_t>(top_bitplane - h) == a && before_plane) {
-        std::vector<PatchCoefficients> v = view();
-        before_plane(h, v);
+  // Ranges between cuts (hooks, the fork); a range starts only when every plane before it was decoded
+  // completely, and its hooks run first.
+  for (;;) {
+    const std::size_t a = st.range_start;
+    const bool in_joint = a < st.joint_planes;
+    const std::size_t limit = in_joint ? std::min(arrived, st.joint_planes) : decodable;
+    if (a >= limit || a >= planes) break;
+    if (!st.hooks_run) {
+      st.hooks_run = true;
+      for (int h : st.hooks) {
+        if (static_cast<std::size_t>(st.top - h) == a && st.before_plane) {
+          std::vector<PatchCoefficients> v;
+          reconstruct(v);
+          st.before_plane(h, v);
+          ++st.hook_version;
+        }
       }
     }
-    if (a < joint) {
-      std::vector<StreamPart> slice(joint_parts.begin() + static_cast<std::ptrdiff_t>(a),
-                                    joint_parts.begin() + static_cast<std::ptrdiff_t>(b));
-      decode_planes(joint_coder, top_bitplane, a, slice, joint_outcome);
-      if (joint_outcome.error) std::rethrow_exception(joint_outcome.error);
-      if (joint_outcome.corrupt) status = Status::kCorrupt;
-      result.partial = joint_outcome.partial;
-      result.segments_complete = joint_outcome.planes_complete;
-      if (joint_outcome.planes_complete != b || joint_outcome.corrupt) break;
-      continue;
-    }
-    // The per-patch planes follow only a complete, clean joint part.
-    if (!fork) {
-      fork = true;
-      coders.reserve(static_cast<std::size_t>(np));
-      for (int c = 0; c < np; ++c) {
-        coders.emplace_back(layout, bands, c, nullptr);
-        coders.back().copy_contexts(joint_coder);
-      }
-    }
-    parallel_for(np, max_threads, [&](int c) {
-      CoderOutcome& outcome = outcomes[static_cast<std::size_t>(c)];
-      try {
-        const auto& mine = parts[static_cast<std::size_t>(c)];
-        std::vector<StreamPart> slice(mine.begin() + static_cast<std::ptrdiff_t>(a - joint),
-                                      mine.begin() + static_cast<std::ptrdiff_t>(b - joint));
-        decode_planes(coders[static_cast<std::size_t>(c)], top_bitplane, a, slice, outcome);
-      } catch (...) {
-        outcome.error = std::current_exception();  // rethrown below, on the caller's thread
-      }
-    });
-    std::size_t complete = planes;
+    const std::size_t cut = *std::upper_bound(st.cuts.begin(), st.cuts.end(), a);
+    const std::size_t end = std::min(cut, limit);
+    std::size_t done = 0;
     bool stop = false;
-    for (const CoderOutcome& o : outcomes) {
-      if (o.error) std::rethrow_exception(o.error);
-      if (o.corrupt) status = Status::kCorrupt, stop = true;
-      complete = std::min(complete, o.planes_complete);
-      result.partial = result.partial || o.partial;
+    if (in_joint) {
+      advance(*st.joint, st.joint_run, st.top, end, [&](std::size_t t) {
+        return StreamPart{segment(t), t < segments.size(), true};
+      });
+      if (st.joint_run.error) std::rethrow_exception(st.joint_run.error);
+      if (st.joint_run.corrupt) status = Status::kCorrupt, st.corrupt = stop = true;
+      done = st.joint_run.next;
+    } else {
+      if (st.coders.empty()) {
+        st.coders.reserve(static_cast<std::size_t>(np));
+        for (int c = 0; c < np; ++c) {
+          st.coders.emplace_back(st.layout, st.bands, c, nullptr);
+          st.coders.back().copy_contexts(*st.joint);
+          st.runs[static_cast<std::size_t>(c)].next = st.joint_planes;
+        }
+      }
+      parallel_for(np, st.max_threads, [&](int c) {
+        CoderRun& run = st.runs[static_cast<std::size_t>(c)];
+        advance(st.coders[static_cast<std::size_t>(c)], run, st.top, end,
+                [&](std::size_t t) { return st.splits[t - st.joint_planes].part(c); });
+      });
+      done = planes;
+      for (const CoderRun& r : st.runs) {
+        if (r.error) std::rethrow_exception(r.error);
+        if (r.corrupt) status = Status::kCorrupt, st.corrupt = stop = true;
+        done = std::min(done, r.next);
+      }
     }
-    result.segments_complete = joint + complete;
-    if (stop || joint + complete != b) break;
+    if (stop || done != cut) break;
+    st.range_start = cut;
+    st.hooks_run = false;
   }
-  // The reconstruction of every patch, in parallel.
-  parallel_for(np, max_threads, [&](int c) {
+
+  if (st.coders.empty()) {
+    result.segments_complete = st.joint_run.next;
+    result.partial = st.joint_run.partial;
+  } else {
+    std::size_t complete = planes;
+    for (const CoderRun& r : st.runs) {
+      complete = std::min(complete, r.next);
+      result.partial = result.partial || r.partial;
+    }
+    result.segments_complete = complete;
+  }
+  st.joint_run.partial = false;
+  for (CoderRun& r : st.runs) r.partial = false;
+  st.last = result;
+  return status;
+}
+
+void BitplaneDecoder::reconstruct(std::vector<PatchCoefficients>& out) const {
+  if (!s_) {
+    out.clear();
+    return;
+  }
+  const State& st = *s_;
+  const std::size_t size = (std::size_t{1} << st.layout.level) + 1, samples = size * size;
+  const int np = st.layout.num_patches;
+  out.resize(static_cast<std::size_t>(np));
+  parallel_for(np, st.max_threads, [&](int c) {
     auto& patch = out[static_cast<std::size_t>(c)];
     for (auto& ch : patch) ch.assign(samples, 0);
-    for (const auto& band : bands) {
+    for (const auto& band : st.bands) {
       if (band.patch == c) reconstruct_band(band, patch);
     }
   });
+}
+
+std::vector<std::uint64_t> BitplaneDecoder::patch_versions() const {
+  if (!s_) return {};
+  const State& st = *s_;
+  std::vector<std::uint64_t> v;
+  for (const CoderRun& r : st.runs) v.push_back(st.joint_run.version + st.hook_version + r.version);
+  return v;
+}
+
+Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
+                        const std::vector<std::vector<std::uint8_t>>& coded,
+                        std::span<const std::span<const std::uint8_t>> segments,
+                        std::span<const std::uint8_t> partial_tail, std::vector<PatchCoefficients>& out,
+                        BitplaneDecodeResult& result, int max_threads, const DecodeHook& before_plane) {
+  result = {};
+  BitplaneDecoder decoder;
+  const Status s = decoder.reset(layout, top_bitplane, coded, max_threads, before_plane);
+  if (s != Status::kOk) return s;
+  const Status status = decoder.update(segments, partial_tail, result);
+  decoder.reconstruct(out);
   return status;
 }
 

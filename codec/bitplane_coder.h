@@ -50,10 +50,10 @@
 // the interleave a function of the sizes alone: byte k of stream p is placed at (k + ½)/size_p, merged by
 // that time. So the decoder takes the streams apart before decoding and runs the patches in parallel, and
 // a byte prefix of a segment holds the same fraction of every patch's plane — close to the order of one
-// joint coder. Per-patch coders from the first plane (separate contexts, sizes, flushes) and patch-major order
-// both cost surface PSNR at low rates; the joint start (geometry_codec: joint until 2 KB) and the interleave
-// remove both (figures: docs/measurements.md).
-// Version 1 (independent_patches false): one stream for all patches throughout; still decoded.
+// joint coder. Per-patch coders from the first plane (separate contexts, sizes, flushes) and patch-major
+// order both cost surface PSNR at low rates; the joint start (geometry_codec: joint until 2 KB) and the
+// interleave remove both (figures: docs/measurements.md). Version 1 (independent_patches false): one stream
+// for all patches throughout; still decoded.
 //
 // Decoding reconstructs each significant coefficient at the middle of its remaining uncertainty interval
 // (known bits down to plane q: |c| ∈ [known, known + 2^q), reconstructed as known + 2^(q−1)); insignificant
@@ -67,6 +67,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -152,6 +153,41 @@ struct BitplaneDecodeResult {
 /// before decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got
 /// (scratch for the hook).
 using DecodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view)>;
+
+/// Incremental decoding (a class because its state is reused): the decoder keeps its significance lists,
+/// contexts, range-decoder states and its place inside the plane it stopped in, and each update() continues
+/// from there, so every byte is decoded once however the stream arrives. After any sequence of updates
+/// whose last one got `segments` and `partial_tail`, result and reconstruct() are bit for bit those of
+/// decode_bitplanes() on the same arguments (for streams of the encoder; after a kCorrupt the decoder stops
+/// and may hold more than a one-shot decode of a later prefix would).
+class BitplaneDecoder {
+ public:
+  BitplaneDecoder();
+  ~BitplaneDecoder();
+  BitplaneDecoder(BitplaneDecoder&&) noexcept;
+  BitplaneDecoder& operator=(BitplaneDecoder&&) noexcept;
+
+  /// Starts over. kInvalidArgument (and nothing to decode) on the errors of decode_bitplanes().
+  Status reset(const BitplaneLayout& layout, int top_bitplane, std::vector<std::vector<std::uint8_t>> coded,
+               int max_threads = 0, DecodeHook before_plane = {});
+  /// Continues with a longer prefix of the stream: `segments` start with the complete segments of the
+  /// previous call (same contents; the memory may have moved), `partial_tail` is a prefix of the next one
+  /// and extends the previous call's tail when that segment is still the one in progress. Returns as
+  /// decode_bitplanes(); kCorrupt is sticky. Cost: the symbols of the new bytes (plus the hooks reached).
+  Status update(std::span<const std::span<const std::uint8_t>> segments,
+                std::span<const std::uint8_t> partial_tail, BitplaneDecodeResult& result);
+  /// The reconstruction of what was decoded (as decode_bitplanes()' `out`).
+  void reconstruct(std::vector<PatchCoefficients>& out) const;
+  /// Per patch, a counter that grows whenever an update() may have changed that patch's coefficients (joint
+  /// planes and hooks change every patch): a patch whose counter did not change between two reconstruct()
+  /// calls has the same coefficients.
+  std::vector<std::uint64_t> patch_versions() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
 Status decode_bitplanes(const BitplaneLayout& layout, int top_bitplane,
                         const std::vector<std::vector<std::uint8_t>>& coded,
                         std::span<const std::span<const std::uint8_t>> segments,

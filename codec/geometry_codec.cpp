@@ -166,7 +166,9 @@ class Reader {
     return true;
   }
   /// Varint of at most 5 bytes (values < 2^35), canonical (no trailing zero byte).
-  bool varint(std::uint64_t& v) { return detail::read_varint(bytes_, pos_, v, 5, true) == detail::VarintRead::kOk; }
+  bool varint(std::uint64_t& v) {
+    return detail::read_varint(bytes_, pos_, v, 5, true) == detail::VarintRead::kOk;
+  }
   bool small_int(int& out, std::uint64_t max) {
     std::uint64_t v;
     if (!varint(v) || v > max) return false;
@@ -258,11 +260,24 @@ struct FrameField {
   std::vector<int> start;                                         // start plane of step k at [k − 1]
   std::vector<std::vector<std::array<std::int64_t, 3>>> normals;  // [patch][grid index]
   std::vector<std::uint8_t> ready;                                // [k − 1]: normals of step k computed
+  // Frames built so far (an incremental decoder reconstructs many times from the same normals).
+  mutable std::vector<std::vector<Frame>> frames;        // [patch][grid index]
+  mutable std::vector<std::vector<std::uint8_t>> built;  // [patch][grid index]: frames[...] is valid
 
-  /// The frame at a framed position (built when needed: only non-zero coefficients need one).
-  Frame frame(std::size_t p, int idx) const {
-    const auto& n = normals[p][static_cast<std::size_t>(idx)];
-    return make_frame(n[0], n[1], n[2]);
+  /// The frame at a framed position (built when first needed: only non-zero coefficients need one; the
+  /// normal of a position never changes once its step is ready).
+  const Frame& frame(std::size_t p, int idx) const {
+    const auto i = static_cast<std::size_t>(idx);
+    if (built[p].empty()) {  // first frame of this patch
+      frames[p].resize(normals[p].size());
+      built[p].assign(normals[p].size(), 0);
+    }
+    if (!built[p][i]) {
+      const auto& n = normals[p][i];
+      frames[p][i] = make_frame(n[0], n[1], n[2]);
+      built[p][i] = 1;
+    }
+    return frames[p][i];
   }
 
   /// Calls f(i, j, index) for every detail position of step k.
@@ -286,7 +301,7 @@ struct FrameField {
           for (int r = 0; r < 3; ++r)
             w[r] = coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)];
           if (w[0] == 0 && w[1] == 0 && w[2] == 0) return;
-          const Frame f = frame(p, idx);
+          const Frame& f = frame(p, idx);
           w[1] *= std::int64_t{1} << tangential_shift;
           w[2] *= std::int64_t{1} << tangential_shift;
           for (int c = 0; c < 3; ++c) {
@@ -376,7 +391,7 @@ struct FrameField {
           for (int c = 0; c < 3; ++c)
             d[c] = coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)];
           if (d[0] == 0 && d[1] == 0 && d[2] == 0) return;
-          const Frame f = frame(p, idx);
+          const Frame& f = frame(p, idx);
           for (int r = 0; r < 3; ++r) {
             const std::int64_t v = static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r)]) * d[0] +
                                    static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r + 1)]) * d[1] +
@@ -404,6 +419,8 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
     const std::size_t size = static_cast<std::size_t>(grid_size(h.level));
     ff.normals.assign(static_cast<std::size_t>(h.num_patches),
                       std::vector<std::array<std::int64_t, 3>>(size * size));
+    ff.frames.resize(static_cast<std::size_t>(h.num_patches));
+    ff.built.resize(static_cast<std::size_t>(h.num_patches));
   }
   return ff;
 }
@@ -616,36 +633,82 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   return result;
 }
 
-Status decode_geometry(const GeometryCodecHeader& header,
-                       std::span<const std::span<const std::uint8_t>> segments,
-                       std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,
-                       const GeometryDecodeOptions& options) {
-  out = DecodedGeometry{};
+struct GeometryDecoder::State {
+  GeometryCodecHeader header;
+  GeometryDecodeOptions options;
+  Ownership own;
+  FrameField ff;
+  BitplaneDecoder bits;
+  BitplaneDecodeResult last;
+  // result() cache: the grids of the last call, valid while the coefficients and the drop are the same.
+  std::vector<std::uint64_t> versions;
+  int cached_drop = -1;
+  DecodedGeometry cached;
+  std::vector<PatchCoefficients> scratch;  // coefficients of the last result()
+};
+
+GeometryDecoder::GeometryDecoder() = default;
+GeometryDecoder::~GeometryDecoder() = default;
+GeometryDecoder::GeometryDecoder(GeometryDecoder&&) noexcept = default;
+GeometryDecoder& GeometryDecoder::operator=(GeometryDecoder&&) noexcept = default;
+
+Status GeometryDecoder::reset(const GeometryCodecHeader& header, const GeometryDecodeOptions& options) {
+  s_.reset();
   if (!header_ok(header) || options.drop_finest_steps < 0) return Status::kInvalidArgument;
+  auto st = std::make_unique<State>();
+  st->header = header;
+  st->options = options;
+  st->own = seam_ownership(header.level, header.num_patches, header.seams);
+  st->ff = make_frame_field(header, st->own);
+  State* raw = st.get();
+  const DecodeHook hook = [raw](int plane, std::vector<PatchCoefficients>& view) {
+    raw->ff.compute(plane, view);
+  };
+  const Status s =
+      st->bits.reset(make_layout(header), header.top_bitplane, st->own.coded, options.max_threads, hook);
+  if (s != Status::kOk) return s;
+  s_ = std::move(st);
+  return Status::kOk;
+}
+
+Status GeometryDecoder::update(std::span<const std::span<const std::uint8_t>> segments,
+                               std::span<const std::uint8_t> partial_tail) {
+  if (!s_) return Status::kInvalidArgument;
+  return s_->bits.update(segments, partial_tail, s_->last);
+}
+
+void GeometryDecoder::result(DecodedGeometry& out, int drop_finest_steps) {
+  out = DecodedGeometry{};
+  if (!s_) return;
+  State& st = *s_;
+  const GeometryCodecHeader& header = st.header;
   const int level = header.level, np = header.num_patches, steps = header.steps;
   const std::size_t size = static_cast<std::size_t>(grid_size(level)), samples = size * size;
-  const Ownership own = seam_ownership(level, np, header.seams);
-  std::vector<PatchCoefficients> coefs;
-  BitplaneDecodeResult r;
-  FrameField ff = make_frame_field(header, own);
-  const DecodeHook hook = [&](int plane, std::vector<PatchCoefficients>& view) { ff.compute(plane, view); };
-  const Status status = decode_bitplanes(make_layout(header), header.top_bitplane, own.coded, segments,
-                                         partial_tail, coefs, r, options.max_threads, hook);
-  out.segments_complete = r.segments_complete;
-  out.partial = r.partial;
-  if (coefs.size() != static_cast<std::size_t>(np)) return status == Status::kOk ? Status::kCorrupt : status;
-  ff.to_xyz(coefs);
+  const int drop = std::min(drop_finest_steps < 0 ? st.options.drop_finest_steps : drop_finest_steps, steps);
+  std::vector<std::uint64_t> versions = st.bits.patch_versions();
+  if (versions == st.versions && drop == st.cached_drop) {
+    out = st.cached;
+    return;
+  }
+  std::vector<PatchCoefficients>& coefs = st.scratch;  // reused: no allocation per call
+  st.bits.reconstruct(coefs);
+  const Ownership& own = st.own;
+  // The grids are built in the cache (its buffers are reused from call to call), then copied out.
+  DecodedGeometry& res = st.cached;
+  st.cached_drop = -1;  // invalid until complete
+  res.segments_complete = st.last.segments_complete;
+  res.partial = st.last.partial;
+  st.ff.to_xyz(coefs);
   for (const auto& [copy, owner] : own.copies) {
     for (int c = 0; c < 3; ++c)
       coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
   }
   // Per patch (in parallel): drop the finest details, find the finest step with a non-zero detail, inverse
   // transform, dequantize.
-  const int drop = std::min(options.drop_finest_steps, steps);
   std::vector<int> finest(static_cast<std::size_t>(np), steps + 1);  // steps + 1: none
-  out.patches.resize(static_cast<std::size_t>(np));
-  parallel_for(np, options.max_threads, [&](int p) {
-    Grid3& g = out.patches[static_cast<std::size_t>(p)];
+  res.patches.resize(static_cast<std::size_t>(np));
+  parallel_for(np, st.options.max_threads, [&](int p) {
+    Grid3& g = res.patches[static_cast<std::size_t>(p)];
     g.level = level;
     g.values.resize(3 * samples);
     for (int c = 0; c < 3; ++c) {
@@ -691,7 +754,21 @@ Status decode_geometry(const GeometryCodecHeader& header,
     }
   });
   const int finest_step = *std::min_element(finest.begin(), finest.end());
-  out.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
+  res.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
+  st.versions = std::move(versions);
+  st.cached_drop = drop;
+  out = st.cached;
+}
+
+Status decode_geometry(const GeometryCodecHeader& header,
+                       std::span<const std::span<const std::uint8_t>> segments,
+                       std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,
+                       const GeometryDecodeOptions& options) {
+  out = DecodedGeometry{};
+  GeometryDecoder decoder;
+  if (decoder.reset(header, options) != Status::kOk) return Status::kInvalidArgument;
+  const Status status = decoder.update(segments, partial_tail);
+  decoder.result(out);
   return status;
 }
 

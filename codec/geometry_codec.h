@@ -20,6 +20,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -145,6 +146,36 @@ struct DecodedGeometry {
 /// refuse (built by hand) or a negative drop_finest_steps. Cost: proportional to the bytes decoded; a
 /// version-2/3 stream decodes its patches on parallel threads (options.max_threads); version 3 adds the
 /// frame construction of its framed steps (timings: tests/bench/codec_bench.cpp --pack, docs/codec-v3.md).
+/// Incremental decoding of one model's stream (a class because its state is reused): update() continues from
+/// where the previous prefix ended (BitplaneDecoder: each byte is decoded once), result() reconstructs what
+/// was decoded — with any drop_finest_steps, so a banded morph takes all its bands from one decode.
+/// After any sequence of updates whose last one got (segments, partial_tail), result() is bit for bit
+/// decode_geometry() of the same arguments (streams of the encoder; after kCorrupt the decoder stops).
+class GeometryDecoder {
+ public:
+  GeometryDecoder();
+  ~GeometryDecoder();
+  GeometryDecoder(GeometryDecoder&&) noexcept;
+  GeometryDecoder& operator=(GeometryDecoder&&) noexcept;
+
+  /// Starts over for a stream with this header. kInvalidArgument (then update() does nothing) for a header
+  /// that parse() would refuse.
+  Status reset(const GeometryCodecHeader& header, const GeometryDecodeOptions& options = {});
+  /// Continues with a longer prefix of the stream (the arguments of decode_geometry(); the complete segments
+  /// of the previous call come first, same contents, possibly elsewhere in memory). Returns as
+  /// decode_geometry(); kCorrupt is sticky. Cost: the symbols of the new bytes.
+  Status update(std::span<const std::span<const std::uint8_t>> segments,
+                std::span<const std::uint8_t> partial_tail);
+  /// What was decoded, as decode_geometry() would output it with `drop_finest_steps` (−1: the options'
+  /// value). Cost: the inverse transforms (about a tenth of a full decode; the same grids are returned from
+  /// a cache while nothing new was decoded).
+  void result(DecodedGeometry& out, int drop_finest_steps = -1);
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
 Status decode_geometry(const GeometryCodecHeader& header,
                        std::span<const std::span<const std::uint8_t>> segments,
                        std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,

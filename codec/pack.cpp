@@ -483,97 +483,199 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
   return std::move(out);
 }
 
-PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDecodeOptions& options) {
-  PackDecodeResult result;
-  const std::span<const std::uint8_t> data = bytes.first(std::min(bytes.size(), options.max_bytes));
-  result.status = read_pack_info(data, result.info);
-  if (result.status != Status::kOk) return result;
-  const PackInfo& info = result.info;
-  result.bytes_used = info.manifest_end;
-
-  // Gather each model's segments: complete CRC-checked chunks in order, then at most one partial chunk.
-  struct Streams {
-    std::vector<std::span<const std::uint8_t>> geometry, normals;
-    std::span<const std::uint8_t> geometry_tail, normals_tail;
-    std::span<const std::uint8_t> fine_mask;
+struct PackDecoder::State {
+  PackDecodeOptions options;
+  bool have_info = false;
+  bool failed = false;      // an allocation failed on a hostile manifest: no models
+  bool crc_failed = false;  // decoding stopped at a chunk that failed its CRC
+  Status status = Status::kOk;
+  PackInfo info;
+  std::size_t next_chunk = 0;  // first chunk not yet complete and verified
+  std::size_t chunks_decoded = 0, bytes_used = 0;
+  struct Model {
+    GeometryDecoder geometry, normals;
+    bool with_normals = false;
+    std::vector<std::size_t> geometry_chunks, normal_chunks;
     bool has_fine_mask = false;
+    std::vector<std::vector<std::uint8_t>> fine_mask;
+    Status geometry_status = Status::kOk, normals_status = Status::kOk;
   };
-  std::vector<Streams> streams(info.models.size());
-  for (const ChunkInfo& chunk : info.chunks) {
-    Streams& s = streams[static_cast<std::size_t>(chunk.model)];
-    const bool geometry = chunk.kind == ChunkKind::kGeometry;
-    if (chunk.offset + chunk.size > data.size()) {
-      result.status = Status::kTruncated;
-      if (options.partial_chunks && chunk.offset < data.size() && chunk.kind != ChunkKind::kHoleMask &&
-          (geometry || options.normals)) {
-        const auto tail = data.subspan(static_cast<std::size_t>(chunk.offset));
-        (geometry ? s.geometry_tail : s.normals_tail) = tail;
-        result.bytes_used = data.size();
-      }
-      break;
-    }
-    const auto payload = data.subspan(static_cast<std::size_t>(chunk.offset), chunk.size);
-    if (kCheckCrc && crc32(payload) != chunk.crc32) {
-      result.status = Status::kCorrupt;
-      break;
-    }
-    if (chunk.kind == ChunkKind::kHoleMask) {
-      s.fine_mask = payload;
-      s.has_fine_mask = true;
-    } else {
-      (geometry ? s.geometry : s.normals).push_back(payload);
-    }
-    ++result.chunks_decoded;
-    result.bytes_used = static_cast<std::size_t>(chunk.offset + chunk.size);
-  }
+  std::vector<Model> models;
+  std::ptrdiff_t tail_chunk = -1;  // the chunk whose prefix was decoded last (−1: none)
 
-  for (std::size_t m = 0; m < info.models.size(); ++m) {
-    const PackModelInfo& model_info = info.models[m];
-    const Streams& s = streams[m];
-    DecodedModel model;
-    model.name = model_info.name;
-    model.normalization = model_info.normalization;
-    model.seams = model_info.geometry.seams;
-    model.hole_mask = model_info.hole_mask;
-    model.hole_mask_level = model_info.hole_mask_level;
-    if (s.has_fine_mask) {
-      const int shift = model_info.fine_hole_mask_level - model_info.hole_mask_level;
-      (info.version == 1 ? decode_fine_masks_v1 : decode_fine_masks)(
-          s.fine_mask, model_info.hole_mask, 1 << model_info.fine_hole_mask_level, shift, model.hole_mask);
-      model.hole_mask_level = model_info.fine_hole_mask_level;
+  std::span<const std::uint8_t> payload(std::span<const std::uint8_t> data, std::size_t c) const {
+    return data.subspan(static_cast<std::size_t>(info.chunks[c].offset), info.chunks[c].size);
+  }
+  /// Feeds one model's stream (geometry or normals) its verified chunks and `tail`.
+  void feed(std::span<const std::uint8_t> data, Model& m, bool geometry, std::span<const std::uint8_t> tail) {
+    const auto& list = geometry ? m.geometry_chunks : m.normal_chunks;
+    std::vector<std::span<const std::uint8_t>> segments;
+    segments.reserve(list.size());
+    for (std::size_t c : list) segments.push_back(payload(data, c));
+    (geometry ? m.geometry_status : m.normals_status) =
+        (geometry ? m.geometry : m.normals).update(segments, tail);
+  }
+  void reset_stream(Model& m, std::size_t index, bool geometry) {
+    const PackModelInfo& mi = info.models[index];
+    if (geometry)
+      m.geometry.reset(mi.geometry,
+                       {.drop_finest_steps = options.drop_finest_steps, .max_threads = options.max_threads});
+    else
+      m.normals.reset(mi.normals, {.max_threads = options.max_threads});
+  }
+};
+
+PackDecoder::PackDecoder(const PackDecodeOptions& options) : s_(std::make_unique<State>()) {
+  s_->options = options;
+}
+PackDecoder::~PackDecoder() = default;
+PackDecoder::PackDecoder(PackDecoder&&) noexcept = default;
+PackDecoder& PackDecoder::operator=(PackDecoder&&) noexcept = default;
+
+void PackDecoder::update(std::span<const std::uint8_t> bytes) {
+  State& st = *s_;
+  if (st.failed) return;
+  const PackDecodeOptions& options = st.options;
+  const std::span<const std::uint8_t> data = bytes.first(std::min(bytes.size(), options.max_bytes));
+  try {
+    if (!st.have_info) {
+      st.status = read_pack_info(data, st.info);
+      if (st.status != Status::kOk) return;
+      st.have_info = true;
+      st.models.resize(st.info.models.size());
+      for (std::size_t m = 0; m < st.models.size(); ++m) {
+        st.models[m].with_normals = options.normals && st.info.models[m].has_normals;
+        st.reset_stream(st.models[m], m, true);
+        if (st.models[m].with_normals) st.reset_stream(st.models[m], m, false);
+      }
     }
-    model.geometry_passes = s.geometry.size();
-    try {
+    const PackInfo& info = st.info;
+    // Complete chunks, CRC-checked, in order; decoding stops for good at the first that fails.
+    for (; !st.crc_failed && st.next_chunk < info.chunks.size(); ++st.next_chunk) {
+      const std::size_t c = st.next_chunk;
+      const ChunkInfo& chunk = info.chunks[c];
+      if (chunk.offset + chunk.size > data.size()) break;
+      const auto payload = st.payload(data, c);
+      State::Model& m = st.models[static_cast<std::size_t>(chunk.model)];
+      if (kCheckCrc && crc32(payload) != chunk.crc32) {
+        st.crc_failed = true;
+        // A prefix of this chunk was decoded as a partial tail: decode its stream again without it.
+        if (st.tail_chunk == static_cast<std::ptrdiff_t>(c) && chunk.kind != ChunkKind::kHoleMask) {
+          const bool geometry = chunk.kind == ChunkKind::kGeometry;
+          st.reset_stream(m, static_cast<std::size_t>(chunk.model), geometry);
+          st.feed(data, m, geometry, {});
+        }
+        st.tail_chunk = -1;
+        break;
+      }
+      if (chunk.kind == ChunkKind::kHoleMask) {
+        const PackModelInfo& mi = info.models[static_cast<std::size_t>(chunk.model)];
+        const int shift = mi.fine_hole_mask_level - mi.hole_mask_level;
+        (info.version == 1 ? decode_fine_masks_v1 : decode_fine_masks)(
+            payload, mi.hole_mask, 1 << mi.fine_hole_mask_level, shift, m.fine_mask);
+        m.has_fine_mask = true;
+      } else {
+        (chunk.kind == ChunkKind::kGeometry ? m.geometry_chunks : m.normal_chunks).push_back(c);
+      }
+      ++st.chunks_decoded;
+    }
+    // The first incomplete chunk: a byte prefix of an embedded stream.
+    st.bytes_used = st.next_chunk == 0 ? info.manifest_end
+                                       : static_cast<std::size_t>(info.chunks[st.next_chunk - 1].offset +
+                                                                  info.chunks[st.next_chunk - 1].size);
+    st.status = st.crc_failed ? Status::kCorrupt : Status::kOk;
+    std::ptrdiff_t tail = -1;
+    if (!st.crc_failed && st.next_chunk < info.chunks.size()) {
+      st.status = Status::kTruncated;
+      const ChunkInfo& chunk = info.chunks[st.next_chunk];
+      if (options.partial_chunks && chunk.offset < data.size() && chunk.kind != ChunkKind::kHoleMask &&
+          (chunk.kind == ChunkKind::kGeometry || options.normals)) {
+        tail = static_cast<std::ptrdiff_t>(st.next_chunk);
+        st.bytes_used = data.size();
+      }
+    }
+    st.tail_chunk = tail;
+    for (std::size_t m = 0; m < st.models.size(); ++m) {
+      State::Model& model = st.models[m];
+      const auto tail_of = [&](ChunkKind kind) {
+        if (tail < 0) return std::span<const std::uint8_t>{};
+        const ChunkInfo& chunk = info.chunks[static_cast<std::size_t>(tail)];
+        if (chunk.model != static_cast<int>(m) || chunk.kind != kind) return std::span<const std::uint8_t>{};
+        return data.subspan(static_cast<std::size_t>(chunk.offset));
+      };
+      st.feed(data, model, true, tail_of(ChunkKind::kGeometry));
+      if (model.with_normals) st.feed(data, model, false, tail_of(ChunkKind::kNormals));
+    }
+  } catch (const std::exception&) {
+    // The decoders do not throw on bytes; a failed allocation on a hostile manifest lands here.
+    st.failed = true;
+    st.status = Status::kCorrupt;
+    st.models.clear();
+  }
+}
+
+PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
+  State& st = *s_;
+  PackDecodeResult result;
+  result.status = st.status;
+  if (!st.have_info) return result;
+  result.info = st.info;
+  result.chunks_decoded = st.chunks_decoded;
+  result.bytes_used = st.bytes_used;
+  if (st.failed) return result;
+  try {
+    for (std::size_t m = 0; m < st.models.size(); ++m) {
+      const PackModelInfo& model_info = st.info.models[m];
+      State::Model& sm = st.models[m];
+      DecodedModel model;
+      model.name = model_info.name;
+      model.normalization = model_info.normalization;
+      model.seams = model_info.geometry.seams;
+      model.hole_mask = model_info.hole_mask;
+      model.hole_mask_level = model_info.hole_mask_level;
+      if (sm.has_fine_mask) {
+        model.hole_mask = sm.fine_mask;
+        model.hole_mask_level = model_info.fine_hole_mask_level;
+      }
+      model.geometry_passes = sm.geometry_chunks.size();
       DecodedGeometry decoded;
-      const Status g = decode_geometry(
-          model_info.geometry, s.geometry, s.geometry_tail, decoded,
-          {.drop_finest_steps = options.drop_finest_steps, .max_threads = options.max_threads});
-      if (g != Status::kOk) result.status = Status::kCorrupt;
+      sm.geometry.result(decoded, drop_finest_steps);
+      if (sm.geometry_status != Status::kOk) result.status = Status::kCorrupt;
       model.geometry = std::move(decoded.patches);
       model.detail_level = decoded.detail_level;
-      if (options.normals && model_info.has_normals && (!s.normals.empty() || !s.normals_tail.empty())) {
-        DecodedGeometry decoded_normals;
-        if (decode_geometry(model_info.normals, s.normals, s.normals_tail, decoded_normals,
-                            {.max_threads = options.max_threads}) != Status::kOk)
-          result.status = Status::kCorrupt;
-        model.normals = std::move(decoded_normals.patches);
-        for (Grid3& grid : model.normals) {
-          for (std::size_t k = 0; k + 2 < grid.values.size(); k += 3) {
-            float* n = grid.values.data() + k;
-            const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            if (len > 0) n[0] /= len, n[1] /= len, n[2] /= len;
+      const bool any_normals =
+          !sm.normal_chunks.empty() ||
+          (st.tail_chunk >= 0 &&
+           st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].model == static_cast<int>(m) &&
+           st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].kind == ChunkKind::kNormals);
+      if (sm.with_normals && any_normals) {
+        if (sm.normals_status != Status::kOk) result.status = Status::kCorrupt;
+        if (normals) {
+          DecodedGeometry decoded_normals;
+          sm.normals.result(decoded_normals);
+          model.normals = std::move(decoded_normals.patches);
+          for (Grid3& grid : model.normals) {
+            for (std::size_t k = 0; k + 2 < grid.values.size(); k += 3) {
+              float* n = grid.values.data() + k;
+              const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+              if (len > 0) n[0] /= len, n[1] /= len, n[2] /= len;
+            }
           }
         }
       }
-    } catch (const std::exception&) {
-      // decode_geometry does not throw on bytes; a failed allocation on a hostile manifest lands here.
-      result.status = Status::kCorrupt;
-      result.models.clear();
-      return result;
+      result.models.push_back(std::move(model));
     }
-    result.models.push_back(std::move(model));
+  } catch (const std::exception&) {
+    result.status = Status::kCorrupt;
+    result.models.clear();
   }
   return result;
+}
+
+PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDecodeOptions& options) {
+  PackDecoder decoder(options);
+  decoder.update(bytes);
+  return decoder.result();
 }
 
 }  // namespace geomip::codec

@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -155,7 +156,36 @@ struct PackDecodeResult {
   std::size_t bytes_used = 0;      ///< bytes of the buffer that contributed
 };
 
+/// Decodes a pack or a byte prefix of one. One-shot: a PackDecoder given `bytes` once.
 PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDecodeOptions& options = {});
+
+/// Incremental decoding of a pack as its bytes arrive (a class because its state is reused): update() takes
+/// the longer prefix received so far and decodes only what is new in it (GeometryDecoder per model and
+/// stream: each byte is decoded once), result() gives the models. After any sequence of updates, result()
+/// equals decode_pack() of the last update's bytes with the same options bit for bit (for packs of the
+/// encoder; a chunk whose CRC fails after a prefix of it was decoded makes its model decode again from its
+/// verified chunks, as decode_pack() would).
+class PackDecoder {
+ public:
+  explicit PackDecoder(const PackDecodeOptions& options = {});
+  ~PackDecoder();
+  PackDecoder(PackDecoder&&) noexcept;
+  PackDecoder& operator=(PackDecoder&&) noexcept;
+
+  /// Continues with `bytes`: a prefix of the pack at least as long as the previous call's, with the same
+  /// contents there (it may live elsewhere in memory; options.max_bytes still applies). Never throws on
+  /// bytes. Cost: the CRCs and symbols of the new chunk bytes.
+  void update(std::span<const std::uint8_t> bytes);
+  /// The models of the bytes so far, as decode_pack() returns them; `drop_finest_steps` ≥ 0 overrides the
+  /// options' (the banded morph's per-level reconstructions come from one decode), `normals` false leaves
+  /// the normal maps out. Cost: the inverse transforms (no symbol is decoded again); cached per model while
+  /// nothing new arrived and the drop is the same.
+  PackDecodeResult result(int drop_finest_steps = -1, bool normals = true);
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
 
 /// CRC-32 (IEEE 802.3, zlib's crc32).
 std::uint32_t crc32(std::span<const std::uint8_t> bytes);

@@ -3,25 +3,29 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace geomip::codec {
 namespace {
 
 using I64 = std::int64_t;
 
-/// Prediction of odd sample t (between evens t and t+1) of a line whose evens are e(0..E−1).
-template <typename Even>
-inline I64 predict(const Even& e, int t, int num_evens, bool cubic) {
-  if (!cubic || num_evens < 4) return (e(t) + e(t + 1) + 1) >> 1;
-  I64 sum;
-  if (t == 0) {
-    sum = 5 * e(0) + 15 * e(1) - 5 * e(2) + e(3);
-  } else if (t == num_evens - 2) {
-    sum = 5 * e(num_evens - 1) + 15 * e(num_evens - 2) - 5 * e(num_evens - 3) + e(num_evens - 4);
-  } else {
-    sum = -e(t - 1) + 9 * (e(t) + e(t + 1)) - e(t + 2);
-  }
-  return (sum + 8) >> 4;  // arithmetic shift: floor division
+/// The prediction of odd sample t (between evens t and t+1) of a line whose evens are e(0..E−1), as taps:
+/// (Σ w_k · e(at_k) + round) >> shift (arithmetic shift: floor division). Linear: (e(t) + e(t+1) + 1) >> 1;
+/// cubic (E ≥ 4): (−e(t−1) + 9 e(t) + 9 e(t+1) − e(t+2) + 8) >> 4 inside, the one-sided cubic at the ends.
+struct Taps {
+  int at[4];
+  I64 w[4];
+  I64 round;
+  int shift;
+};
+
+Taps taps(int t, int num_evens, bool cubic) {
+  if (!cubic || num_evens < 4) return {{t, t + 1, t, t}, {1, 1, 0, 0}, 1, 1};
+  if (t == 0) return {{0, 1, 2, 3}, {5, 15, -5, 1}, 8, 4};
+  if (t == num_evens - 2)
+    return {{num_evens - 1, num_evens - 2, num_evens - 3, num_evens - 4}, {5, 15, -5, 1}, 8, 4};
+  return {{t - 1, t, t + 1, t + 2}, {-1, 9, 9, -1}, 8, 4};
 }
 
 inline std::int32_t wrap(I64 v) {
@@ -29,30 +33,58 @@ inline std::int32_t wrap(I64 v) {
 }
 
 /// One pass of one step. `rows` = true: the row pass (lines along i); false: the column pass.
-/// sign = −1: forward (subtract the prediction), +1: inverse (add it).
+/// sign = −1: forward (subtract the prediction), +1: inverse (add it). The taps of each odd position are
+/// chosen once per pass, so the inner loops have no branches.
 void pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int sign) {
   const int intervals = (size - 1) / s;  // of the current grid along a line
   const int num_evens = intervals / 2 + 1;
   const int num_odds = intervals / 2;
   if (rows) {
+    std::vector<Taps> all(static_cast<std::size_t>(num_odds));
+    for (int t = 0; t < num_odds; ++t) all[static_cast<std::size_t>(t)] = taps(t, num_evens, cubic);
+    const std::ptrdiff_t step = 2 * static_cast<std::ptrdiff_t>(s);
+    const bool interior =
+        cubic && num_evens >= 4;  // then taps(t) for 0 < t < num_odds − 1 are (−1, 9, 9, −1)
     for (int j = 0; j < size; j += s) {
       std::int32_t* row = g + static_cast<std::ptrdiff_t>(j) * size;
-      auto e = [&](int u) { return static_cast<I64>(row[2 * u * s]); };
-      for (int t = 0; t < num_odds; ++t) {
+      int t = 0;
+      const auto general = [&] {
+        const Taps& p = all[static_cast<std::size_t>(t)];
+        const I64 sum = p.w[0] * row[p.at[0] * step] + p.w[1] * row[p.at[1] * step] +
+                        p.w[2] * row[p.at[2] * step] + p.w[3] * row[p.at[3] * step];
         std::int32_t& x = row[(2 * t + 1) * s];
-        x = wrap(x + sign * predict(e, t, num_evens, cubic));
+        x = wrap(x + sign * ((sum + p.round) >> p.shift));
+      };
+      if (interior) {
+        general();  // t = 0
+        // Cubic interior, t = 1 .. num_odds − 2: constant weights.
+        for (t = 1; t + 1 < num_odds; ++t) {
+          const std::int32_t* e = row + (t - 1) * step;
+          const I64 sum = 9 * (static_cast<I64>(e[step]) + e[2 * step]) - e[0] - e[3 * step];
+          std::int32_t& x = row[(2 * t + 1) * s];
+          x = wrap(x + sign * ((sum + 8) >> 4));
+        }
       }
+      for (; t < num_odds; ++t) general();
     }
   } else {
     // Column pass, row-major friendly: for each odd row, all columns of the current grid at once.
     const std::ptrdiff_t line = static_cast<std::ptrdiff_t>(size);
     for (int t = 0; t < num_odds; ++t) {
+      const Taps p = taps(t, num_evens, cubic);
       std::int32_t* odd = g + static_cast<std::ptrdiff_t>(2 * t + 1) * s * line;
+      const std::int32_t* r[4];
+      for (int k = 0; k < 4; ++k) r[k] = g + static_cast<std::ptrdiff_t>(2 * p.at[k]) * s * line;
+      if (cubic && num_evens >= 4 && t > 0 && t + 1 < num_odds) {
+        for (int i = 0; i < size; i += s) {
+          const I64 sum = 9 * (static_cast<I64>(r[1][i]) + r[2][i]) - r[0][i] - r[3][i];
+          odd[i] = wrap(odd[i] + sign * ((sum + 8) >> 4));
+        }
+        continue;
+      }
       for (int i = 0; i < size; i += s) {
-        auto e = [&](int u) {
-          return static_cast<I64>(g[static_cast<std::ptrdiff_t>(2 * u) * s * line + i]);
-        };
-        odd[i] = wrap(odd[i] + sign * predict(e, t, num_evens, cubic));
+        const I64 sum = p.w[0] * r[0][i] + p.w[1] * r[1][i] + p.w[2] * r[2][i] + p.w[3] * r[3][i];
+        odd[i] = wrap(odd[i] + sign * ((sum + p.round) >> p.shift));
       }
     }
   }

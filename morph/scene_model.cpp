@@ -255,19 +255,35 @@ void apply_similarity(const Similarity& xf, SceneModel& model) {
   for (std::size_t k = 0; k + 2 < model.normals.size(); k += 3) rotate(&model.normals[k], 1.0);
 }
 
+Similarity up_rotation(char up) {
+  Similarity xf;
+  if (up == 'z') xf.rotation = {1, 0, 0, 0, 0, 1, 0, -1, 0};  // −90° about x: +z → +y, +y → −z
+  if (up == 'x') xf.rotation = {0, -1, 0, 1, 0, 0, 0, 0, 1};  // +90° about z: +x → +y, +y → −x
+  return xf;
+}
+
 std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
                                      codec::Status& status, std::size_t& bytes_used) {
-  codec::PackDecodeOptions options;
-  options.partial_chunks = false;  // only complete, CRC-checked chunks: the last complete level stays
-  codec::PackDecodeResult full = codec::decode_pack(bytes, options);
+  return SceneDecoder(settings).update(bytes, status, bytes_used);
+}
+
+// Only complete, CRC-checked chunks: the last complete level stays.
+SceneDecoder::SceneDecoder(const DecodeSettings& settings)
+    : settings_(settings), decoder_({.partial_chunks = false}) {}
+
+std::vector<SceneModel> SceneDecoder::update(std::span<const std::uint8_t> bytes, codec::Status& status,
+                                             std::size_t& bytes_used) {
+  if (!settings_.incremental) decoder_ = codec::PackDecoder({.partial_chunks = false});
+  decoder_.update(bytes);
+  codec::PackDecodeResult full = decoder_.result();
   status = full.status;
   bytes_used = full.bytes_used;
   if (full.models.empty() || full.models[0].geometry_passes == 0 || full.models[0].geometry.empty())
     return {};
   std::vector<SceneModel> out;
-  const int bands = std::max(1, std::min(settings.bands, full.models[0].geometry[0].level + 1));
+  const int bands = std::max(1, std::min(settings_.bands, full.models[0].geometry[0].level + 1));
   const auto align = [&] {
-    if (!settings.align) return;
+    if (!settings_.align) return;
     for (std::size_t m = 1; m < out.size(); ++m)
       if (same_layout(out[m], out[0])) apply_similarity(best_alignment(out[m], out[0]), out[m]);
   };
@@ -279,9 +295,7 @@ std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const 
   std::vector<std::vector<codec::DecodedModel>> by_model(full.models.size());
   for (std::size_t m = 0; m < full.models.size(); ++m) by_model[m].push_back(std::move(full.models[m]));
   for (int d = 1; d < bands; ++d) {
-    options.drop_finest_steps = d;
-    options.normals = false;
-    codec::PackDecodeResult r = codec::decode_pack(bytes, options);
+    codec::PackDecodeResult r = decoder_.result(d, false);  // the same decode, finest d steps dropped
     for (std::size_t m = 0; m < by_model.size() && m < r.models.size(); ++m)
       by_model[m].push_back(std::move(r.models[m]));
   }

@@ -81,17 +81,40 @@ Similarity best_alignment(const SceneModel& model, const SceneModel& reference);
 /// normals rotated by R.
 void apply_similarity(const Similarity& xf, SceneModel& model);
 
+/// The rotation that turns the model's axis `up` ('x', 'y' or 'z'; anything else: identity) into +y, the
+/// viewer's up (a right-handed rotation by 90° about the third axis: z-up data such as the horse stands up).
+Similarity up_rotation(char up);
+
 struct DecodeSettings {
-  /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 decodes B times with
-  /// drop_finest_steps = 0 … B−1).
+  /// Wavelet bands for the wavelet-domain morph (1 = geometry only; B > 1 reconstructs one decode B times,
+  /// with drop_finest_steps = 0 … B−1).
   int bands = 1;
   /// Align models 1, 2, … to model 0 (best_alignment) so that morphs between them do not rotate or shrink.
   bool align = true;
+  /// SceneDecoder: false decodes every prefix from scratch (the cost before incremental decoding; for
+  /// measurements only).
+  bool incremental = true;
 };
 
 /// Decodes a byte prefix of a pack into scene models. Returns an empty vector (status in `status`) when the
-/// prefix holds no geometry pass of model 0 yet.
+/// prefix holds no geometry pass of model 0 yet. One-shot: a SceneDecoder updated once.
 std::vector<SceneModel> decode_scene(std::span<const std::uint8_t> bytes, const DecodeSettings& settings,
                                      codec::Status& status, std::size_t& bytes_used);
+
+/// decode_scene() for a stream (a class because its decoder state is reused): each update() takes the longer
+/// prefix received so far and decodes only its new bytes (codec::PackDecoder: complete chunks only, as
+/// decode_scene()); a banded model takes its B bands from that one decode (per-level reconstructions,
+/// codec::PackDecoder::result with drop_finest_steps = 0 … B−1), not from B decodes. Returns what
+/// decode_scene() returns for the same bytes.
+class SceneDecoder {
+ public:
+  explicit SceneDecoder(const DecodeSettings& settings);
+  std::vector<SceneModel> update(std::span<const std::uint8_t> bytes, codec::Status& status,
+                                 std::size_t& bytes_used);
+
+ private:
+  DecodeSettings settings_;
+  codec::PackDecoder decoder_;
+};
 
 }  // namespace geomip::morph

@@ -1,5 +1,6 @@
 #include "stream_viewer/camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace geomip::viewer {
@@ -56,6 +57,37 @@ std::array<float, 16> view_projection(const Camera& camera, int width, int heigh
   proj[11] = -1;
   proj[14] = 2 * far_plane * near_plane / (near_plane - far_plane);
   return multiply(proj, view);
+}
+
+float framing_distance(const Camera& camera, std::span<const float> xyz, int width, int height, float fill) {
+  const std::size_t points = xyz.size() / 3;
+  if (points == 0) return camera.distance;
+  const std::size_t stride = std::max<std::size_t>(1, points / 20000);
+  // Fraction of the viewport the points span at distance d: max(height fraction, width fraction), or
+  // infinity when a point is behind the near plane (too close).
+  const auto span_at = [&](float d) {
+    Camera c = camera;
+    c.distance = d;
+    const auto m = view_projection(c, width, height);
+    float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (std::size_t k = 0; k < points; k += stride) {
+      const float* p = &xyz[3 * k];
+      const float w = m[3] * p[0] + m[7] * p[1] + m[11] * p[2] + m[15];
+      if (!(w > 0.05f)) return INFINITY;
+      for (int r = 0; r < 2; ++r) {
+        const float v = (m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r]) / w;
+        lo[r] = std::min(lo[r], v);
+        hi[r] = std::max(hi[r], v);
+      }
+    }
+    return std::max(hi[0] - lo[0], hi[1] - lo[1]) / 2;  // NDC spans 2
+  };
+  float near_d = 0.3f, far_d = 20.0f;  // span decreases with the distance
+  for (int it = 0; it < 40; ++it) {
+    const float mid = 0.5f * (near_d + far_d);
+    (span_at(mid) > fill ? near_d : far_d) = mid;
+  }
+  return far_d;
 }
 
 }  // namespace geomip::viewer

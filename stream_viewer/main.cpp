@@ -41,9 +41,12 @@ struct Options {
   int width = 1280, height = 720;
   std::string screenshot, first_screenshot;
   bool bench = false, checker = false, wireframe = false;
+  bool decode_each_prefix = false;
   std::uint64_t limit_rate = 0;
   double timeout = 120;
   float yaw = 0.6f, pitch = 0.35f, distance = 3.2f;
+  bool distance_given = false;  // --distance: no automatic framing
+  std::string up = "y";         // the models' up axis
 };
 
 struct Ui {
@@ -52,6 +55,7 @@ struct Ui {
   bool animate = false;
   float anim = 0;  // position in [0, models) when animating
   bool dragging = false;
+  bool camera_moved = false;  // the user dragged or zoomed: the camera is no longer framed automatically
   double last_x = 0, last_y = 0;
   int max_level = 0;
 };
@@ -103,6 +107,7 @@ void mouse_button(GLFWwindow* w, int button, int action, int) {
 void cursor_pos(GLFWwindow* w, double x, double y) {
   auto* ui = static_cast<Ui*>(glfwGetWindowUserPointer(w));
   if (!ui->dragging) return;
+  ui->camera_moved = true;
   ui->settings.camera.yaw -= static_cast<float>(x - ui->last_x) * 0.01f;
   ui->settings.camera.pitch = std::clamp(ui->settings.camera.pitch + static_cast<float>(y - ui->last_y) * 0.01f,
                                          -1.5f, 1.5f);
@@ -112,8 +117,24 @@ void cursor_pos(GLFWwindow* w, double x, double y) {
 
 void scroll(GLFWwindow* w, double, double dy) {
   auto* ui = static_cast<Ui*>(glfwGetWindowUserPointer(w));
+  ui->camera_moved = true;
   ui->settings.camera.distance = std::clamp(ui->settings.camera.distance * std::pow(0.9f, static_cast<float>(dy)),
                                             0.3f, 20.0f);
+}
+
+/// The xyz samples of the scene models' first layers (the geometry itself, or the coarse base of a banded
+/// model).
+std::vector<float> base_layers(const std::vector<morph::SceneModel>& models) {
+  std::vector<float> xyz;
+  for (const morph::SceneModel& m : models) {
+    const std::size_t per = 3u * static_cast<std::size_t>(m.size()) * static_cast<std::size_t>(m.size());
+    for (int p = 0; p < m.num_patches; ++p) {
+      const auto first =
+          m.positions.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(p) * m.bands * per);
+      xyz.insert(xyz.end(), first, first + static_cast<std::ptrdiff_t>(per));
+    }
+  }
+  return xyz;
 }
 
 /// Options that can only be checked once the manifest is known: "" or one line for exit code 2.
@@ -161,7 +182,9 @@ int run(const Options& opt) {
     Renderer renderer;
     Offscreen target(opt.width, opt.height);
     PackSource source(opt.source, FetchOptions{.limit_rate = opt.limit_rate},
-                      morph::DecodeSettings{.bands = wavelet ? opt.bands : 1, .align = !opt.no_align});
+                      morph::DecodeSettings{.bands = wavelet ? opt.bands : 1,
+                                            .align = !opt.no_align,
+                                            .incremental = !opt.decode_each_prefix});
     Ui ui;
     ui.settings.width = opt.width;
     ui.settings.height = opt.height;
@@ -205,12 +228,19 @@ int run(const Options& opt) {
         }
       }
       if (auto u = source.take_update()) {
+        if (opt.up != "y")
+          for (morph::SceneModel& m : u->models) morph::apply_similarity(morph::up_rotation(opt.up[0]), m);
         renderer.set_models(u->models);
         have_models = true;
         shown_bytes = u->bytes_used;
         total = u->total;
         detail = u->models[0].detail_level;
         ui.max_level = renderer.model_level(std::clamp(opt.model, 0, renderer.model_count() - 1));
+        // Frame all models together (~70 % of the height for the largest; they are aligned to the first, so a
+        // morph keeps one camera) until the user moves the camera or gave --distance.
+        if (!opt.distance_given && !ui.camera_moved)
+          ui.settings.camera.distance = framing_distance(ui.settings.camera, base_layers(u->models),
+                                                         ui.settings.width, ui.settings.height);
         std::cout << "geomip-view: showing " << shown_bytes << " of " << total << " bytes, detail level " << detail
                   << "/" << ui.max_level << "\n";
       }
@@ -303,6 +333,12 @@ int run(const Options& opt) {
                   << " models, level " << (ui.settings.level < 0 ? ui.max_level : ui.settings.level) << ", "
                   << (opt.morph || opt.animate ? (wavelet ? "wavelet morph" : "linear morph") : "no morph") << ": "
                   << bench_ms / frames_after_load << " ms/frame over " << frames_after_load << " frames\n";
+      if (opt.bench) {
+        const PackSource::DecodeStats d = source.decode_stats();
+        std::cout << "geomip-view: decode " << (opt.decode_each_prefix ? "(every prefix from scratch)" : "(incremental)")
+                  << ": " << d.updates << " updates, " << d.thread_cpu_ms << " ms CPU of the decode thread, "
+                  << d.wall_ms << " ms wall\n";
+      }
     }
     // Exactly one line for whatever went wrong.
     std::string err = source.error();
@@ -377,16 +413,23 @@ int main(int argc, char** argv) {
   app.add_option("--screenshot", opt.screenshot, "headless: write the last frame as PNG");
   app.add_option("--first-screenshot", opt.first_screenshot,
                  "write the first frame that shows a model (streaming: the coarsest level) as PNG");
-  app.add_flag("--bench", opt.bench, "headless: print ms/frame");
+  app.add_flag("--bench", opt.bench, "headless: print ms/frame and the decoding's time");
+  app.add_flag("--decode-each-prefix", opt.decode_each_prefix,
+               "for measurements: decode every received prefix from scratch (the viewer before incremental "
+               "decoding) instead of each byte once");
   app.add_flag("--checker", opt.checker, "checkerboard texture in parameter space");
   app.add_flag("--wireframe", opt.wireframe, "wireframe");
   app.add_option("--limit-rate", opt.limit_rate, "download (or read) at most this many bytes per second");
   app.add_option("--timeout", opt.timeout, "headless: seconds to wait for the pack")->check(non_negative("seconds"));
+  app.add_option("--up", opt.up, "the models' up axis, shown upright (z for z-up data such as the horse)")
+      ->check(CLI::IsMember({"x", "y", "z"}));
   app.add_option("--yaw", opt.yaw, "camera yaw (radians)");
   app.add_option("--pitch", opt.pitch, "camera pitch (radians)");
-  app.add_option("--distance", opt.distance, "camera distance (normalized units)");
+  app.add_option("--distance", opt.distance,
+                 "camera distance (normalized units); default: the models fill about 70 % of the frame height");
   try {
     app.parse(argc, argv);
+    opt.distance_given = app.count("--distance") > 0;
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

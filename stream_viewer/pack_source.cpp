@@ -1,10 +1,24 @@
 #include "stream_viewer/pack_source.h"
 
+#include <time.h>
+
 #include <algorithm>
+#include <chrono>
 
 namespace geomip::viewer {
+namespace {
 
-PackSource::PackSource(const std::string& source, FetchOptions fetch, morph::DecodeSettings decode) : decode_(decode) {
+/// CPU time of the calling thread, milliseconds (POSIX CLOCK_THREAD_CPUTIME_ID).
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) / 1e6;
+}
+
+}  // namespace
+
+PackSource::PackSource(const std::string& source, FetchOptions fetch, morph::DecodeSettings decode)
+    : decode_(decode) {
   fetcher_ = std::make_unique<Fetcher>(source, fetch, [this] { wake_.notify_all(); });
   decoder_ = std::thread([this] { decode_loop(); });
 }
@@ -24,6 +38,11 @@ std::optional<SourceUpdate> PackSource::take_update() {
   std::optional<SourceUpdate> u = std::move(pending_);
   pending_.reset();
   return u;
+}
+
+PackSource::DecodeStats PackSource::decode_stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return decode_stats_;
 }
 
 bool PackSource::done() const {
@@ -59,6 +78,7 @@ void PackSource::decode_loop() {
 void PackSource::decode_chunks() {
   const codec::PackInfo* info = nullptr;  // the fetcher's, checked against the source's size
   std::size_t next_chunk = 0;             // first chunk not yet complete
+  morph::SceneDecoder scene(decode_);     // decodes each chunk once, however many updates there are
   for (;;) {
     std::uint64_t end = 0;
     {
@@ -69,7 +89,8 @@ void PackSource::decode_chunks() {
         const std::uint64_t received = fetcher_->received();
         if (!info) info = fetcher_->info();
         std::size_t c = next_chunk;
-        while (info && c < info->chunks.size() && info->chunks[c].offset + info->chunks[c].size <= received) ++c;
+        while (info && c < info->chunks.size() && info->chunks[c].offset + info->chunks[c].size <= received)
+          ++c;
         if (info && c > next_chunk && decode_error_.empty()) {
           next_chunk = c;
           end = info->chunks[c - 1].offset + info->chunks[c - 1].size;
@@ -88,17 +109,28 @@ void PackSource::decode_chunks() {
     std::vector<morph::SceneModel> models;
     std::string err;
     try {
-      models = morph::decode_scene({fetcher_->data(), static_cast<std::size_t>(end)}, decode_, status, used);
+      const auto t0 = std::chrono::steady_clock::now();
+      const double cpu0 = thread_cpu_ms();
+      models = scene.update({fetcher_->data(), static_cast<std::size_t>(end)}, status, used);
+      const double cpu = thread_cpu_ms() - cpu0;
+      const double wall =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      std::lock_guard<std::mutex> lock(mutex_);
+      decode_stats_.updates += 1;
+      decode_stats_.thread_cpu_ms += cpu;
+      decode_stats_.wall_ms += wall;
     } catch (const std::exception& e) {
       err = std::string("decode failed: ") + e.what();
     }
     if (status == codec::Status::kCorrupt || status == codec::Status::kUnsupportedVersion)
-      err = "decode stopped at byte " + std::to_string(used) + ": " + std::string(codec::status_message(status));
+      err = "decode stopped at byte " + std::to_string(used) + ": " +
+            std::string(codec::status_message(status));
     std::lock_guard<std::mutex> lock(mutex_);
     if (!err.empty() && decode_error_.empty()) decode_error_ = err;  // later chunks are not decoded
     decoded_end_ = end;
     // bytes_used: what the shown models really come from (less than `end` when a chunk failed its CRC)
-    if (!models.empty()) pending_ = SourceUpdate{std::move(models), std::min<std::uint64_t>(used, end), fetcher_->total()};
+    if (!models.empty())
+      pending_ = SourceUpdate{std::move(models), std::min<std::uint64_t>(used, end), fetcher_->total()};
   }
 }
 

@@ -1,5 +1,6 @@
 // The viewer's glue to the codec: a pack from a file or URL, fetched in the background (fetcher.h) and
-// decoded on a worker thread each time new complete chunks arrive; the render thread polls take_update(),
+// decoded on a worker thread each time new complete chunks arrive — incrementally (morph::SceneDecoder), so
+// each byte is decoded once however many updates the stream brings; the render thread polls take_update(),
 // which never blocks on the network or the decoder.
 #pragma once
 
@@ -14,8 +15,8 @@
 #include <vector>
 
 #include "codec/pack.h"
-#include "stream_viewer/fetcher.h"
 #include "morph/scene_model.h"
+#include "stream_viewer/fetcher.h"
 
 namespace geomip::viewer {
 
@@ -46,6 +47,16 @@ class PackSource {
   /// Whole pack received and decoded without error.
   bool complete() const;
 
+  /// What decoding cost so far: scene updates (each decodes only the chunks that completed since the last
+  /// one: morph::SceneDecoder), the decode thread's CPU time in them (the per-patch worker threads a decode
+  /// starts are not counted) and their wall time.
+  struct DecodeStats {
+    int updates = 0;
+    double thread_cpu_ms = 0;
+    double wall_ms = 0;
+  };
+  DecodeStats decode_stats() const;
+
  private:
   void decode_loop();
   void decode_chunks();  ///< the decode loop proper; may throw (decode_loop turns that into error())
@@ -59,6 +70,7 @@ class PackSource {
   std::optional<SourceUpdate> pending_;
   std::string decode_error_;
   std::uint64_t decoded_end_ = 0;
+  DecodeStats decode_stats_;
   std::thread decoder_;
 };
 

@@ -3,6 +3,20 @@
 // Pack decode times (the issue's benchmark: a whole level-8 bunny pack, in-process):
 //   codec_bench --pack FILE.gip     (CODEC_DECODE_REPS = repetitions, best taken; default 20)
 //
+// Streaming and Draco (issue #16's figures, all ratios from one run):
+//   codec_bench --stream FILE.gip [MESH.obj]     (CODEC_DECODE_REPS as above; default 10)
+// prints the full one-shot decode time; the time to decode the pack as 64 equal byte increments with the
+// incremental decoder (PackDecoder), (a) with the models reconstructed after every increment, as a viewer
+// that shows each one does, (b) reconstructed once at the end, and (c) the old way, a one-shot decode of
+// every prefix; each as a ratio to the full decode. With MESH (the mesh the pack was made from), also
+// Draco's in-process decode of that full mesh (14-bit positions, compression level 10, best of the same
+// repetitions) and geomip's full decode as a ratio to it.
+//
+// For instruction counts (valgrind --tool=callgrind, repeatable on a shared machine), one decode on one
+// thread:
+//   codec_bench --decode-once FILE.gip full|increments|shown
+// (full: decode_pack; increments: 64 PackDecoder updates, models at the end; shown: models after each).
+//
 // Rate–distortion report instead of benchmarks:
 //   codec_bench --rd FILE.geometry.exr|synthetic [--filter linear|cubic|both] [--steps N] [--bits B] [--mesh
 //   M | --surface on] [--frames K] [--tshift T] [--orient 0|1]
@@ -28,6 +42,7 @@
 #include <thread>
 #include <vector>
 
+#include "baselines/draco_baseline.h"
 #include "codec/geometry_codec.h"
 #include "codec/pack.h"
 #include "gimage/exr_io.h"
@@ -222,16 +237,22 @@ int rd_report(const Model& m, const std::string& filters, int steps, int bits) {
   return 0;
 }
 
-/// --pack FILE: in-process decode time of a .gip (best of `reps`), whole and for a few prefixes, geometry
-/// only and with normal maps, on one thread and on every hardware thread.
-int pack_report(const std::string& path) {
+/// The bytes of `path`; false (and a line on stderr) when it cannot be read.
+bool read_file(const std::string& path, std::vector<std::uint8_t>& bytes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     std::fprintf(stderr, "codec_bench: cannot open %s\n", path.c_str());
-    return 2;
+    return false;
   }
-  const std::vector<std::uint8_t> pack((std::istreambuf_iterator<char>(in)),
-                                       std::istreambuf_iterator<char>());
+  bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return true;
+}
+
+/// --pack FILE: in-process decode time of a .gip (best of `reps`), whole and for a few prefixes, geometry
+/// only and with normal maps, on one thread and on every hardware thread.
+int pack_report(const std::string& path) {
+  std::vector<std::uint8_t> pack;
+  if (!read_file(path, pack)) return 2;
   const int reps = std::getenv("CODEC_DECODE_REPS") ? std::atoi(std::getenv("CODEC_DECODE_REPS")) : 20;
   std::printf("%s: %zu bytes, %u hardware threads, best of %d\n", path.c_str(), pack.size(),
               std::thread::hardware_concurrency(), reps);
@@ -258,10 +279,100 @@ int pack_report(const std::string& path) {
   return 0;
 }
 
+/// Best wall time of `reps` runs of f(), milliseconds.
+template <typename F>
+double best_ms(int reps, F&& f) {
+  double best = 1e30;
+  for (int k = 0; k < reps; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    best = std::min(best,
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return best;
+}
+
+/// --stream FILE [MESH]: see the file comment.
+int stream_report(const std::string& path, const char* mesh_path) {
+  std::vector<std::uint8_t> pack;
+  if (!read_file(path, pack)) return 2;
+  const int reps = std::getenv("CODEC_DECODE_REPS") ? std::atoi(std::getenv("CODEC_DECODE_REPS")) : 10;
+  constexpr int kIncrements = 64;
+  std::vector<std::size_t> cuts;
+  for (int k = 1; k <= kIncrements; ++k)
+    cuts.push_back(pack.size() * static_cast<std::size_t>(k) / kIncrements);
+  std::printf("%s: %zu bytes, %u hardware threads, best of %d\n", path.c_str(), pack.size(),
+              std::thread::hardware_concurrency(), reps);
+  for (int threads : {1, 0}) {
+    const PackDecodeOptions options{.max_threads = threads};
+    PackDecodeResult r;
+    const double full = best_ms(reps, [&] { r = decode_pack(pack, options); });
+    const double shown = best_ms(reps, [&] {
+      PackDecoder decoder(options);
+      for (std::size_t n : cuts) {
+        decoder.update(std::span<const std::uint8_t>(pack.data(), n));
+        benchmark::DoNotOptimize(decoder.result());
+      }
+    });
+    const double at_end = best_ms(reps, [&] {
+      PackDecoder decoder(options);
+      for (std::size_t n : cuts) decoder.update(std::span<const std::uint8_t>(pack.data(), n));
+      benchmark::DoNotOptimize(decoder.result());
+    });
+    const double prefixes = best_ms(std::max(1, reps / 5), [&] {
+      for (std::size_t n : cuts)
+        benchmark::DoNotOptimize(decode_pack(pack, {.max_bytes = n, .max_threads = threads}));
+    });
+    std::printf("  %-9s full decode %7.2f ms (%s, detail level %d)\n", threads == 1 ? "1 thread" : "threads",
+                full, std::string(status_message(r.status)).c_str(),
+                r.models.empty() ? -1 : r.models[0].detail_level);
+    std::printf("  %-9s %d increments, shown after each: %7.2f ms = %.2fx the full decode\n", "", kIncrements,
+                shown, shown / full);
+    std::printf("  %-9s %d increments, shown at the end: %7.2f ms = %.2fx\n", "", kIncrements, at_end,
+                at_end / full);
+    std::printf("  %-9s %d one-shot decodes of the prefixes: %7.2f ms = %.2fx\n", "", kIncrements, prefixes,
+                prefixes / full);
+    if (mesh_path && threads == 1) {
+      const geomip::TriMesh mesh = geomip::read_mesh(mesh_path);
+      const geomip::DracoResult draco =
+          geomip::draco_encode(mesh, {.quantization_bits = 14, .compression_level = 10, .decode_runs = reps});
+      std::printf("  Draco (in-process, %s, %zu vertices, 14 bits, level 10): %zu bytes, decode %.2f ms\n",
+                  mesh_path, mesh.positions.size(), draco.bytes.size(), draco.decode_ms);
+      std::printf("  geomip full decode (1 thread) / Draco decode = %.2f\n", full / draco.decode_ms);
+      const double full_threads = best_ms(reps, [&] { r = decode_pack(pack); });
+      std::printf("  geomip full decode (all threads, %.2f ms) / Draco decode = %.2f\n", full_threads,
+                  full_threads / draco.decode_ms);
+    }
+  }
+  return 0;
+}
+
+/// --decode-once FILE MODE: see the file comment.
+int decode_once(const std::string& path, const std::string& mode) {
+  std::vector<std::uint8_t> pack;
+  if (!read_file(path, pack)) return 2;
+  const PackDecodeOptions options{.max_threads = 1};
+  if (mode == "full") {
+    benchmark::DoNotOptimize(decode_pack(pack, options));
+    return 0;
+  }
+  PackDecoder decoder(options);
+  for (int k = 1; k <= 64; ++k) {
+    decoder.update(
+        std::span<const std::uint8_t>(pack.data(), pack.size() * static_cast<std::size_t>(k) / 64));
+    if (mode == "shown") benchmark::DoNotOptimize(decoder.result());
+  }
+  benchmark::DoNotOptimize(decoder.result());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 4 && std::strcmp(argv[1], "--decode-once") == 0) return decode_once(argv[2], argv[3]);
   if (argc == 3 && std::strcmp(argv[1], "--pack") == 0) return pack_report(argv[2]);
+  if ((argc == 3 || argc == 4) && std::strcmp(argv[1], "--stream") == 0)
+    return stream_report(argv[2], argc == 4 ? argv[3] : nullptr);
   if (argc >= 3 && std::strcmp(argv[1], "--rd") == 0) {
     std::string filters = "both";
     int steps = -1, bits = 16;

@@ -3,38 +3,40 @@
 // decoding):
 //   ./build/tests/make_golden_pack tests/data/golden-pillow-v3.gip   (format version 3)
 // (tests/data/golden-pillow.gip was written by format version 1, golden-pillow-v2.gip by version 2.)
+// With --per-patch, a small fuzzer seed instead (tests/fuzz/seeds/pack/pillow-l4-per-patch.gip): one level-4
+// pillow with normal maps whose joint part ends after 64 bytes, so most of its bytes are per-patch streams
+// (the other seeds are smaller than the default 2 KB joint part):
+//   ./build/tests/make_golden_pack --per-patch tests/fuzz/seeds/pack/pillow-l4-per-patch.gip
 #include "codec/pack.h"
 #include "tests/codec/pillow.h"
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <string>
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: make_golden_pack OUT.gip\n");
+  const bool per_patch = argc == 3 && std::string(argv[1]) == "--per-patch";
+  if (argc != 2 && !per_patch) {
+    std::fprintf(stderr, "usage: make_golden_pack [--per-patch] OUT.gip\n");
     return 2;
   }
+  const char* path = argv[argc - 1];
+  geomip::codec::PackWriteOptions options;
+  if (per_patch) options.geometry.joint_bytes = options.normal_codec.joint_bytes = 64;
   std::vector<geomip::codec::PackModelInput> models;
-  for (int m = 0; m < 2; ++m) {
-    const geomip::test::Pillow p = geomip::test::make_pillow(5, m == 0 ? 1.0 : 2.0);
+  for (int m = 0; m < (per_patch ? 1 : 2); ++m) {
+    const geomip::test::Pillow p = geomip::test::make_pillow(per_patch ? 4 : 5, m == 0 ? 1.0 : 2.0);
     geomip::codec::PackModelInput in;
     in.name = m == 0 ? "a" : "b";
     in.geometry = p.patches;
     in.seams = p.seams;
-    in.normals = p.patches;
-    for (auto& g : in.normals) {
-      for (std::size_t k = 0; k < g.values.size(); k += 3) {
-        float* v = g.values.data() + k;
-        const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        for (int c = 0; c < 3; ++c) v[c] = len > 0 ? v[c] / len : (c == 2 ? 1.f : 0.f);
-      }
-    }
+    in.normals = geomip::test::position_normals(p.patches);
     models.push_back(std::move(in));
   }
-  const std::vector<std::uint8_t> pack = geomip::codec::write_pack(models);
-  std::ofstream out(argv[1], std::ios::binary);
+  const std::vector<std::uint8_t> pack = geomip::codec::write_pack(models, options);
+  std::ofstream out(path, std::ios::binary);
   out.write(reinterpret_cast<const char*>(pack.data()), static_cast<std::streamsize>(pack.size()));
-  std::printf("%s: %zu bytes\n", argv[1], pack.size());
+  std::printf("%s: %zu bytes\n", path, pack.size());
   return out ? 0 : 1;
 }

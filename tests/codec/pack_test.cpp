@@ -25,17 +25,8 @@ PackModelInput pillow_model(int level, const std::string& name, double scale = 1
   m.name = name;
   m.geometry = p.patches;
   m.seams = p.seams;
-  if (normals) {
-    // Any smooth unit field will do for the container tests: the normalized position.
-    m.normals = p.patches;
-    for (Grid3& g : m.normals) {
-      for (std::size_t k = 0; k < g.values.size(); k += 3) {
-        float* v = g.values.data() + k;
-        const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        for (int c = 0; c < 3; ++c) v[c] = len > 0 ? v[c] / len : (c == 2 ? 1.f : 0.f);
-      }
-    }
-  }
+  // Any smooth unit field will do for the container tests: the normalized position.
+  if (normals) m.normals = test::position_normals(p.patches);
   return m;
 }
 

@@ -1,6 +1,6 @@
 // A closed two-patch test surface for codec tests: a "pillow" over [−1,1]², the top patch z = h(x, y), the
-// bottom patch z = −h with its (i, j) transposed so both are oriented outward; h = 0 on the square's border, so
-// the four sides are glued (reversed), and seam samples are bit-identical in both patches.
+// bottom patch z = −h with its (i, j) transposed so both are oriented outward; h = 0 on the square's border,
+// so the four sides are glued (reversed), and seam samples are bit-identical in both patches.
 #pragma once
 
 #include "codec/geometry_codec.h"
@@ -20,6 +20,20 @@ struct Pillow {
   std::vector<codec::Grid3> patches;
   std::vector<codec::PatchSeam> seams;
 };
+
+/// A smooth unit vector field for normal-map tests: each sample's normalized position ((0, 0, 1) at the
+/// origin). The normal maps of the golden packs are made this way.
+inline std::vector<codec::Grid3> position_normals(const std::vector<codec::Grid3>& patches) {
+  std::vector<codec::Grid3> normals = patches;
+  for (codec::Grid3& g : normals) {
+    for (std::size_t k = 0; k < g.values.size(); k += 3) {
+      float* v = g.values.data() + k;
+      const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (int c = 0; c < 3; ++c) v[c] = len > 0 ? v[c] / len : (c == 2 ? 1.f : 0.f);
+    }
+  }
+  return normals;
+}
 
 /// The pillow sampled on (2^level+1)² grids, with `scale` applied to every coordinate.
 inline Pillow make_pillow(int level, double scale = 1.0) {
@@ -54,10 +68,18 @@ inline Pillow make_pillow(int level, double scale = 1.0) {
 inline void side_sample(int level, int side, int k, int& i, int& j) {
   const int last = 1 << level;
   switch (side) {
-    case 0: i = k, j = 0; break;
-    case 1: i = last, j = k; break;
-    case 2: i = last - k, j = last; break;
-    default: i = 0, j = last - k; break;
+    case 0:
+      i = k, j = 0;
+      break;
+    case 1:
+      i = last, j = k;
+      break;
+    case 2:
+      i = last - k, j = last;
+      break;
+    default:
+      i = 0, j = last - k;
+      break;
   }
 }
 

@@ -8,9 +8,10 @@
 // fuzzer's time on them would leave it at ~25 inputs/s instead of a thousand and more. The check is here, in
 // the harness: it reads the same manifest the decoder reads, with read_pack_info(), and changes nothing in
 // codec/.
-#include "tests/fuzz/fuzz_bounds.h"
 #include "codec/pack.h"
+#include "tests/fuzz/fuzz_bounds.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
@@ -30,8 +31,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   // One decode per input, its options chosen by the input's length: the whole pack; a prefix as a streaming
   // client sees it (partial chunks, no normals, the finest step dropped); a longer prefix of whole chunks
-  // only. One thread: starting a thread per patch and input would cost more than the decoding.
-  switch (size % 3) {
+  // only; the whole pack fed to the incremental decoder in increments of 1 to 64 bytes (the first byte
+  // decides), as the viewer feeds it. One thread: starting a thread per patch and input would cost more than
+  // the decoding.
+  switch (size % 4) {
     case 0:
       geomip::codec::decode_pack(bytes, {.max_threads = 1});
       break;
@@ -42,10 +45,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                                          .drop_finest_steps = 1,
                                          .max_threads = 1});
       break;
-    default:
+    case 2:
       geomip::codec::decode_pack(bytes,
                                  {.max_bytes = size - size / 8, .partial_chunks = false, .max_threads = 1});
       break;
+    default: {
+      geomip::codec::PackDecoder decoder({.max_threads = 1});
+      const std::size_t step = 1 + (size > 0 ? data[0] % 64 : 0);
+      for (std::size_t n = 0; n < size; n = std::min(size, n + step)) decoder.update(bytes.first(n));
+      decoder.update(bytes);
+      decoder.result();
+      break;
+    }
   }
   return 0;
 }

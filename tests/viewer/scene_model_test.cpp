@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "tests/viewer/viewer_fixtures.h"
 
@@ -128,7 +129,7 @@ TEST(Alignment, RecoversAKnownSimilarity) {
     EXPECT_NEAR(det, 1.0, 1e-9);
   }
   EXPECT_THROW(morph::best_alignment(morph::make_scene_model(testing::decoded_model(4, 1)),
-                              morph::make_scene_model(testing::decoded_model(3, 1))),
+                                     morph::make_scene_model(testing::decoded_model(3, 1))),
                std::invalid_argument);
 }
 
@@ -163,7 +164,8 @@ TEST(DecodeScene, AlignedModelsMorphWithoutCollapsing) {
   for (bool align : {true, false}) {
     codec::Status status;
     std::size_t used = 0;
-    const auto models = morph::decode_scene(bytes, morph::DecodeSettings{.bands = 1, .align = align}, status, used);
+    const auto models =
+        morph::decode_scene(bytes, morph::DecodeSettings{.bands = 1, .align = align}, status, used);
     ASSERT_EQ(models.size(), 2u);
     const auto mid = morph::evaluate_morph(models[0], models[1], 0.5f, morph::MorphSchedule::kLinear);
     std::vector<float> all;
@@ -186,9 +188,53 @@ TEST(DecodeScene, AlignedModelsMorphWithoutCollapsing) {
   }
 }
 
-// What the streaming viewer does with every prefix that arrives: morph::decode_scene never throws on a prefix, and
-// gives either nothing (no geometry pass of model 0 yet) or both models at the pack's level, finite, with
-// more bytes never giving fewer models.
+// --up: the chosen axis becomes +y (a rotation: lengths and handedness kept).
+TEST(UpRotation, TurnsTheUpAxisIntoPlusY) {
+  for (char up : {'x', 'y', 'z'}) {
+    const auto r = morph::up_rotation(up).rotation;
+    const int a = up - 'x';
+    // Column a of R is R·e_a: it must be +y.
+    EXPECT_EQ(r[static_cast<std::size_t>(a)], 0.0) << up;
+    EXPECT_EQ(r[static_cast<std::size_t>(3 + a)], 1.0) << up;
+    EXPECT_EQ(r[static_cast<std::size_t>(6 + a)], 0.0) << up;
+    const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                       r[2] * (r[3] * r[7] - r[4] * r[6]);
+    EXPECT_EQ(det, 1.0) << up;
+  }
+}
+
+// The streaming viewer's decoder (morph::SceneDecoder, each byte decoded once, the bands of the wavelet morph
+// from one decode) gives, after every update, exactly what a one-shot decode_scene of that prefix gives.
+TEST(SceneDecoder, StreamEqualsOneShotDecodeOfEveryPrefix) {
+  const auto bytes = codec::write_pack({testing::pack_input(5, 0), testing::pack_input(5, 1)});
+  for (int bands : {1, 3}) {
+    morph::SceneDecoder decoder(morph::DecodeSettings{.bands = bands});
+    for (std::size_t n = 0; n <= bytes.size(); n += 1 + n / 7) {
+      codec::Status status = codec::Status::kOk, one_status = codec::Status::kOk;
+      std::size_t used = 0, one_used = 0;
+      const auto models = decoder.update({bytes.data(), n}, status, used);
+      const auto one =
+          morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands}, one_status, one_used);
+      EXPECT_EQ(status, one_status) << n;
+      EXPECT_EQ(used, one_used) << n;
+      ASSERT_EQ(models.size(), one.size()) << n;
+      for (std::size_t m = 0; m < models.size(); ++m) {
+        EXPECT_EQ(models[m].bands, bands);
+        EXPECT_EQ(models[m].detail_level, one[m].detail_level) << n;
+        ASSERT_EQ(models[m].positions.size(), one[m].positions.size());
+        EXPECT_EQ(std::memcmp(models[m].positions.data(), one[m].positions.data(),
+                              models[m].positions.size() * sizeof(float)),
+                  0)
+            << n << " bytes, model " << m << ", " << bands << " bands";
+        EXPECT_EQ(models[m].normals, one[m].normals) << n;
+      }
+    }
+  }
+}
+
+// What the streaming viewer does with every prefix that arrives: morph::decode_scene never throws on a
+// prefix, and gives either nothing (no geometry pass of model 0 yet) or both models at the pack's level,
+// finite, with more bytes never giving fewer models.
 TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
   const auto bytes = codec::write_pack({testing::pack_input(4, 0), testing::pack_input(4, 1)});
   bool seen_models = false;
@@ -197,7 +243,8 @@ TEST(DecodeScene, EveryPrefixOfAPackDecodesCleanly) {
     std::size_t used = 0;
     std::vector<morph::SceneModel> models;
     for (int bands : {1, 3}) {
-      ASSERT_NO_THROW(models = morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands}, status, used))
+      ASSERT_NO_THROW(models = morph::decode_scene({bytes.data(), n}, morph::DecodeSettings{.bands = bands},
+                                                   status, used))
           << n << " bytes";
       EXPECT_LE(used, n);
       if (models.empty()) {

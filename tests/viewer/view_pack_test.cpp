@@ -181,6 +181,16 @@ class ViewPackTest : public ::testing::Test {
 };
 GlContext* ViewPackTest::context_ = nullptr;
 
+/// The viewer's default camera for a pack's decoded models (one band each): all of them framed together to
+/// about 70 % of the height (framing_distance).
+Camera framed(const std::vector<morph::SceneModel>& models) {
+  std::vector<float> xyz;
+  for (const auto& m : models) xyz.insert(xyz.end(), m.positions.begin(), m.positions.end());
+  Camera camera;
+  camera.distance = framing_distance(camera, xyz, kW, kH);
+  return camera;
+}
+
 std::vector<morph::SceneModel> decode_file(const fs::path& path) {
   const auto bytes = read_bytes(path);
   codec::Status status;
@@ -202,11 +212,41 @@ TEST_F(ViewPackTest, ScreenshotCoversTheDecodedModelsSilhouette) {
                          std::to_string(level) + " --screenshot " + png.string());
       ASSERT_EQ(r.code, 0) << r.err;
       const auto image = image_coverage(load(png));
-      const auto reference = cpu_coverage(models[m], level, Camera{}, kW, kH);
+      const auto reference = cpu_coverage(models[m], level, framed(models), kW, kH);
       EXPECT_GT(count(reference), std::size_t(kW * kH / 20));
       EXPECT_GT(iou(image, reference), 0.95) << "model " << m << " level " << level;
       EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "no cracks: model " << m << " level " << level;
     }
+}
+
+// The default camera frames the models: the larger silhouette's bounding box spans 60–80 % of the frame's
+// height (or of its width, for models wider than the frame's aspect), and neither model is cut off. (Both
+// models of a pack are framed together, so a morph between them keeps one camera.)
+TEST_F(ViewPackTest, DefaultCameraFramesTheModels) {
+  const fs::path pack = pack_file(6);
+  double largest = 0;
+  for (int m = 0; m < 2; ++m) {
+    const fs::path png = work_dir() / ("framed" + std::to_string(m) + ".png");
+    const ViewRun r = view(pack.string() + " " + size_args() + " --model " + std::to_string(m) + " --screenshot " +
+                           png.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto image = image_coverage(load(png));
+    int x0 = kW, x1 = -1, y0 = kH, y1 = -1;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x)
+        if (image[static_cast<std::size_t>(y) * kW + x])
+          x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    ASSERT_GE(y1, y0) << "nothing drawn";
+    const double height = static_cast<double>(y1 - y0 + 1) / kH, width = static_cast<double>(x1 - x0 + 1) / kW;
+    std::cout << "model " << m << ": silhouette spans " << height << " of the height, " << width << " of the width\n";
+    largest = std::max({largest, height, width});
+    EXPECT_GT(x0, 0) << "model " << m << " cut off";
+    EXPECT_LT(x1, kW - 1) << "model " << m << " cut off";
+    EXPECT_GT(y0, 0) << "model " << m << " cut off";
+    EXPECT_LT(y1, kH - 1) << "model " << m << " cut off";
+  }
+  EXPECT_GE(largest, 0.6);
+  EXPECT_LE(largest, 0.8);
 }
 
 #ifdef GEOMIP_BINARY
@@ -226,7 +266,7 @@ TEST_F(ViewPackTest, ConvertedMeshCoversItsSilhouetteWithoutCracks) {
                            " --screenshot " + png.string());
     ASSERT_EQ(r.code, 0) << r.err;
     const auto image = image_coverage(load(png));
-    const auto reference = cpu_coverage(models[0], level, Camera{}, kW, kH);
+    const auto reference = cpu_coverage(models[0], level, framed(models), kW, kH);
     EXPECT_GT(count(reference), std::size_t(kW * kH / 20));
     EXPECT_GT(iou(image, reference), 0.95) << "level " << level;
     EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "no cracks at level " << level;
@@ -282,7 +322,7 @@ TEST_F(ViewPackTest, GoldenPackRendersBothModelsAndTheirMorph) {
                            png.string());
     ASSERT_EQ(r.code, 0) << r.err;
     alone.push_back(load(png));
-    const auto reference = cpu_coverage(models[m], models[m].level, Camera{}, kW, kH);
+    const auto reference = cpu_coverage(models[m], models[m].level, framed(models), kW, kH);
     EXPECT_GT(iou(image_coverage(alone.back()), reference), 0.95) << "model " << m;
     EXPECT_EQ(interior_misses(image_coverage(alone.back()), reference, kW, kH), 0u) << "model " << m;
   }
@@ -337,7 +377,7 @@ TEST_F(ViewPackTest, StreamingShowsACoarseModelFromTheFirstFewPercent) {
   EXPECT_EQ(of, total);
   EXPECT_LE(shown, total / 20) << "first model should come from at most 5% of the pack";
   const auto coarse = image_coverage(load(first));
-  const auto full = cpu_coverage(full_models[0], full_models[0].level, Camera{}, kW, kH);
+  const auto full = cpu_coverage(full_models[0], full_models[0].level, framed(full_models), kW, kH);
   EXPECT_GT(count(coarse), count(full) / 4) << "the coarse model should be visible";
   EXPECT_GT(iou(coarse, full), 0.6) << "and overlap the full model";
   EXPECT_GT(iou(image_coverage(load(last)), full), 0.95) << "the final frame is the full model";
@@ -358,7 +398,7 @@ TEST_F(ViewPackTest, ServerWithoutRangeSupportStreamsTheWholeFile) {
   std::istringstream(r.out.substr(at + 22)) >> shown;
   EXPECT_LT(shown, total / 2) << "one plain GET still shows coarse levels before the end";
   const auto models = decode_file(pack);
-  EXPECT_GT(iou(image_coverage(load(last)), cpu_coverage(models[0], models[0].level, Camera{}, kW, kH)), 0.95);
+  EXPECT_GT(iou(image_coverage(load(last)), cpu_coverage(models[0], models[0].level, framed(models), kW, kH)), 0.95);
 }
 
 TEST_F(ViewPackTest, ServerKilledMidStreamKeepsTheLastCompleteLevel) {
@@ -372,7 +412,7 @@ TEST_F(ViewPackTest, ServerKilledMidStreamKeepsTheLastCompleteLevel) {
   EXPECT_NE(r.err.find("connection"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("kept the level"), std::string::npos) << r.err;
   const auto models = decode_file(pack);
-  EXPECT_GT(iou(image_coverage(load(last)), cpu_coverage(models[0], models[0].level, Camera{}, kW, kH)), 0.8)
+  EXPECT_GT(iou(image_coverage(load(last)), cpu_coverage(models[0], models[0].level, framed(models), kW, kH)), 0.8)
       << "the last complete level is still shown";
 }
 

@@ -487,5 +487,103 @@ TEST(PartitionErrors, BadMeshesAreRejectedWithAClearMessage) {
   expect_invalid(t.mesh, t.p, aux, "must be distinct");
 }
 
+// ------------------------------------------------------------------------------------------- quad layouts
+
+// The cube's 6 faces as quads over its 8 corners (test::cube()'s vertex ids), counter-clockwise from outside.
+const std::vector<std::array<int, 4>> kCubeQuads = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                                    {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+
+// test::sphere() keeps the cube's corners as vertices 0..7 (subdivision appends).
+QuadLayout cube_layout() {
+  return QuadLayout{{0, 1, 2, 3, 4, 5, 6, 7}, kCubeQuads};
+}
+
+void expect_invalid_layout(const TriMesh& m, const QuadLayout& layout, const std::string& fragment) {
+  try {
+    partition_mesh_layout(m, layout);
+    ADD_FAILURE() << "no exception; expected one mentioning '" << fragment << "'";
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("partition_mesh:"), std::string::npos) << what;
+    EXPECT_NE(what.find(fragment), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+TEST(PartitionLayout, CubeLayoutOnASphereGivesSixGluedDisks) {
+  const TriMesh m = sphere(4);
+  const QuadLayout layout = cube_layout();
+  const PartitionResult r = partition_mesh_layout(m, layout);
+  EXPECT_EQ(test::check_partition(m, layout.corners, r, &layout), "");
+  EXPECT_EQ(embedding_problems(r), "");
+  // By symmetry every face of the cube gets a sixth of the sphere.
+  const PartitionStats stats = partition_stats(r);
+  EXPECT_GT(stats.area_balance, 0.95);
+}
+
+TEST(PartitionLayout, CornerCyclesAreKeptWhenShortestPathsWouldCross) {
+  // Corners moved off the cube's vertices (towards a neighbouring face centre) and a rotated sphere: the
+  // paths are no longer mesh lines, and each must leave its corners between the right neighbours.
+  TriMesh m = sphere(4);
+  const Eigen::Matrix3d rot =
+      (Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
+  for (auto& p : m.positions) p = rot * p;
+  QuadLayout layout = cube_layout();
+  const TriMesh c = test::cube();
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d corner = c.positions[k] - Eigen::Vector3d::Constant(0.5);
+    const Eigen::Vector3d pushed = corner + Eigen::Vector3d(0.25 * (k % 3 == 0 ? 1 : -1), 0.1 * (k % 2), 0.0);
+    layout.corners[k] = nearest_vertex(m, rot * pushed.normalized());
+  }
+  const PartitionResult r = partition_mesh_layout(m, layout);
+  EXPECT_EQ(test::check_partition(m, layout.corners, r, &layout), "");
+  EXPECT_EQ(embedding_problems(r), "");
+}
+
+TEST(PartitionLayout, TorusGridLayoutOfNineQuads) {
+  const int n = 24, mm = 12;
+  const TriMesh m = test::torus(n, mm);
+  auto id = [&](int i, int j) { return ((i + n) % n) * mm + (j + mm) % mm; };
+  QuadLayout layout;
+  auto corner = [&](int a, int b) { return ((a + 3) % 3) * 3 + (b + 3) % 3; };
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) layout.corners.push_back(id(a * n / 3, b * mm / 3));
+  }
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b)
+      layout.quads.push_back({corner(a, b), corner(a + 1, b), corner(a + 1, b + 1), corner(a, b + 1)});
+  }
+  const PartitionResult r = partition_mesh_layout(m, layout);
+  EXPECT_EQ(test::check_partition(m, layout.corners, r, &layout), "");
+  EXPECT_EQ(embedding_problems(r), "");
+}
+
+TEST(PartitionLayout, BadLayoutsAreRejectedWithOneLine) {
+  const TriMesh m = sphere(3);
+  QuadLayout open = cube_layout();
+  open.quads.pop_back();
+  expect_invalid_layout(m, open, "not closed");
+  QuadLayout flipped = cube_layout();
+  std::reverse(flipped.quads[2].begin(), flipped.quads[2].end());
+  expect_invalid_layout(m, flipped, "same way by two quads");
+  QuadLayout repeated = cube_layout();
+  repeated.quads[0][1] = repeated.quads[0][0];
+  expect_invalid_layout(m, repeated, "repeats corner");
+  QuadLayout out_of_range = cube_layout();
+  out_of_range.quads[0][0] = 8;
+  expect_invalid_layout(m, out_of_range, "outside [0,8)");
+  QuadLayout bad_vertex = cube_layout();
+  bad_vertex.corners[3] = static_cast<int>(m.positions.size());
+  expect_invalid_layout(m, bad_vertex, "out of range");
+  // Inside out: a closed quad surface, but its corner cycles run clockwise on the mesh.
+  QuadLayout inside_out = cube_layout();
+  for (auto& q : inside_out.quads) std::reverse(q.begin(), q.end());
+  expect_invalid_layout(m, inside_out, "counter-clockwise seen from outside");
+  // A sphere's layout on a torus: wrong Euler characteristic.
+  const TriMesh t = test::torus(16, 8);
+  expect_invalid_layout(t, cube_layout(), "Euler characteristic 2");
+  EXPECT_EQ(check_quad_layout(cube_layout(), 8, 0), "");
+}
+
 }  // namespace
 }  // namespace geomip

@@ -707,6 +707,28 @@ PartitionResult partition_layout(const TriMesh& mesh, const QuadLayout& layout, 
         .norm();
   };
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return length(a) < length(b); });
+  // A spanning tree of the corners first (Kruskal, shortest first): tree paths cannot close a loop around a
+  // corner that a later path must reach. Then the other edges, shortest first.
+  {
+    std::vector<int> root(layout.corners.size());
+    for (std::size_t c = 0; c < root.size(); ++c) root[c] = static_cast<int>(c);
+    auto find = [&](int c) {
+      while (root[c] != c) c = root[c] = root[root[c]];
+      return c;
+    };
+    std::vector<int> tree, rest;
+    for (int e : order) {
+      const int a = find(layout_from(layout, edge_half[e])), b = find(layout_to(layout, edge_half[e]));
+      if (a != b) {
+        root[a] = b;
+        tree.push_back(e);
+      } else {
+        rest.push_back(e);
+      }
+    }
+    order = tree;
+    order.insert(order.end(), rest.begin(), rest.end());
+  }
   std::vector<PathSpec> specs;
   for (int e : order) {
     const int h = edge_half[e];

@@ -158,8 +158,8 @@ std::string check_quad_layout(const QuadLayout& layout, std::size_t num_vertices
 
 /// Partitions `closed_manifold` into one quadrilateral disk patch per quad of `layout`, of any genus.
 ///
-/// Layout edges are traced as Dijkstra shortest paths (edge graph, Euclidean lengths), shortest corner
-/// distance first. A path never passes through a corner other than its own two, nor through a vertex of an
+/// Layout edges are traced as Dijkstra shortest paths (edge graph, Euclidean lengths): first a spanning
+/// tree of the corners (Kruskal, shortest corner distance first), then the other edges, shortest first. A path never passes through a corner other than its own two, nor through a vertex of an
 /// earlier path. At both of its corners it must leave the corner between the already traced paths that are
 /// its neighbours in the layout's cyclic order around that corner (Praun et al. 2001, §3.3), so that paths
 /// land between the right neighbours and each region between them is bounded by its quad's four paths.

@@ -2,11 +2,13 @@
 // from the triangles), shared by the unit and real-mesh tests of partition_mesh().
 #pragma once
 
+#include "mesh/errors.h"
 #include "mesh/mesh.h"
 #include "mesh/mesh_topology.h"
 #include "mesh/predicates.h"
 #include "param/mesh_partition.h"
 
+#include <gtest/gtest.h>
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
@@ -20,6 +22,21 @@
 #include <vector>
 
 namespace geomip::test {
+
+/// `call()` must throw InvalidInput with a one-line message holding `prefix` (the function's name) and
+/// `fragment` (the reason).
+template <class Call>
+void expect_invalid_input(Call&& call, const std::string& prefix, const std::string& fragment) {
+  try {
+    call();
+    ADD_FAILURE() << "no exception; expected one mentioning '" << fragment << "'";
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(prefix), std::string::npos) << what;
+    EXPECT_NE(what.find(fragment), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
 
 inline double surface_area(const TriMesh& m) {
   double a = 0.0;

@@ -1,0 +1,377 @@
+#include "param/quad_layout.h"
+
+#include "mesh/errors.h"
+#include "mesh/mesh_topology.h"
+#include "mesh/predicates.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+#include <vector>
+
+namespace geomip {
+namespace {
+
+const char* const kFn = "choose_quad_layout: ";
+
+// Half-edge collapses on a closed manifold triangle mesh, shortest edge first, vertices never moved.
+class Simplifier {
+ public:
+  explicit Simplifier(const TriMesh& mesh) : m_(mesh) {
+    vf_.resize(m_.positions.size());
+    for (int f = 0; f < static_cast<int>(m_.triangles.size()); ++f) {
+      for (int v : m_.triangles[f]) vf_[v].push_back(f);
+    }
+    face_alive_.assign(m_.triangles.size(), 1);
+    stamp_.assign(m_.positions.size(), 0);
+    for (int v = 0; v < static_cast<int>(vf_.size()); ++v) {
+      if (!vf_[v].empty()) ++alive_;
+    }
+  }
+
+  // Collapses until `target` vertices remain; false when no legal collapse is left before that. When only
+  // collapses that turn a normal by 90° or more are left, they are allowed (the coarse mesh only guides the
+  // layout; the link condition keeps it a closed manifold).
+  bool simplify_to(std::size_t target) {
+    for (int v = 0; v < static_cast<int>(vf_.size()); ++v) push_edges(v);
+    while (alive_ > target) {
+      if (heap_.empty() && check_normals_) {
+        check_normals_ = false;
+        for (int v = 0; v < static_cast<int>(vf_.size()); ++v) push_edges(v);
+      }
+      if (heap_.empty()) return false;
+      const Entry e = heap_.top();
+      heap_.pop();
+      if (e.stamp_u != stamp_[e.u] || e.stamp_v != stamp_[e.v] || vf_[e.u].empty() || vf_[e.v].empty())
+        continue;
+      if (!legal(e.u, e.v)) continue;  // re-pushed when a neighbour changes
+      collapse(e.u, e.v);
+    }
+    return true;
+  }
+
+  // The coarse mesh: its triangles (original vertex ids), counter-clockwise.
+  std::vector<std::array<int, 3>> triangles() const {
+    std::vector<std::array<int, 3>> t;
+    for (std::size_t f = 0; f < m_.triangles.size(); ++f) {
+      if (face_alive_[f]) t.push_back(m_.triangles[f]);
+    }
+    return t;
+  }
+
+ private:
+  struct Entry {
+    double cost;
+    int u, v;  // collapse u into v
+    std::uint32_t stamp_u, stamp_v;
+    bool operator<(const Entry& o) const {  // max-heap: invert for the cheapest, ties by ids
+      return std::tie(cost, u, v) > std::tie(o.cost, o.u, o.v);
+    }
+  };
+
+  std::vector<int> neighbours(int u) const {
+    std::vector<int> n;
+    for (int f : vf_[u]) {
+      for (int w : m_.triangles[f]) {
+        if (w != u) n.push_back(w);
+      }
+    }
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+    return n;
+  }
+
+  Eigen::Vector3d normal(const std::array<int, 3>& t) const {
+    const auto& p = m_.positions;
+    return (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]);
+  }
+
+  // The link condition (u and v share exactly the two wing vertices) and no normal turned by ≥ 90°.
+  bool legal(int u, int v) const {
+    const std::vector<int> nu = neighbours(u), nv = neighbours(v);
+    if (!std::binary_search(nu.begin(), nu.end(), v)) return false;
+    std::vector<int> common;
+    std::set_intersection(nu.begin(), nu.end(), nv.begin(), nv.end(), std::back_inserter(common));
+    if (common.size() != 2) return false;
+    for (int f : vf_[u]) {
+      if (!check_normals_) break;
+      std::array<int, 3> t = m_.triangles[f];
+      if (std::find(t.begin(), t.end(), v) != t.end()) continue;
+      const Eigen::Vector3d before = normal(t);
+      for (int& w : t) {
+        if (w == u) w = v;
+      }
+      const Eigen::Vector3d after = normal(t);
+      if (!(after.dot(before) > 0.0)) return false;
+    }
+    return true;
+  }
+
+  void collapse(int u, int v) {
+    for (int f : vf_[u]) {
+      auto& t = m_.triangles[f];
+      if (std::find(t.begin(), t.end(), v) != t.end()) {
+        face_alive_[f] = 0;
+        for (int w : t) {
+          if (w == u) continue;
+          auto& list = vf_[w];
+          list.erase(std::remove(list.begin(), list.end(), f), list.end());
+        }
+      } else {
+        for (int& w : t) {
+          if (w == u) w = v;
+        }
+        vf_[v].push_back(f);
+      }
+    }
+    vf_[u].clear();
+    --alive_;
+    const std::vector<int> around = neighbours(v);
+    ++stamp_[v];
+    for (int w : around) ++stamp_[w];
+    push_edges(v);
+    for (int w : around) push_edges(w);
+  }
+
+  // Cost of removing u into v: the area of u's star (the vertex with the least surface around it goes
+  // first, which evens out the coarse triangles' areas), ties broken by the edge's length.
+  void push_edges(int u) {
+    double star = 0.0;
+    for (int f : vf_[u]) star += normal(m_.triangles[f]).norm();
+    for (int v : neighbours(u)) {
+      const double length = (m_.positions[u] - m_.positions[v]).norm();
+      heap_.push({star + 1e-3 * length * length, u, v, stamp_[u], stamp_[v]});
+    }
+  }
+
+  TriMesh m_;
+  std::vector<std::vector<int>> vf_;
+  std::vector<char> face_alive_;
+  std::vector<std::uint32_t> stamp_;
+  std::size_t alive_ = 0;
+  bool check_normals_ = true;
+  std::priority_queue<Entry> heap_;
+};
+
+// Maximum matching in a general graph: Edmonds' blossom algorithm, completing `match` (−1 = unmatched) by
+// augmenting paths. O(V³).
+class BlossomMatcher {
+ public:
+  BlossomMatcher(const std::vector<std::vector<int>>& graph, std::vector<int>& match)
+      : g_(graph), match_(match), n_(static_cast<int>(graph.size())) {}
+
+  void run() {
+    for (int root = 0; root < n_; ++root) {
+      if (match_[root] >= 0) continue;
+      int v = find_path(root);
+      while (v >= 0) {  // augment along parent links
+        const int pv = parent_[v], ppv = match_[pv];
+        match_[v] = pv;
+        match_[pv] = v;
+        v = ppv;
+      }
+    }
+  }
+
+ private:
+  int lca(int a, int b) {
+    std::vector<char> seen(n_, 0);
+    for (;;) {
+      a = base_[a];
+      seen[a] = 1;
+      if (match_[a] < 0) break;
+      a = parent_[match_[a]];
+    }
+    for (;;) {
+      b = base_[b];
+      if (seen[b]) return b;
+      b = parent_[match_[b]];
+    }
+  }
+
+  void mark_path(int v, int b, int child) {
+    while (base_[v] != b) {
+      blossom_[base_[v]] = blossom_[base_[match_[v]]] = 1;
+      parent_[v] = child;
+      child = match_[v];
+      v = parent_[match_[v]];
+    }
+  }
+
+  int find_path(int root) {
+    used_.assign(n_, 0);
+    parent_.assign(n_, -1);
+    base_.resize(n_);
+    for (int i = 0; i < n_; ++i) base_[i] = i;
+    used_[root] = 1;
+    std::queue<int> q;
+    q.push(root);
+    while (!q.empty()) {
+      const int v = q.front();
+      q.pop();
+      for (int to : g_[v]) {
+        if (base_[v] == base_[to] || match_[v] == to) continue;
+        if (to == root || (match_[to] >= 0 && parent_[match_[to]] >= 0)) {
+          const int b = lca(v, to);
+          blossom_.assign(n_, 0);
+          mark_path(v, b, to);
+          mark_path(to, b, v);
+          for (int i = 0; i < n_; ++i) {
+            if (blossom_[base_[i]]) {
+              base_[i] = b;
+              if (!used_[i]) {
+                used_[i] = 1;
+                q.push(i);
+              }
+            }
+          }
+        } else if (parent_[to] < 0) {
+          parent_[to] = v;
+          if (match_[to] < 0) return to;
+          used_[match_[to]] = 1;
+          q.push(match_[to]);
+        }
+      }
+    }
+    return -1;
+  }
+
+  const std::vector<std::vector<int>>& g_;
+  std::vector<int>& match_;
+  int n_;
+  std::vector<int> parent_, base_;
+  std::vector<char> used_, blossom_;
+};
+
+// The quad of triangles a and b, which share an edge: the shared edge x→y of a, a's third vertex z, b's w.
+std::array<int, 4> quad_of(const std::array<int, 3>& a, const std::array<int, 3>& b) {
+  for (int k = 0; k < 3; ++k) {
+    const int x = a[k], y = a[(k + 1) % 3], z = a[(k + 2) % 3];
+    for (int j = 0; j < 3; ++j) {
+      if (b[j] == y && b[(j + 1) % 3] == x) return {x, b[(j + 2) % 3], y, z};
+    }
+  }
+  return {-1, -1, -1, -1};
+}
+
+}  // namespace
+
+QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions& options) {
+  const TopologyReport topo = analyze_topology(mesh);
+  if (!topo.manifold || topo.boundary_edges > 0 || topo.components != 1 || !topo.genus ||
+      topo.degenerate_faces > 0) {
+    throw InvalidInput(std::string(kFn) +
+                       "the mesh must be one closed, manifold, oriented component without degenerate "
+                       "triangles; run repair_mesh first");
+  }
+  const int genus = *topo.genus;
+  const long long k = options.patches;
+  const long long target = k + 2 - 2LL * genus;
+  const long long vertices = static_cast<long long>(mesh.positions.size() - topo.unreferenced_vertices);
+  if (k < 2)
+    throw InvalidInput(std::string(kFn) + "a layout needs at least 2 patches, got " + std::to_string(k));
+  if (target < 4) {
+    throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches are too few for genus " +
+                       std::to_string(genus) + " (K + 2 - 2g = " + std::to_string(target) +
+                       " coarse vertices; at least 4 are needed)");
+  }
+  if (target > vertices) {
+    throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches need " + std::to_string(target) +
+                       " corners but the mesh has " + std::to_string(vertices) + " vertices");
+  }
+  Simplifier simplifier(mesh);
+  if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
+    throw InvalidInput(std::string(kFn) + "cannot simplify the mesh to " + std::to_string(target) +
+                       " vertices for " + std::to_string(k) +
+                       " patches without folding it; try more patches");
+  }
+  const std::vector<std::array<int, 3>> coarse = simplifier.triangles();
+  const int nf = static_cast<int>(coarse.size());
+  // Dual graph: triangles sharing an edge.
+  std::unordered_map<std::uint64_t, int> by_edge;
+  for (int f = 0; f < nf; ++f) {
+    for (int j = 0; j < 3; ++j) by_edge[directed_edge_key(coarse[f][j], coarse[f][(j + 1) % 3])] = f;
+  }
+  std::vector<std::vector<int>> dual(nf);
+  for (int f = 0; f < nf; ++f) {
+    for (int j = 0; j < 3; ++j) {
+      const auto it = by_edge.find(directed_edge_key(coarse[f][(j + 1) % 3], coarse[f][j]));
+      if (it != by_edge.end()) dual[f].push_back(it->second);
+    }
+  }
+  const auto& p = mesh.positions;
+  auto normal = [&](const std::array<int, 3>& t) {
+    return Eigen::Vector3d((p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]));
+  };
+  double total_area = 0.0;
+  for (const auto& t : coarse) total_area += 0.5 * normal(t).norm();
+  const double mean_quad = total_area / static_cast<double>(k);
+  // Scores of pairing f with g (lower first): flatness, area near the mean, longest shared edge.
+  const std::array<std::function<double(int, int)>, 3> scores = {
+      [&](int f, int g) { return -normal(coarse[f]).normalized().dot(normal(coarse[g]).normalized()); },
+      [&](int f, int g) {
+        return std::abs(0.5 * (normal(coarse[f]).norm() + normal(coarse[g]).norm()) - mean_quad);
+      },
+      [&](int f, int g) {
+        const auto q = quad_of(coarse[f], coarse[g]);
+        return -(p[q[0]] - p[q[2]]).norm();
+      }};
+  QuadLayoutChoice best;
+  best.area_balance = -1.0;
+  std::string last_error;
+  for (const auto& score : scores) {
+    std::vector<std::tuple<double, int, int>> pairs;
+    for (int f = 0; f < nf; ++f) {
+      for (int g : dual[f]) {
+        if (f < g) pairs.emplace_back(score(f, g), f, g);
+      }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    std::vector<int> match(nf, -1);
+    for (const auto& [s, f, g] : pairs) {
+      if (match[f] < 0 && match[g] < 0) {
+        match[f] = g;
+        match[g] = f;
+      }
+    }
+    BlossomMatcher(dual, match).run();
+    if (std::count(match.begin(), match.end(), -1) > 0) {
+      last_error = "the coarse mesh's triangles cannot all be paired";
+      continue;
+    }
+    QuadLayout layout;
+    std::unordered_map<int, int> corner_of;
+    for (int f = 0; f < nf; ++f) {
+      if (match[f] < f) continue;
+      std::array<int, 4> q = quad_of(coarse[f], coarse[match[f]]);
+      for (int& v : q) {
+        const auto [it, fresh] = corner_of.emplace(v, static_cast<int>(layout.corners.size()));
+        if (fresh) layout.corners.push_back(v);
+        v = it->second;
+      }
+      layout.quads.push_back(q);
+    }
+    try {
+      const double balance = partition_stats(partition_mesh_layout(mesh, layout)).area_balance;
+      ++best.candidates;
+      if (balance > best.area_balance) {
+        best.layout = std::move(layout);
+        best.area_balance = balance;
+      }
+    } catch (const InvalidInput& e) {
+      last_error = e.what();
+    }
+  }
+  if (best.candidates == 0) {
+    throw InvalidInput(std::string(kFn) + "no pairing of the coarse mesh partitions the mesh into " +
+                       std::to_string(k) + " patches (" + last_error + "); try another number of patches");
+  }
+  return best;
+}
+
+}  // namespace geomip

@@ -1,8 +1,8 @@
 // geomip param MESH... -o DIR [--points CORR.json]: consistent parameterization (paper §3), written as
 // DIR/<stem>.param.obj (per-patch texture coordinates) and DIR/<stem>.param.json (layout and figures).
-#include "mesh/errors.h"
 #include "param/consistent_parameterization.h"
 #include "param/unit_square.h"
+#include "mesh/errors.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/model_inputs.h"
@@ -25,9 +25,7 @@ struct ParamArgs {
   bool no_baseline = false;
 };
 
-nlohmann::json stretch_json(const StretchValues& s) {
-  return {{"l2", s.l2}, {"linf", s.linf}};
-}
+nlohmann::json stretch_json(const StretchValues& s) { return {{"l2", s.l2}, {"linf", s.linf}}; }
 
 void write_param_obj(std::ostream& out, const ModelParameterization& m, const std::string& name) {
   out << "# geomip consistent parameterization of " << name << "\n"
@@ -57,8 +55,7 @@ void write_param_obj(std::ostream& out, const ModelParameterization& m, const st
 }
 
 nlohmann::json param_json(const ModelParameterization& m, const std::string& mesh_path,
-                          const std::vector<int>& partition_points,
-                          const std::vector<int>& auxiliary_points) {
+                          const std::vector<int>& partition_points, const std::vector<int>& auxiliary_points) {
   nlohmann::json j;
   j["mesh"] = mesh_path;
   j["vertices"] = m.mesh.positions.size();
@@ -72,8 +69,7 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
   for (std::size_t k = 0; k < m.patches.size(); ++k) {
     const auto& p = m.patches[k];
     nlohmann::json corners = nlohmann::json::array();
-    for (int c = 0; c < 4; ++c)
-      corners.push_back({{"vertex", p.corners[c]}, {"u", kCorner[c].x()}, {"v", kCorner[c].y()}});
+    for (int c = 0; c < 4; ++c) corners.push_back({{"vertex", p.corners[c]}, {"u", kCorner[c].x()}, {"v", kCorner[c].y()}});
     nlohmann::json sides = nlohmann::json::array();
     for (int s = 0; s < 4; ++s) sides.push_back(p.sides[s]);
     patches.push_back({{"patch", k},
@@ -100,23 +96,24 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
   }
   j["adjacency"] = adjacency;
   nlohmann::json features = nlohmann::json::array();
-  for (const auto& f : m.features)
-    features.push_back({{"vertex", f.vertex}, {"patch", f.patch}, {"u", f.uv.x()}, {"v", f.uv.y()}});
+  for (const auto& f : m.features) features.push_back({{"vertex", f.vertex}, {"patch", f.patch}, {"u", f.uv.x()}, {"v", f.uv.y()}});
   j["features"] = features;
   j["flipped_triangles"] = flipped;
   j["warp_events"] = m.warp_events;
   j["seam_mismatches"] = m.seam_mismatches;
   const StageSeconds& s = m.seconds;
-  j["seconds"] = {{"partition", s.partition},           {"progressive_mesh", s.progressive_mesh},
-                  {"base_embedding", s.base_embedding}, {"feature_warp", s.feature_warp},
-                  {"coarse_to_fine", s.coarse_to_fine}, {"final_optimization", s.final_optimization},
+  j["seconds"] = {{"partition", s.partition},
+                  {"progressive_mesh", s.progressive_mesh},
+                  {"base_embedding", s.base_embedding},
+                  {"feature_warp", s.feature_warp},
+                  {"coarse_to_fine", s.coarse_to_fine},
+                  {"final_optimization", s.final_optimization},
                   {"mvc_baseline", s.mvc_baseline}};
   return j;
 }
 
 int run_param(const ParamArgs& args) {
-  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param",
-                                               args.common.quiet || args.common.json, args.common.patches);
+  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param", args.common.quiet || args.common.json);
   const std::vector<ParameterizationInput>& inputs = models.inputs;
   const std::vector<std::string>& paths = models.paths;
 
@@ -137,18 +134,13 @@ int run_param(const ParamArgs& args) {
     const std::string stem = (std::filesystem::path(args.common.output) / inputs[i].name).string();
     write_file_atomically(stem + ".param.obj",
                           [&](std::ostream& out) { write_param_obj(out, result[i], paths[i]); });
-    nlohmann::json j =
-        param_json(result[i], paths[i], inputs[i].partition_points, inputs[i].auxiliary_points);
-    if (!inputs[i].layout_quads.empty())
-      j["layout_quads"] = inputs[i].layout_quads;  // corners: partition_points
+    nlohmann::json j = param_json(result[i], paths[i], inputs[i].partition_points, inputs[i].auxiliary_points);
+    if (!inputs[i].layout_quads.empty()) j["layout_quads"] = inputs[i].layout_quads;  // corners: partition_points
     j["seconds"]["total_all_models"] = seconds;
     write_file_atomically(stem + ".param.json", [&](std::ostream& out) { out << j.dump(2) << "\n"; });
     if (args.common.json) {
-      summary.push_back({{"mesh", paths[i]},
-                         {"obj", stem + ".param.obj"},
-                         {"json", stem + ".param.json"},
-                         {"patches", j["patches"].size()},
-                         {"flipped_triangles", j["flipped_triangles"]}});
+      summary.push_back({{"mesh", paths[i]}, {"obj", stem + ".param.obj"}, {"json", stem + ".param.json"},
+                         {"patches", j["patches"].size()}, {"flipped_triangles", j["flipped_triangles"]}});
     } else if (!args.common.quiet) {
       std::cout << "param " << paths[i] << " → " << stem << ".param.obj\n";
       for (const auto& p : result[i].patches) {
@@ -177,8 +169,7 @@ CommandRunner add_param_command(CLI::App& app) {
       "embedding, stretch optimization, feature alignment, coarse-to-fine. Writes DIR/<stem>.param.obj and "
       "DIR/<stem>.param.json per model. Open or non-manifold meshes are repaired first.");
   add_model_options(cmd, args->common);
-  cmd->add_flag("--no-baseline", args->no_baseline,
-                "Skip the full-patch MVC embedding used as stretch baseline");
+  cmd->add_flag("--no-baseline", args->no_baseline, "Skip the full-patch MVC embedding used as stretch baseline");
   return [args] { return run_param(*args); };
 }
 

@@ -51,11 +51,11 @@ struct RdArgs {
   bool json = false;
   bool quick = false;
   bool lindstrom_turk = false;  // also the draco_lt series (CGAL Lindstrom-Turk decimation) and its envelope
-  std::size_t samples = 0;      // face samples per surface for the evaluation; 0 = surface_distance's default
-  unsigned threads = 0;         // 0 = hardware_concurrency
-  int level = 8;                // geomip: geometry image level of the pack whose prefixes are measured
-  bool no_geomip = false;       // only the baselines
-  int patches = 2;              // geomip: patches of the automatic layout (--patches)
+  std::size_t samples = 0;  // face samples per surface for the evaluation; 0 = surface_distance's default
+  unsigned threads = 0;     // 0 = hardware_concurrency
+  int level = 8;            // geomip: geometry image level of the pack whose prefixes are measured
+  bool no_geomip = false;   // only the baselines
+  int patches = 2;          // geomip: patches of the automatic layout (--patches)
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -190,8 +190,8 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
   return out;
 }
 
-/// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only
-/// pack), then one job per prefix size: decode the first N bytes and build the level-N mesh.
+/// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only pack),
+/// then one job per prefix size: decode the first N bytes and build the level-N mesh.
 Series geomip_series(const std::string& mesh_path, int level, int patches, bool quick,
                      std::vector<std::uint8_t>& pack_out, ProgressBar& progress) {
   const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches);
@@ -214,13 +214,11 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, bool 
       for (int r = 0; r < 3; ++r) {
         const auto t0 = std::chrono::steady_clock::now();
         result = codec::decode_pack(*pack, decode);
-        best_ms = std::min(
-            best_ms,
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        best_ms = std::min(best_ms,
+                           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       }
       if (result.models.empty())
-        throw SolverFailure("geomip rd: a " + std::to_string(size) +
-                            "-byte prefix of the pack does not decode");
+        throw SolverFailure("geomip rd: a " + std::to_string(size) + "-byte prefix of the pack does not decode");
       Coded c;
       c.decoded = decoded_mesh(result.models.front());
       c.point.method = "geomip";
@@ -285,8 +283,7 @@ int run_rd(const RdArgs& args) {
   ProgressBar progress("rd", !args.json);
   std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
-  if (!args.no_geomip)
-    plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.quick, pack, progress));
+  if (!args.no_geomip) plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.quick, pack, progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -372,8 +369,7 @@ int run_rd(const RdArgs& args) {
     comparison_text = format("%-9s %12s %16s %8s\n", "bytes", "geomip dB", "draco_envelope dB", "margin");
     for (std::size_t size : {1500, 2000, 4700, 8800, 12000, 16000, 21100, 32800, 42800}) {
       const double g = envelope_at(geomip_front, size), d = envelope_at(envelope_points, size);
-      comparison.push_back(
-          {{"bytes", size}, {"geomip_db", g}, {"draco_envelope_db", d}, {"margin_db", g - d}});
+      comparison.push_back({{"bytes", size}, {"geomip_db", g}, {"draco_envelope_db", d}, {"margin_db", g - d}});
       comparison_text += format("%-9zu %12.2f %16.2f %+8.2f\n", size, g, d, g - d);
     }
   }
@@ -407,8 +403,9 @@ int run_rd(const RdArgs& args) {
     std::cout << point_row(p);
   }
   std::cout << "(" << candidates << " decimate-then-Draco points, the envelopes' candidates, are in rd.csv)\n"
-            << comparison_text << "wrote " << (dir / "rd.csv").string() << " and "
-            << (dir / "rd.svg").string() << format(" in %.1f s\n", seconds);
+            << comparison_text
+            << "wrote " << (dir / "rd.csv").string() << " and " << (dir / "rd.svg").string()
+            << format(" in %.1f s\n", seconds);
   return kExitOk;
 }
 

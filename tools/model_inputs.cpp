@@ -128,8 +128,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       throw InvalidInput("give either meshes or --points CORR.json (which names the meshes), not both");
     }
     if (patches != 2) {
-      throw InvalidInput(
-          "--patches chooses an automatic layout; with --points CORR.json the file gives the points");
+      throw InvalidInput("--patches chooses an automatic layout; with --points CORR.json the file gives the points");
     }
     specs = read_correspondence(points_file_arg);
   } else {
@@ -179,19 +178,17 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
   cmd->add_option("-o,--output", args.output, "Output directory (created if missing)")->required();
   cmd->add_flag("--json", args.json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar, no report");
-  cmd->add_option(
-         "--sampling-exponent", args.sampling_exponent,
-         "Curvature sampling exponent g: stretch weights ((eps + |II|^2)/eps)^g give bent regions more "
-         "samples; 0 = plain geometric stretch (default: 1/3 for param, gimage, remesh; 0 for convert)")
+  cmd->add_option("--sampling-exponent", args.sampling_exponent,
+                  "Curvature sampling exponent g: stretch weights ((eps + |II|^2)/eps)^g give bent regions more "
+                  "samples; 0 = plain geometric stretch (default: 1/3 for param, gimage, remesh; 0 for convert)")
       ->check(CLI::Range(0.0, 2.0));
   add_patches_option(cmd, args.patches);
 }
 
 void add_patches_option(CLI::App* cmd, int& patches) {
-  cmd->add_option(
-      "--patches", patches,
-      "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop; "
-      "K >= 3 pairs the triangles of a coarse mesh into K quads (any genus: K + 2 - 2g >= 4)");
+  cmd->add_option("--patches", patches,
+                  "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop; "
+                  "K >= 3 pairs the triangles of a coarse mesh into K quads (any genus: K + 2 - 2g >= 4)");
 }
 
 void apply_sampling(const ModelArgs& args, ParameterizationOptions& options) {

@@ -43,8 +43,8 @@ void add_model_options(CLI::App* cmd, ModelArgs& args);
 /// `meshes`: one mesh (automatic partition points) or none when `points_file` names them. `command` prefixes
 /// the repair note ("geomip param"); `quiet` silences it. `patches`: see ModelArgs::patches.
 /// \throw InvalidInput when both or neither are given, several meshes come without CORR.json, a file is
-///   unreadable, a point is out of range, `patches` ≠ 2 comes with CORR.json, or no K-quad layout fits
-///   the mesh (choose_quad_layout()).
+///   unreadable, a point is out of range, `patches` < 2, `patches` ≠ 2 comes with CORR.json, or no K-quad
+///   layout fits the mesh (choose_quad_layout()).
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file,
                               const std::string& command, bool quiet, int patches = 2);
 

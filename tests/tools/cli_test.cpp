@@ -67,7 +67,7 @@ TEST_F(Cli, HelpOnEveryCommand) {
     EXPECT_EQ(r.exit_code, 0) << args;
     EXPECT_NE(r.out.find("Usage"), std::string::npos) << args;
   }
-  EXPECT_EQ(geomip("").exit_code, 2);              // no subcommand
+  EXPECT_EQ(geomip("").exit_code, 2);             // no subcommand
   EXPECT_EQ(geomip("frobnicate x").exit_code, 2);  // unknown subcommand
   EXPECT_EQ(geomip("info").exit_code, 2);          // missing argument
 }
@@ -77,9 +77,9 @@ TEST_F(Cli, InfoJsonHasTheDocumentedKeys) {
   const Outcome r = geomip("info --json '" + mesh + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  for (const char* key :
-       {"vertices", "faces", "components", "boundary_loops", "genus", "manifold", "non_manifold_edges",
-        "non_manifold_vertices", "degenerate_faces", "unreferenced_vertices", "bbox_diagonal"}) {
+  for (const char* key : {"vertices", "faces", "components", "boundary_loops", "genus", "manifold",
+                          "non_manifold_edges", "non_manifold_vertices", "degenerate_faces",
+                          "unreferenced_vertices", "bbox_diagonal"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["vertices"], 2930);
@@ -124,7 +124,7 @@ TEST_F(Cli, RepairWritesAtomicallyAndNeverLeavesPartialFiles) {
   EXPECT_EQ(slurp(out), "precious");
   // Output into a missing directory: a clear error, nothing written.
   const Outcome bad_dir = geomip("repair '" + std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj' -o '" + dir_ +
-                                 "/no/such/dir/x.obj'");
+                             "/no/such/dir/x.obj'");
   EXPECT_NE(bad_dir.exit_code, 0);
   EXPECT_NE(bad_dir.err.find("does not exist"), std::string::npos) << bad_dir.err;
   // Unsupported output format is rejected before any work.
@@ -242,8 +242,7 @@ class CliParam : public Cli {
     return file(name, "{\"models\": [" + models_json + "]}");
   }
   std::string model(const std::string& points, const std::string& features = "[]") {
-    return "{\"mesh\": \"" + spot_ + "\", \"partition_points\": " + points + ", \"features\": " + features +
-           "}";
+    return "{\"mesh\": \"" + spot_ + "\", \"partition_points\": " + points + ", \"features\": " + features + "}";
   }
 };
 
@@ -334,9 +333,8 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
   expect_two(corr("dup.json", model("[10, 10, 200, 300]")), "distinct");
   expect_two(corr("range.json", model("[10, 20, 30, 99999]")), "99999");
   expect_two(corr("three.json", model("[10, 20, 30]")), "4 points");
-  expect_two(
-      corr("features.json", model("[0, 1000, 2000, 2900]", "[5]") + "," + model("[0, 1000, 2000, 2900]")),
-      "features");
+  expect_two(corr("features.json", model("[0, 1000, 2000, 2900]", "[5]") + "," + model("[0, 1000, 2000, 2900]")),
+             "features");
   expect_two(file("garbage.json", "{not json"), "JSON");
   expect_two(dir_ + "/missing.json", "no such file");
   // Several meshes without a correspondence file.
@@ -366,8 +364,7 @@ class CliGimage : public Cli {
     }
     std::string points = "[";
     const Eigen::Vector3d corners[4] = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
-    for (int k = 0; k < 4; ++k)
-      points += (k ? ", " : "") + std::to_string(test::nearest_vertex(a, corners[k]));
+    for (int k = 0; k < 4; ++k) points += (k ? ", " : "") + std::to_string(test::nearest_vertex(a, corners[k]));
     points += "]";
     return file("pair.json", "{\"models\": [{\"mesh\": \"a.obj\", \"partition_points\": " + points +
                                  "}, {\"mesh\": \"b.obj\", \"partition_points\": " + points + "}]}");
@@ -388,7 +385,7 @@ TEST_F(CliGimage, GimageWritesOnePyramidPerPatch) {
   EXPECT_EQ(g.info.kind, "geometry");
   EXPECT_EQ(g.info.adjacency.size(), 8u);
   EXPECT_EQ(g.info.source_mesh, "spot.obj");  // the file name, never the converting machine's directories
-  ASSERT_EQ(g.parts[0].size(), 6u);           // 17, 9, 5, 3, 2, 1
+  ASSERT_EQ(g.parts[0].size(), 6u);  // 17, 9, 5, 3, 2, 1
   EXPECT_EQ(g.parts[0][0].width, 17);
   EXPECT_EQ(g.parts[0][3].width, 3);
   const GeometryImageFile n = read_geometry_image_exr(out + "/spot.normals.exr");
@@ -438,10 +435,10 @@ TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
 TEST_F(CliGimage, BadInputsExitTwo) {
   const std::string out = dir_ + "/out";
   for (const std::string& args : {"gimage '" + spot_ + "' --level 11 -o '" + out + "'",
-                                  "gimage '" + spot_ + "' --level 4 --normal-level 3 -o '" + out + "'",
-                                  "remesh '" + spot_ + "' --level -1 -o '" + out + "'",
-                                  "remesh '" + dir_ + "/missing.obj' --level 2 -o '" + out + "'",
-                                  "remesh '" + spot_ + "' '" + spot_ + "' --level 2 -o '" + out + "'"}) {
+                                 "gimage '" + spot_ + "' --level 4 --normal-level 3 -o '" + out + "'",
+                                 "remesh '" + spot_ + "' --level -1 -o '" + out + "'",
+                                 "remesh '" + dir_ + "/missing.obj' --level 2 -o '" + out + "'",
+                                 "remesh '" + spot_ + "' '" + spot_ + "' --level 2 -o '" + out + "'"}) {
     const Outcome r = geomip(args);
     EXPECT_FALSE(r.crashed) << args;
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
@@ -500,7 +497,7 @@ TEST_F(Cli, EvalReportsMetroDistancesAndInfinitePsnrForIdenticalMeshes) {
   ASSERT_EQ(mapped.exit_code, 0) << mapped.err;
   const auto m = nlohmann::json::parse(mapped.out);
   EXPECT_NEAR(m["error_map_scale_pct"].get<double>(), 25 / std::sqrt(2.0), 1e-4);  // every face at 0.25
-  EXPECT_NEAR(m["approx_to_original"]["max_at"][2].get<double>(), 0.25, 1e-12);    // a point of `lifted`
+  EXPECT_NEAR(m["approx_to_original"]["max_at"][2].get<double>(), 0.25, 1e-12);   // a point of `lifted`
   for (const std::string& path : {map, map_original}) {
     const TriMesh back = read_mesh(path);
     EXPECT_EQ(back.num_vertices(), 4u) << path;
@@ -544,10 +541,8 @@ TEST_F(Cli, AnimalsGetIdenticalFeatureCoordinates) {
     for (std::size_t m = 1; m < models.size(); ++m) {
       const auto& f = models[m]["features"][k];
       EXPECT_EQ(f["patch"], f0["patch"]) << "feature " << k << " model " << m;
-      EXPECT_LE(std::abs(f["u"].get<double>() - f0["u"].get<double>()), 1e-9)
-          << "feature " << k << " model " << m;
-      EXPECT_LE(std::abs(f["v"].get<double>() - f0["v"].get<double>()), 1e-9)
-          << "feature " << k << " model " << m;
+      EXPECT_LE(std::abs(f["u"].get<double>() - f0["u"].get<double>()), 1e-9) << "feature " << k << " model " << m;
+      EXPECT_LE(std::abs(f["v"].get<double>() - f0["v"].get<double>()), 1e-9) << "feature " << k << " model " << m;
     }
   }
 }
@@ -587,8 +582,7 @@ TEST_F(CliGimage, AdaptiveRemeshIsWatertightSharedAndCoarserForLargerEps) {
   const std::string out = dir_ + "/bad";
   EXPECT_EQ(geomip("remesh '" + spot_ + "' --adaptive -1 -o '" + out + "'").exit_code, 2);
   EXPECT_EQ(geomip("remesh '" + spot_ + "' --adaptive 0.01 --max-depth 11 -o '" + out + "'").exit_code, 2);
-  EXPECT_EQ(geomip("remesh '" + spot_ + "' -o '" + out + "'").exit_code,
-            2);  // neither --level nor --adaptive
+  EXPECT_EQ(geomip("remesh '" + spot_ + "' -o '" + out + "'").exit_code, 2);  // neither --level nor --adaptive
 }
 
 }  // namespace
@@ -599,8 +593,8 @@ namespace {
 
 class CliPack : public CliGimage {};
 
-// convert → decode: the whole pack gives the level-N remesh's connectivity (watertight, consistently
-// oriented); a prefix gives a coarser but still watertight model; --json keys; outputs atomic.
+// convert → decode: the whole pack gives the level-N remesh's connectivity (watertight, consistently oriented);
+// a prefix gives a coarser but still watertight model; --json keys; outputs atomic.
 TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
   const std::string pack = dir_ + "/spot.gip";
   Outcome r = geomip("convert --json '" + spot_ + "' --level 5 -o '" + pack + "'");
@@ -627,8 +621,7 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
   EXPECT_EQ(j["models"][0]["faces"], 2 * 2 * 16 * 16);
   EXPECT_LT(j["bytes_used"].get<std::size_t>(), bytes);
   EXPECT_EQ(analyze_topology(read_mesh(dir_ + "/prefix.ply")).boundary_loops, 0u);
-  for (const auto& e : fs::directory_iterator(dir_))
-    EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos);
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos);
 
   // glTF out and in: the same decode as .glb and .gltf gives the same `geomip info` counts as the OBJ.
   const auto info_of = [&](const std::string& path) {
@@ -703,18 +696,10 @@ TEST_F(CliPack, InfoDescribesAPack) {
   EXPECT_EQ(previous, fs::file_size(pack));
   const std::uint64_t first = j["first_level_bytes"];
   EXPECT_LT(first, fs::file_size(pack));
-  EXPECT_EQ(
-      geomip("decode -q '" + pack + "' --bytes " + std::to_string(first) + " -o '" + dir_ + "/first.obj'")
-          .exit_code,
-      0);
-  EXPECT_EQ(
-      geomip("decode -q '" + pack + "' --bytes " + std::to_string(first - 1) + " -o '" + dir_ + "/none.obj'")
-          .exit_code,
-      2);
+  EXPECT_EQ(geomip("decode -q '" + pack + "' --bytes " + std::to_string(first) + " -o '" + dir_ + "/first.obj'").exit_code, 0);
+  EXPECT_EQ(geomip("decode -q '" + pack + "' --bytes " + std::to_string(first - 1) + " -o '" + dir_ + "/none.obj'").exit_code, 2);
   const Outcome text = geomip("info '" + pack + "'");
-  EXPECT_NE(text.out.find("first level of detail after " + std::to_string(first) + " bytes"),
-            std::string::npos)
-      << text.out;
+  EXPECT_NE(text.out.find("first level of detail after " + std::to_string(first) + " bytes"), std::string::npos) << text.out;
   expect_bad_input("info '" + file("junk.gip", "not a pack") + "'", "junk.gip");
 }
 
@@ -752,10 +737,10 @@ TEST_F(CliPack, PrefixesWithoutALevelOfDetailExitTwoWithoutOutput) {
   EXPECT_GT(first_level_bytes, manifest_end + 1);
   EXPECT_LT(first_level_bytes, bytes.size());
   EXPECT_FALSE(fs::exists(out));
-  EXPECT_EQ(geomip("decode -q '" + pack + "' --bytes " + std::to_string(first_level_bytes - 1) + " -o '" +
-                   out + "'")
-                .exit_code,
-            2);
+  EXPECT_EQ(
+      geomip("decode -q '" + pack + "' --bytes " + std::to_string(first_level_bytes - 1) + " -o '" + out + "'")
+          .exit_code,
+      2);
   EXPECT_FALSE(fs::exists(out));
   // From there on, a coarse model with an extent.
   r = geomip("decode -q '" + pack + "' --bytes " + std::to_string(first_level_bytes) + " -o '" + out + "'");
@@ -791,8 +776,7 @@ TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {
   expect_bad_input("decode '" + pack + "' --bytes 10 -o '" + out + "'", pack);  // inside the manifest
   EXPECT_FALSE(fs::exists(out));
   // The truncated file decodes when the prefix is asked for on purpose.
-  EXPECT_EQ(geomip("decode -q '" + truncated + "' --bytes " + std::to_string(bytes.size() / 2) + " -o '" +
-                   out + "'")
+  EXPECT_EQ(geomip("decode -q '" + truncated + "' --bytes " + std::to_string(bytes.size() / 2) + " -o '" + out + "'")
                 .exit_code,
             0);
   for (const char* args : {"convert --help", "encode --help", "decode --help"})

@@ -654,6 +654,12 @@ TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
   EXPECT_EQ(t.boundary_loops, 0u);
   EXPECT_TRUE(t.manifold);
   EXPECT_EQ(t.genus, 0);
+  r = geomip("param --quiet '" + spot_ + "' --patches 6 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto param = nlohmann::json::parse(slurp(out + "/spot.param.json"));
+  EXPECT_EQ(param["patches"].size(), 6u);
+  EXPECT_EQ(param["layout_quads"].size(), 6u);
+  EXPECT_EQ(param["flipped_triangles"], 0);
   const std::string pack = dir_ + "/spot6.gip";
   r = geomip("convert --quiet '" + spot_ + "' --patches 6 --level 4 --no-normals -o '" + pack + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;

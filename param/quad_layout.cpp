@@ -5,6 +5,7 @@
 #include "mesh/predicates.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -22,13 +23,23 @@ const char* const kFn = "choose_quad_layout: ";
 // Half-edge collapses on a closed manifold triangle mesh, shortest edge first, vertices never moved.
 class Simplifier {
  public:
-  explicit Simplifier(const TriMesh& mesh) : m_(mesh) {
+  // `centroid_rule`: of two merged vertices the one nearer their area's centroid stays; else the one that
+  // stands for more area.
+  Simplifier(const TriMesh& mesh, bool centroid_rule) : m_(mesh), centroid_rule_(centroid_rule) {
     vf_.resize(m_.positions.size());
     for (int f = 0; f < static_cast<int>(m_.triangles.size()); ++f) {
       for (int v : m_.triangles[f]) vf_[v].push_back(f);
     }
     face_alive_.assign(m_.triangles.size(), 1);
     stamp_.assign(m_.positions.size(), 0);
+    carried_.assign(m_.positions.size(), 0.0);
+    moment_.assign(m_.positions.size(), Eigen::Vector3d::Zero());
+    for (const auto& t : m_.triangles) {
+      for (int v : t) {
+        carried_[v] += normal(t).norm() / 6.0;
+        moment_[v] += normal(t).norm() / 6.0 * m_.positions[v];
+      }
+    }
     for (int v = 0; v < static_cast<int>(vf_.size()); ++v) {
       if (!vf_[v].empty()) ++alive_;
     }
@@ -130,6 +141,8 @@ class Simplifier {
       }
     }
     vf_[u].clear();
+    carried_[v] += carried_[u];
+    moment_[v] += moment_[u];
     --alive_;
     const std::vector<int> around = neighbours(v);
     ++stamp_[v];
@@ -138,14 +151,23 @@ class Simplifier {
     for (int w : around) push_edges(w);
   }
 
-  // Cost of removing u into v: the area of u's star (the vertex with the least surface around it goes
-  // first, which evens out the coarse triangles' areas), ties broken by the edge's length.
+  // Cost of merging u into v: the surface area the two vertices then stand for (each vertex starts with a
+  // third of its star's area and inherits the area of the vertices merged into it). Merging the smallest
+  // pair first is greedy clustering into equal areas: every coarse vertex stands for a similar share of
+  // the surface, so the coarse triangles, hence the patches, get similar areas. The vertex nearer the
+  // merged area's centroid stays, so coarse vertices sit near the middle of what they stand for.
   void push_edges(int u) {
-    double star = 0.0;
-    for (int f : vf_[u]) star += normal(m_.triangles[f]).norm();
     for (int v : neighbours(u)) {
-      const double length = (m_.positions[u] - m_.positions[v]).norm();
-      heap_.push({star + 1e-3 * length * length, u, v, stamp_[u], stamp_[v]});
+      const double merged = carried_[u] + carried_[v];
+      const Eigen::Vector3d centre = (moment_[u] + moment_[v]) / merged;
+      const double du = (m_.positions[u] - centre).squaredNorm(),
+                   dv = (m_.positions[v] - centre).squaredNorm();
+      if (centroid_rule_) {
+        if (dv > du || (dv == du && v > u)) continue;  // the vertex nearer the merged area's centroid stays
+      } else if (carried_[u] > carried_[v] || (carried_[u] == carried_[v] && v > u)) {
+        continue;  // the vertex that stands for more area stays
+      }
+      heap_.push({merged, u, v, stamp_[u], stamp_[v]});
     }
   }
 
@@ -153,10 +175,51 @@ class Simplifier {
   std::vector<std::vector<int>> vf_;
   std::vector<char> face_alive_;
   std::vector<std::uint32_t> stamp_;
+  std::vector<double> carried_;          // surface area each vertex stands for
+  std::vector<Eigen::Vector3d> moment_;  // Σ area · position over that area
   std::size_t alive_ = 0;
   bool check_normals_ = true;
+  bool centroid_rule_ = true;
   std::priority_queue<Entry> heap_;
 };
+
+// Delaunay edge flips on the coarse mesh (in 3D: an edge is flipped when the two angles opposite it sum to
+// more than π and the new edge does not exist yet), so that its edges, later traced as shortest paths, join
+// near corners and its triangles are not slivers. At most 50 flips per triangle (3D angles need not
+// converge as in the plane).
+void delaunay_flips(const std::vector<Eigen::Vector3d>& p, std::vector<std::array<int, 3>>& t) {
+  auto angle = [&](int at, int a, int b) {
+    const Eigen::Vector3d u = p[a] - p[at], v = p[b] - p[at];
+    return std::atan2(u.cross(v).norm(), u.dot(v));
+  };
+  const std::size_t budget = 50 * t.size() + 100;
+  for (std::size_t flips = 0; flips < budget;) {
+    std::unordered_map<std::uint64_t, int> by_edge;
+    for (int f = 0; f < static_cast<int>(t.size()); ++f) {
+      for (int j = 0; j < 3; ++j) by_edge[directed_edge_key(t[f][j], t[f][(j + 1) % 3])] = f;
+    }
+    bool flipped = false;
+    for (int f = 0; f < static_cast<int>(t.size()) && !flipped; ++f) {
+      for (int j = 0; j < 3 && !flipped; ++j) {
+        const int x = t[f][j], y = t[f][(j + 1) % 3], z = t[f][(j + 2) % 3];
+        const auto it = by_edge.find(directed_edge_key(y, x));
+        if (it == by_edge.end()) continue;
+        const int g = it->second;
+        int w = -1;
+        for (int v : t[g]) {
+          if (v != x && v != y) w = v;
+        }
+        if (w < 0 || w == z || by_edge.count(directed_edge_key(z, w))) continue;
+        if (angle(z, x, y) + angle(w, y, x) <= M_PI + 1e-9) continue;
+        t[f] = {x, w, z};
+        t[g] = {w, y, z};
+        flipped = true;
+        ++flips;
+      }
+    }
+    if (!flipped) break;
+  }
+}
 
 // Maximum matching in a general graph: Edmonds' blossom algorithm, completing `match` (−1 = unmatched) by
 // augmenting paths. O(V³).
@@ -259,38 +322,10 @@ std::array<int, 4> quad_of(const std::array<int, 3>& a, const std::array<int, 3>
   return {-1, -1, -1, -1};
 }
 
-}  // namespace
-
-QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions& options) {
-  const TopologyReport topo = analyze_topology(mesh);
-  if (!topo.manifold || topo.boundary_edges > 0 || topo.components != 1 || !topo.genus ||
-      topo.degenerate_faces > 0) {
-    throw InvalidInput(std::string(kFn) +
-                       "the mesh must be one closed, manifold, oriented component without degenerate "
-                       "triangles; run repair_mesh first");
-  }
-  const int genus = *topo.genus;
-  const long long k = options.patches;
-  const long long target = k + 2 - 2LL * genus;
-  const long long vertices = static_cast<long long>(mesh.positions.size() - topo.unreferenced_vertices);
-  if (k < 2)
-    throw InvalidInput(std::string(kFn) + "a layout needs at least 2 patches, got " + std::to_string(k));
-  if (target < 4) {
-    throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches are too few for genus " +
-                       std::to_string(genus) + " (K + 2 - 2g = " + std::to_string(target) +
-                       " coarse vertices; at least 4 are needed)");
-  }
-  if (target > vertices) {
-    throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches need " + std::to_string(target) +
-                       " corners but the mesh has " + std::to_string(vertices) + " vertices");
-  }
-  Simplifier simplifier(mesh);
-  if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
-    throw InvalidInput(std::string(kFn) + "cannot simplify the mesh to " + std::to_string(target) +
-                       " vertices for " + std::to_string(k) +
-                       " patches without folding it; try more patches");
-  }
-  const std::vector<std::array<int, 3>> coarse = simplifier.triangles();
+// Pairs `coarse` (closed, 2k triangles over mesh vertices) into k quads by each greedy score completed to a
+// perfect matching; every pairing that partitions `mesh` is measured and kept in `best` if more balanced.
+void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int, 3>>& coarse, long long k,
+                           QuadLayoutChoice& best, std::string& last_error) {
   const int nf = static_cast<int>(coarse.size());
   // Dual graph: triangles sharing an edge.
   std::unordered_map<std::uint64_t, int> by_edge;
@@ -321,9 +356,6 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
         const auto q = quad_of(coarse[f], coarse[g]);
         return -(p[q[0]] - p[q[2]]).norm();
       }};
-  QuadLayoutChoice best;
-  best.area_balance = -1.0;
-  std::string last_error;
   for (const auto& score : scores) {
     std::vector<std::tuple<double, int, int>> pairs;
     for (int f = 0; f < nf; ++f) {
@@ -367,9 +399,49 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
       last_error = e.what();
     }
   }
+}
+
+}  // namespace
+
+QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions& options) {
+  const TopologyReport topo = analyze_topology(mesh);
+  if (!topo.manifold || topo.boundary_edges > 0 || topo.components != 1 || !topo.genus ||
+      topo.degenerate_faces > 0) {
+    throw InvalidInput(std::string(kFn) +
+                       "the mesh must be one closed, manifold, oriented component without degenerate "
+                       "triangles; run repair_mesh first");
+  }
+  const int genus = *topo.genus;
+  const long long k = options.patches;
+  const long long target = k + 2 - 2LL * genus;
+  const long long vertices = static_cast<long long>(mesh.positions.size() - topo.unreferenced_vertices);
+  if (k < 2)
+    throw InvalidInput(std::string(kFn) + "a layout needs at least 2 patches, got " + std::to_string(k));
+  if (target < 4) {
+    throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches are too few for genus " +
+                       std::to_string(genus) + " (K + 2 - 2g = " + std::to_string(target) +
+                       " coarse vertices; at least 4 are needed)");
+  }
+  if (target > vertices) {
+    throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches need " + std::to_string(target) +
+                       " corners but the mesh has " + std::to_string(vertices) + " vertices");
+  }
+  QuadLayoutChoice best;
+  best.area_balance = -1.0;
+  std::string last_error;
+  for (const bool centroid_rule : {true, false}) {
+    Simplifier simplifier(mesh, centroid_rule);
+    if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
+      last_error = "cannot simplify the mesh to " + std::to_string(target) + " vertices without folding it";
+      continue;
+    }
+    std::vector<std::array<int, 3>> coarse = simplifier.triangles();
+    delaunay_flips(mesh.positions, coarse);
+    pair_coarse_triangles(mesh, coarse, k, best, last_error);
+  }
   if (best.candidates == 0) {
-    throw InvalidInput(std::string(kFn) + "no pairing of the coarse mesh partitions the mesh into " +
-                       std::to_string(k) + " patches (" + last_error + "); try another number of patches");
+    throw InvalidInput(std::string(kFn) + "no layout of " + std::to_string(k) +
+                       " patches partitions the mesh (" + last_error + "); try another number of patches");
   }
   return best;
 }

@@ -24,11 +24,13 @@ struct QuadLayoutChoice {
 };
 
 /// Chooses a K-quad layout for `closed_manifold` (same preconditions as partition_mesh_layout()):
-/// 1. simplify the mesh by half-edge collapses, shortest edge first, to K + 2 − 2g vertices (g the genus). A
-///    collapse keeps the surviving vertex where it is (so the coarse vertices are mesh vertices), respects
-///    the link condition (the coarse mesh stays a closed manifold of the same genus) and never turns a
-///    triangle's normal by 90° or more. Shortest edges first keeps the coarse triangles of similar size, so
-///    the patches get similar areas (every patch gets the same grid);
+/// 1. simplify the mesh by half-edge collapses to K + 2 − 2g vertices (g the genus), the pair of vertices
+///    that stands for the least surface area first (each vertex starts with a third of its star's area and
+///    inherits the area of the vertices merged into it): greedy clustering into equal areas, so the coarse
+///    triangles, hence the patches, get similar areas (every patch gets the same grid). A collapse keeps the
+///    surviving vertex where it is (so the coarse vertices are mesh vertices), respects the link condition
+///    (the coarse mesh stays a closed manifold of the same genus) and, while it can, never turns a
+///    triangle's normal by 90° or more;
 /// 2. pair the 2K coarse triangles into K quads: a perfect matching of the dual graph, which is cubic and
 ///    bridgeless on a closed triangle mesh, so one exists (Petersen 1891). A greedy matching by one of three
 ///    scores (flattest pairs, pairs closest to the mean quad area, pairs across the longest edge) is

@@ -880,6 +880,17 @@ std::string check_quad_layout(const QuadLayout& layout, std::size_t num_vertices
   LayoutHalfEdges he;
   std::string why = layout_half_edges(layout, he);
   if (!why.empty()) return why;
+  // Uniform remeshing splits each grid quad along a diagonal by the parity of (i + j + patch): an
+  // odd-numbered patch's corner cells have the diagonal that misses the corner. Two such cells meeting at a
+  // corner of only two quads would share their diagonal (an edge of 4 triangles).
+  for (std::size_t c = 0; c < he.out_ccw.size(); ++c) {
+    const auto& fan = he.out_ccw[c];
+    if (fan.size() == 2 && (fan[0] / 4) % 2 == 1 && (fan[1] / 4) % 2 == 1) {
+      return "corner " + std::to_string(c) + " lies in only two quads (" + std::to_string(fan[0] / 4) + " and " +
+             std::to_string(fan[1] / 4) +
+             "), both odd-numbered: their remeshes would fold there; give one of them an even number";
+    }
+  }
   const long long euler = static_cast<long long>(layout.corners.size()) - he.num_edges +
                           static_cast<long long>(layout.quads.size());
   if (euler != 2 - 2LL * genus) {

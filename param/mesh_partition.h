@@ -146,7 +146,9 @@ PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector
 /// quads[q][(s+1)%4]. The quads must form a closed, oriented, manifold surface of the mesh's genus: every
 /// directed layout edge (a, b) appears in exactly one quad and (b, a) in exactly one other, the quads around
 /// each corner form one cycle, and #corners − #edges + #quads = 2 − 2·genus. Two corners share at most one
-/// layout edge (no double edges), and every corner is used.
+/// layout edge (no double edges), and every corner is used. A corner in only two quads must not be in two
+/// odd-numbered ones (uniform_remesh_connectivity()'s diagonal rule would give both corner cells the same
+/// diagonal, an edge of four triangles).
 struct QuadLayout {
   std::vector<int> corners;               ///< mesh vertex ids, distinct
   std::vector<std::array<int, 4>> quads;  ///< indices into `corners`

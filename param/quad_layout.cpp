@@ -322,6 +322,37 @@ std::array<int, 4> quad_of(const std::array<int, 3>& a, const std::array<int, 3>
   return {-1, -1, -1, -1};
 }
 
+// Renumbers the quads so that quads at a corner of only two quads come first in even slots, as
+// check_quad_layout() asks (the remesh's diagonal rule); best effort, the check decides.
+void even_quads_at_two_quad_corners(QuadLayout& layout) {
+  std::vector<int> count(layout.corners.size(), 0);
+  for (const auto& q : layout.quads) {
+    for (int c : q) ++count[c];
+  }
+  std::vector<std::array<int, 4>> marked, rest;
+  for (const auto& q : layout.quads) {
+    const bool at_two = std::any_of(q.begin(), q.end(), [&](int c) { return count[c] == 2; });
+    (at_two ? marked : rest).push_back(q);
+  }
+  if (marked.empty()) return;
+  std::vector<std::array<int, 4>> order(layout.quads.size());
+  std::vector<char> used(order.size(), 0);
+  std::size_t slot = 0;
+  for (const auto& q : marked) {
+    if (slot >= order.size()) slot = 1;  // more marked quads than even slots: odd slots too
+    order[slot] = q;
+    used[slot] = 1;
+    slot += 2;
+  }
+  std::size_t next = 0;
+  for (const auto& q : rest) {
+    while (used[next]) ++next;
+    order[next] = q;
+    used[next] = 1;
+  }
+  layout.quads = std::move(order);
+}
+
 // Pairs `coarse` (closed, 2k triangles over mesh vertices) into k quads by each greedy score completed to a
 // perfect matching; every pairing that partitions `mesh` is measured and kept in `best` if more balanced.
 void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int, 3>>& coarse, long long k,
@@ -388,6 +419,7 @@ void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int
       }
       layout.quads.push_back(q);
     }
+    even_quads_at_two_quad_corners(layout);
     try {
       const double balance = partition_stats(partition_mesh_layout(mesh, layout)).area_balance;
       ++best.candidates;

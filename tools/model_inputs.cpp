@@ -136,7 +136,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       throw InvalidInput("several meshes need --points CORR.json: their partition points must correspond");
     }
     if (meshes.empty()) throw InvalidInput("no mesh given (a MESH or --points CORR.json)");
-    specs.push_back(ModelSpec{meshes[0], {}, {}, {}});
+    specs.push_back(ModelSpec{meshes[0], {}, {}, {}, {}});
   }
 
   for (const auto& spec : specs) {
@@ -163,6 +163,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       in.partition_points = resolve_points(spec.partition_points, source, in.mesh, "partition_points", where);
       in.auxiliary_points = resolve_points(spec.auxiliary_points, source, in.mesh, "auxiliary_points", where);
       in.features = resolve_points(spec.features, source, in.mesh, "features", where);
+      in.layout_quads = spec.layout_quads;
     }
     inputs.push_back(std::move(in));
     paths.push_back(spec.mesh);

@@ -432,6 +432,35 @@ TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
   EXPECT_TRUE(fs::exists(out + "/b.normals.exr"));
 }
 
+// A user layout in CORR.json: the cube's 6 faces over test::sphere()'s corners 0..7 (kept by write_mesh), one
+// face list for both models; a bad layout exits 2 with one line and writes nothing.
+TEST_F(CliGimage, CorrespondenceLayoutGivesSixPatchesAndOneFaceList) {
+  sphere_pair();
+  const std::string quads = "[[0,3,2,1],[4,5,6,7],[0,1,5,4],[1,2,6,5],[2,3,7,6],[3,0,4,7]]";
+  const std::string models = "\"models\": [{\"mesh\": \"a.obj\", \"partition_points\": [0,1,2,3,4,5,6,7]}, "
+                             "{\"mesh\": \"b.obj\", \"partition_points\": [0,1,2,3,4,5,6,7]}]";
+  const std::string corr = file("cube.json", "{\"layout\": {\"quads\": " + quads + "}, " + models + "}");
+  const std::string out = dir_ + "/out";
+  const Outcome r = geomip("remesh --quiet --points '" + corr + "' --level 3 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const TriMesh a = read_mesh(out + "/a.M3.obj");
+  const TriMesh b = read_mesh(out + "/b.M3.obj");
+  EXPECT_EQ(a.triangles.size(), 6u * 2 * 64);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(analyze_topology(a).genus, 0);
+  const std::string bad = dir_ + "/bad";
+  for (const std::string& layout : {std::string("[[0,3,2,1],[4,5,6,7]]"),  // not closed
+                                    std::string("[[0,0,2,1],[4,5,6,7],[0,1,5,4],[1,2,6,5],[2,3,7,6],[3,0,4,7]]"),
+                                    std::string("[[0,3,2]]")}) {
+    const std::string c = file("bad.json", "{\"layout\": {\"quads\": " + layout + "}, " + models + "}");
+    const Outcome e = geomip("remesh --points '" + c + "' --level 2 -o '" + bad + "'");
+    EXPECT_FALSE(e.crashed) << layout;
+    EXPECT_EQ(e.exit_code, 2) << layout << "\n" << e.err;
+    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << layout << "\n" << e.err;
+  }
+  EXPECT_FALSE(fs::exists(bad));
+}
+
 TEST_F(CliGimage, BadInputsExitTwo) {
   const std::string out = dir_ + "/out";
   for (const std::string& args : {"gimage '" + spot_ + "' --level 11 -o '" + out + "'",

@@ -529,6 +529,11 @@ TEST(PartitionLayout, BadLayoutsAreRejectedWithOneLine) {
   const TriMesh t = test::torus(16, 8);
   expect_invalid_layout(t, cube_layout(), "Euler characteristic 2");
   EXPECT_EQ(check_quad_layout(cube_layout(), 8, 0), "");
+  // Two-quad corners: the 2-patch loop as a layout is fine (quads 0 and 1); a pillow in quads 1 and 3 is not
+  // (both odd: their remesh corner cells would share a diagonal).
+  EXPECT_EQ(check_quad_layout(QuadLayout{{0, 1, 2, 3}, {{0, 1, 2, 3}, {0, 3, 2, 1}}}, 4, 0), "");
+  const QuadLayout odd_pillow{{0, 1, 2, 3, 4, 5, 6, 7}, {{4, 5, 6, 7}, {0, 1, 2, 3}, {4, 7, 6, 5}, {0, 3, 2, 1}}};
+  EXPECT_NE(check_quad_layout(odd_pillow, 8, 0).find("both odd-numbered"), std::string::npos);
 }
 
 }  // namespace

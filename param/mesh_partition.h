@@ -4,7 +4,8 @@
 // Genus 0: four partition points P0..P3 are joined by Dijkstra shortest paths P0→P1→P2→P3→P0 (edge graph,
 // Euclidean edge lengths) into one simple closed loop, which cuts the sphere into 2 quadrilateral patches.
 // Genus 1: four partition points are the corners of a periodic 2×2 grid of 4 quadrilateral patches whose
-// 8 edges are each guided through one auxiliary point. Higher genus is rejected.
+// 8 edges are each guided through one auxiliary point. Higher genus is rejected by partition_mesh().
+// Any genus, any number of patches: partition_mesh_layout() traces the edges of a quad layout (QuadLayout).
 //
 // The patches are what the next stages (base mesh by half-edge collapses, mean value embedding on the unit
 // square, §3.3) consume: plain index arrays, no half-edge structure (see ../shared/STYLE.md).

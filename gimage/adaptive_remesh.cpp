@@ -1,8 +1,8 @@
 #include "gimage/adaptive_remesh.h"
 
 #include "gimage/uniform_remesh.h"
-#include "param/unit_square.h"
 #include "mesh/errors.h"
+#include "param/unit_square.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <set>
 #include <string>
 
 namespace geomip {
@@ -276,6 +277,23 @@ std::size_t restrict_quadtree(AdaptiveQuadtree& tree) {
   return splits;
 }
 
+namespace {
+
+// Whether the level-0 uniform remesh of the layout walks every directed edge once (a simplicial surface). A
+// torus's 2x2 grid does not (its 4 vertices repeat edges), so its tree starts at depth 1.
+bool level0_is_simplicial(std::size_t patches, const std::vector<SideLink>& adjacency) {
+  const TriMesh m = uniform_remesh_connectivity(patches, adjacency, 0).mesh;
+  std::set<std::pair<int, int>> directed;
+  for (const auto& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      if (!directed.insert({t[k], t[(k + 1) % 3]}).second) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 AdaptiveQuadtree adaptive_quadtree(const std::vector<AdaptiveQuadErrors>& errors,
                                    const std::vector<SideLink>& adjacency,
                                    const AdaptiveRemeshOptions& options) {
@@ -306,7 +324,7 @@ AdaptiveQuadtree adaptive_quadtree(const std::vector<AdaptiveQuadErrors>& errors
   tree.adjacency = adjacency;
   const std::size_t cells = std::size_t{1} << n;
   tree.depth.assign(patches, std::vector<std::uint8_t>(cells * cells, 0));
-  const int min_depth = std::min(n, patches == 4 ? 1 : 0);
+  const int min_depth = std::min(n, level0_is_simplicial(patches, adjacency) ? 0 : 1);
   // Top-down: (patch, depth, i, j) stack.
   std::vector<std::array<int, 4>> stack;
   for (std::size_t p = 0; p < patches; ++p) {

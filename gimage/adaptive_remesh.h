@@ -13,8 +13,8 @@
 #pragma once
 
 #include "gimage/resample.h"
-#include "param/consistent_parameterization.h"
 #include "mesh/mesh.h"
+#include "param/consistent_parameterization.h"
 #include "param/mesh_partition.h"
 
 #include <cstddef>
@@ -74,8 +74,8 @@ struct AdaptiveRemeshOptions {
 };
 
 /// Splits each patch's root quad while the maximum of `errors` over the models (eq. 6) exceeds ε and the
-/// depth is below n, then (when options.restrict_levels) restrict_quadtree(). A genus-1 layout (4 patches)
-/// starts at depth 1: its level-0 mesh would repeat edges (see uniform_remesh_connectivity()).
+/// depth is below n, then (when options.restrict_levels) restrict_quadtree(). A layout whose level-0 mesh
+/// repeats edges (a genus-1 2×2 grid; see uniform_remesh_connectivity()) starts at depth 1.
 /// \throw InvalidInput when `errors` is empty, the models disagree in n or patch count, ε < 0, or the
 ///   adjacency does not have 4 entries per patch (or none).
 AdaptiveQuadtree adaptive_quadtree(const std::vector<AdaptiveQuadErrors>& errors,

@@ -1,10 +1,10 @@
 #include "param/consistent_parameterization.h"
 
-#include "param/coarse_to_fine.h"
 #include "mesh/errors.h"
 #include "mesh/predicates.h"
-#include "param/unit_square.h"
+#include "param/coarse_to_fine.h"
 #include "param/feature_warp.h"
+#include "param/unit_square.h"
 
 #include <algorithm>
 #include <chrono>
@@ -17,7 +17,9 @@ namespace geomip {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // A patch cut out of the partitioned mesh with local vertex ids, and everything the later stages need.
 struct PatchWork {
@@ -97,7 +99,8 @@ BaseMesh base_mesh(const PatchWork& w) {
     b.positions.push_back(w.local.positions[v]);
     b.uv.push_back(w.uv[v]);
   }
-  for (const auto& t : w.pm.base_triangles) b.triangles.push_back({b.to_base[t[0]], b.to_base[t[1]], b.to_base[t[2]]});
+  for (const auto& t : w.pm.base_triangles)
+    b.triangles.push_back({b.to_base[t[0]], b.to_base[t[1]], b.to_base[t[2]]});
   return b;
 }
 
@@ -108,8 +111,9 @@ void store_base(const BaseMesh& b, PatchWork& w) {
 // A few global stretch sweeps over the current level of a coarse-to-fine pass (Sander et al. 2002 optimize
 // every level of the hierarchy; local moves alone leave clusters of vertices squeezed into tiny kernels,
 // e.g. L2 stretch 96 instead of 1.3 on one of fandisk's patches).
-void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine& c2f, const std::vector<char>& locked,
-                    const ParameterizationOptions& options, unsigned seed, const std::vector<double>* weights) {
+void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine& c2f,
+                    const std::vector<char>& locked, const ParameterizationOptions& options, unsigned seed,
+                    const std::vector<double>* weights) {
   std::vector<std::array<int, 3>> triangles;
   std::vector<char> present(positions.size(), 0);
   for (const auto& t : c2f.current_triangles()) {
@@ -192,8 +196,9 @@ void check_feature_counts(const std::vector<ParameterizationInput>& models) {
   const std::size_t num_features = models[0].features.size();
   for (const auto& m : models) {
     if (m.features.size() != num_features) {
-      throw InvalidInput("parameterize_consistently: model '" + m.name + "' has " + std::to_string(m.features.size()) +
-                         " features, model '" + models[0].name + "' has " + std::to_string(num_features) +
+      throw InvalidInput("parameterize_consistently: model '" + m.name + "' has " +
+                         std::to_string(m.features.size()) + " features, model '" + models[0].name +
+                         "' has " + std::to_string(num_features) +
                          " (features correspond by order: the counts must agree)");
     }
   }
@@ -209,8 +214,8 @@ std::vector<int> feature_of_vertex(const ParameterizationInput& in, std::size_t 
                          "' is vertex " + std::to_string(v) + ", out of range");
     }
     if (vertex_feature[v] >= 0) {
-      throw InvalidInput("parameterize_consistently: features " + std::to_string(vertex_feature[v]) + " and " +
-                         std::to_string(k) + " of model '" + in.name + "' are the same vertex");
+      throw InvalidInput("parameterize_consistently: features " + std::to_string(vertex_feature[v]) +
+                         " and " + std::to_string(k) + " of model '" + in.name + "' are the same vertex");
     }
     vertex_feature[v] = static_cast<int>(k);
   }
@@ -262,14 +267,26 @@ PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size
 
 // Phase A for model i: partition, patches, progressive meshes, base embeddings. `first` is model 0's work
 // (null for model 0 itself): patch counts and feature patches must agree with it.
-ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::size_t i, const ModelWork* first,
-                        const ParameterizationOptions& options, const Progress& progress,
-                        ModelParameterization& o) {
+ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::size_t i,
+                        const ModelWork* first, const ParameterizationOptions& options,
+                        const Progress& progress, ModelParameterization& o) {
   const ParameterizationInput& in = models[i];
   ModelWork w;
   progress("partition", static_cast<double>(i));
   const auto t0 = Clock::now();
-  w.partition = partition_mesh(in.mesh, in.partition_points, in.auxiliary_points);
+  if (in.layout_quads.empty()) {
+    w.partition = partition_mesh(in.mesh, in.partition_points, in.auxiliary_points);
+  } else {
+    if (!in.auxiliary_points.empty()) {
+      throw InvalidInput("parameterize_consistently: model '" + in.name +
+                         "' has a quad layout and auxiliary points; a layout's paths take no guides");
+    }
+    if (i > 0 && in.layout_quads != models[0].layout_quads) {
+      throw InvalidInput("parameterize_consistently: model '" + in.name + "' has other layout quads than '" +
+                         models[0].name + "'; a consistent set shares one layout");
+    }
+    w.partition = partition_mesh_layout(in.mesh, QuadLayout{in.partition_points, in.layout_quads});
+  }
   o.seconds.partition = seconds_since(t0);
   if (first && w.partition.patches.size() != first->partition.patches.size()) {
     throw InvalidInput("parameterize_consistently: model '" + in.name + "' has " +
@@ -290,7 +307,7 @@ ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::s
         throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " is in patch " +
                            std::to_string(w.feature_patch[k]) + " of model '" + in.name + "' but in patch " +
                            std::to_string(first->feature_patch[k]) + " of model '" + models[0].name +
-                           "': corresponding features must lie on corresponding sides of the partition loop");
+                           "': corresponding features must lie in corresponding patches");
       }
     }
   }
@@ -308,8 +325,10 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
   for (std::size_t i = 0; i < work.size(); ++i) {
     const auto& pw = work[i].patches[p];
     std::vector<std::pair<int, Eigen::Vector2d>> by_index;
-    for (std::size_t j = 0; j < pw.features.size(); ++j) by_index.emplace_back(pw.feature_index[j], pw.uv[pw.features[j]]);
-    std::sort(by_index.begin(), by_index.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t j = 0; j < pw.features.size(); ++j)
+      by_index.emplace_back(pw.feature_index[j], pw.uv[pw.features[j]]);
+    std::sort(by_index.begin(), by_index.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
     for (const auto& e : by_index) ordered[i].push_back(e.second);
   }
   const std::vector<Eigen::Vector2d> targets = average_feature_targets(ordered);
@@ -333,13 +352,14 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
       const int feature = index_and_base[k].first;
       const Eigen::Vector2d& from = before[features[k]];
       char where[160];
-      std::snprintf(where, sizeof where, " from (%.3f, %.3f) to the common (%.3f, %.3f) in patch %zu", from.x(),
-                    from.y(), targets[k].x(), targets[k].y(), p);
-      throw InvalidInput("parameterize_consistently: feature " + std::to_string(feature) + " of model '" +
-                         models[i].name + "' (vertex " + std::to_string(models[i].features[feature]) +
-                         ") cannot move" + where + " without folding the parameterization" +
-                         (r.unreached.size() > 1 ? " (" + std::to_string(r.unreached.size() - 1) + " more)" : "") +
-                         "; corresponding features must lie alike on every model: check the correspondence file");
+      std::snprintf(where, sizeof where, " from (%.3f, %.3f) to the common (%.3f, %.3f) in patch %zu",
+                    from.x(), from.y(), targets[k].x(), targets[k].y(), p);
+      throw InvalidInput(
+          "parameterize_consistently: feature " + std::to_string(feature) + " of model '" + models[i].name +
+          "' (vertex " + std::to_string(models[i].features[feature]) + ") cannot move" + where +
+          " without folding the parameterization" +
+          (r.unreached.size() > 1 ? " (" + std::to_string(r.unreached.size() - 1) + " more)" : "") +
+          "; corresponding features must lie alike on every model: check the correspondence file");
     }
     // Exact targets: the warp reaches them to rounding; store the common value itself.
     for (std::size_t j = 0; j < features.size(); ++j) base.uv[features[j]] = targets[j];
@@ -353,8 +373,8 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
 // optimizes each level globally whenever it has grown by `level_growth`. Progress runs over [start,
 // start + share).
 CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<char>& locked,
-                                const ParameterizationOptions& options, const Progress& progress, double start,
-                                double share) {
+                                const ParameterizationOptions& options, const Progress& progress,
+                                double start, double share) {
   CoarseToFine c2f(pw.local, pw.pm, pw.uv);
   std::mt19937 rng(options.seed * 7919u + static_cast<unsigned>(p));
   const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
@@ -372,10 +392,12 @@ CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<
     c2f.split_next(optimize);
     ++level_vertices;
     if ((c2f.splits_done() & 1023u) == 0) {
-      progress("coarse-to-fine", start + share * static_cast<double>(c2f.splits_done()) / double(c2f.num_splits()));
+      progress("coarse-to-fine",
+               start + share * static_cast<double>(c2f.splits_done()) / double(c2f.num_splits()));
     }
     if (options.level_sweeps > 0 && level_vertices >= next_level * options.level_growth && !c2f.finished()) {
-      optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices), weights);
+      optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices),
+                     weights);
       next_level = level_vertices;
     }
   }
@@ -493,7 +515,8 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
     const double share = 2.0 / static_cast<double>(w.patches.size());
     for (std::size_t p = 0; p < w.patches.size(); ++p) {
       const double start = n + 2.0 * static_cast<double>(i) + share * static_cast<double>(p);
-      o.patches.push_back(parameterize_patch(w.patches[p], p, models[i].name, options, progress, start, share, o));
+      o.patches.push_back(
+          parameterize_patch(w.patches[p], p, models[i].name, options, progress, start, share, o));
     }
     o.seam_mismatches = reconcile_seams(o);
   }

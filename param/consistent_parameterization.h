@@ -1,13 +1,13 @@
 // Consistent parameterization of one or several meshes over a common quad-patch base domain: the whole of
 // §3 of ../shared/seed/consistent-mesh-parameterizations.txt, wired from its steps:
 //   partition (mesh_partition.h) → per patch progressive mesh (progressive_mesh.h) → mean-value embedding of
-//   the base mesh (mean_value_embedding.h) → stretch optimization (stretch_optimization.h) → feature alignment
-//   across models (feature_warp.h) → coarse-to-fine vertex insertion with local stretch optimization
-//   (coarse_to_fine.h) → a few global stretch sweeps.
+//   the base mesh (mean_value_embedding.h) → stretch optimization (stretch_optimization.h) → feature
+//   alignment across models (feature_warp.h) → coarse-to-fine vertex insertion with local stretch
+//   optimization (coarse_to_fine.h) → a few global stretch sweeps.
 #pragma once
 
-#include "param/mean_value_embedding.h"
 #include "mesh/mesh.h"
+#include "param/mean_value_embedding.h"
 #include "param/mesh_partition.h"
 #include "param/progressive_mesh.h"
 #include "param/sampling_weights.h"
@@ -24,18 +24,23 @@ namespace geomip {
 
 /// One model to parameterize.
 struct ParameterizationInput {
-  TriMesh mesh;                        ///< closed, manifold, consistently oriented, one component
-  std::vector<int> partition_points;   ///< 4 vertex ids, in loop order; corresponding across models
-  std::vector<int> auxiliary_points;   ///< genus 0: none or 4 path guides; genus 1: 8 (see partition_mesh())
-  std::vector<int> features;           ///< feature vertex ids; same count and order in every model
-  std::string name;                    ///< for messages
+  TriMesh mesh;  ///< closed, manifold, consistently oriented, one component
+  /// Without `layout_quads`: 4 vertex ids, in loop order; corresponding across models. With it: the quad
+  /// layout's corners (any number; QuadLayout::corners), corresponding across models.
+  std::vector<int> partition_points;
+  std::vector<int> auxiliary_points;  ///< genus 0: none or 4 path guides; genus 1: 8 (see partition_mesh())
+  /// A quad layout over `partition_points` (QuadLayout::quads; partition_mesh_layout()): one patch per quad,
+  /// any genus; the same quads in every model; auxiliary_points must then be empty. Empty = partition_mesh().
+  std::vector<std::array<int, 4>> layout_quads;
+  std::vector<int> features;  ///< feature vertex ids; same count and order in every model
+  std::string name;           ///< for messages
 };
 
 /// Defaults of ParameterizationOptions::base_optimization: threshold 10⁻⁴ and up to 200 sweeps (instead of
 /// StretchOptimizationOptions' 10⁻³ / 50). The base mesh (~100 vertices) is cheap to converge, and its layout
 /// decides how much of the square the protrusions (bunny ears) get; chosen with
-/// default_local_optimization() by measured remesh PSNR (README, "Tuning the parameterization"). The threshold
-/// also stops the level and final sweeps, whose counts are level_sweeps / final_sweeps.
+/// default_local_optimization() by measured remesh PSNR (README, "Tuning the parameterization"). The
+/// threshold also stops the level and final sweeps, whose counts are level_sweeps / final_sweeps.
 inline StretchOptimizationOptions default_base_optimization() {
   StretchOptimizationOptions o;
   o.threshold = 1e-4;
@@ -131,7 +136,8 @@ struct ModelParameterization {
 /// Parameterizes `models` consistently: corresponding patches over the same unit squares, corresponding
 /// features at identical (u,v). One model is a plain (non-consistent) parameterization.
 ///
-/// \throw InvalidInput when the models disagree (genus, feature counts), a point is invalid (see
+/// \throw InvalidInput when the models disagree (genus, feature counts, layout quads), a point is invalid
+/// (see
 ///   partition_mesh()), a feature lies on the partition cut, corresponding features fall in different
 ///   patches, or a mesh is not closed and manifold.
 /// \throw SolverFailure when a stage breaks its guarantees (a bug: never the input's fault).

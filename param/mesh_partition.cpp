@@ -1,8 +1,8 @@
 #include "param/mesh_partition.h"
 
 #include "mesh/errors.h"
-#include "mesh/predicates.h"
 #include "mesh/mesh_topology.h"
+#include "mesh/predicates.h"
 
 #include <algorithm>
 #include <cmath>
@@ -124,8 +124,14 @@ std::size_t split_edges(TriMesh& m, const std::vector<std::pair<int, int>>& edge
 // Dijkstra on the edge graph with Euclidean lengths, reusing its arrays between queries.
 class PathTracer {
  public:
+  // `first_ok` / `last_ok` (when not null): the only vertices the path may take right after `source` /
+  // right before `target`.
   std::vector<int> shortest_path(const TriMesh& m, const Connectivity& c, int source, int target,
-                                 const std::vector<char>& blocked) {
+                                 const std::vector<char>& blocked, const std::vector<int>* first_ok = nullptr,
+                                 const std::vector<int>* last_ok = nullptr) {
+    auto listed = [](const std::vector<int>* list, int v) {
+      return !list || std::find(list->begin(), list->end(), v) != list->end();
+    };
     const std::size_t nv = m.positions.size();
     if (dist_.size() != nv) {
       dist_.assign(nv, std::numeric_limits<double>::infinity());
@@ -149,6 +155,7 @@ class PathTracer {
       for (int i = c.out_begin[v]; i < c.out_begin[v + 1]; ++i) {
         const int u = he_to(m, c.out[i]);
         if (blocked[u] && u != target) continue;
+        if ((v == source && !listed(first_ok, u)) || (u == target && !listed(last_ok, v))) continue;
         const double du = d + (m.positions[u] - m.positions[v]).norm();
         if (du < dist_[u]) {
           if (prev_[u] < 0 && u != source) touched_.push_back(u);
@@ -175,6 +182,8 @@ class PathTracer {
 // One path to trace: from corner `from` to corner `to`, through `via` when >= 0.
 struct PathSpec {
   int from, to, via;
+  std::vector<int> first_ok{}, last_ok{};  // allowed first / last steps; empty = any
+  bool restricted = false;                 // first_ok and last_ok apply
 };
 
 std::string vertex_name(int v) {
@@ -191,14 +200,19 @@ class Partitioner {
 
   // Traces `specs` in order; every path avoids all special points but its own and the interior vertices of
   // earlier paths. `special` lists every partition and auxiliary point.
-  void trace(const std::vector<PathSpec>& specs, const std::vector<int>& special) {
+  // `prepare` (optional) is called before each attempt at path k and may restrict its first and last steps
+  // (it sees the paths traced so far and the current mesh).
+  void trace(std::vector<PathSpec> specs, const std::vector<int>& special,
+             const std::function<void(std::size_t, PathSpec&)>& prepare = {}) {
     blocked_.assign(result_.mesh.positions.size(), 0);
     for (int v : special) blocked_[v] = 1;
     for (std::size_t k = 0; k < specs.size(); ++k) {
+      if (prepare) prepare(k, specs[k]);
       std::vector<int> path = trace_one(specs[k]);
       if (path.empty() && options_.split_degenerate) {
         // Earlier paths and chords between them may enclose the corners: opening the chords frees a way.
         split_chords();
+        if (prepare) prepare(k, specs[k]);
         path = trace_one(specs[k]);
       }
       if (path.empty()) {
@@ -326,6 +340,18 @@ class Partitioner {
     return pos == 0;
   }
 
+  // The neighbours of `v` in counter-clockwise order seen from outside.
+  std::vector<int> ring(int v) const {
+    std::vector<int> ring;
+    const int h0 = conn_.out[conn_.out_begin[v]];
+    int h = h0;
+    do {
+      ring.push_back(he_to(result_.mesh, h));
+      h = conn_.opposite[3 * (h / 3) + (h % 3 + 2) % 3];
+    } while (h != h0 && ring.size() <= static_cast<std::size_t>(conn_.out_begin[v + 1] - conn_.out_begin[v]));
+    return ring;
+  }
+
   PartitionResult& result() { return result_; }
   const std::vector<std::vector<int>>& paths() const { return paths_; }
   const Connectivity& connectivity() const { return conn_; }
@@ -336,7 +362,8 @@ class Partitioner {
     if (s.via >= 0) blocked_[s.via] = 0;
     std::vector<int> path;
     if (s.via < 0) {
-      path = tracer_.shortest_path(result_.mesh, conn_, s.from, s.to, blocked_);
+      path = tracer_.shortest_path(result_.mesh, conn_, s.from, s.to, blocked_,
+                                   s.restricted ? &s.first_ok : nullptr, s.restricted ? &s.last_ok : nullptr);
     } else {
       blocked_[s.to] = 1;  // the first leg must not pass through the end corner
       path = tracer_.shortest_path(result_.mesh, conn_, s.from, s.via, blocked_);
@@ -588,16 +615,229 @@ PartitionResult partition_genus1(const TriMesh& mesh, const std::vector<int>& p,
   return std::move(r);
 }
 
-}  // namespace
+// Half-edges of a quad layout: h = 4q + s runs from quads[q][s] to quads[q][(s+1)%4] (corner indices).
+struct LayoutHalfEdges {
+  std::vector<int> opposite;  // per half-edge
+  std::vector<int> edge;      // undirected edge id per half-edge
+  int num_edges = 0;
+  std::vector<std::vector<int>> out_ccw;  // per corner: outgoing half-edges, counter-clockwise
+};
 
-PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector<int>& partition_points,
-                               const std::vector<int>& auxiliary_points, const PartitionOptions& options) {
-  const TriMesh& mesh = closed_manifold;
-  if (partition_points.size() != 4) {
-    throw InvalidInput(std::string(kFn) + "expected 4 partition points, got " +
-                       std::to_string(partition_points.size()));
+int layout_from(const QuadLayout& l, int h) {
+  return l.quads[h / 4][h % 4];
+}
+int layout_to(const QuadLayout& l, int h) {
+  return l.quads[h / 4][(h + 1) % 4];
+}
+
+// Builds the half-edge structure of `l`; returns "" or the first reason it is not a closed quad surface.
+std::string layout_half_edges(const QuadLayout& l, LayoutHalfEdges& he) {
+  const int nc = static_cast<int>(l.corners.size());
+  const int nh = static_cast<int>(4 * l.quads.size());
+  if (l.quads.empty()) return "the layout has no quads";
+  for (std::size_t q = 0; q < l.quads.size(); ++q) {
+    for (int s = 0; s < 4; ++s) {
+      const int c = l.quads[q][s];
+      if (c < 0 || c >= nc) {
+        return "quad " + std::to_string(q) + " names corner " + std::to_string(c) + ", outside [0," +
+               std::to_string(nc) + ")";
+      }
+      for (int t = 0; t < s; ++t) {
+        if (l.quads[q][t] == c) return "quad " + std::to_string(q) + " repeats corner " + std::to_string(c);
+      }
+    }
   }
-  check_points(mesh, partition_points, auxiliary_points);
+  std::unordered_map<std::uint64_t, int> by_key;
+  for (int h = 0; h < nh; ++h) {
+    if (!by_key.emplace(directed_edge_key(layout_from(l, h), layout_to(l, h)), h).second) {
+      return "the layout edge from corner " + std::to_string(layout_from(l, h)) + " to corner " +
+             std::to_string(layout_to(l, h)) +
+             " is walked the same way by two quads (quads not consistently oriented, or overlapping)";
+    }
+  }
+  he.opposite.assign(nh, -1);
+  he.edge.assign(nh, -1);
+  he.num_edges = 0;
+  for (int h = 0; h < nh; ++h) {
+    const auto it = by_key.find(directed_edge_key(layout_to(l, h), layout_from(l, h)));
+    if (it == by_key.end()) {
+      return "the layout edge between corners " + std::to_string(layout_from(l, h)) + " and " +
+             std::to_string(layout_to(l, h)) + " has a quad on one side only (the quads are not closed)";
+    }
+    he.opposite[h] = it->second;
+    if (he.edge[h] < 0) he.edge[h] = he.edge[it->second] = he.num_edges++;
+  }
+  he.out_ccw.assign(nc, {});
+  std::vector<int> out_count(nc, 0);
+  for (int h = 0; h < nh; ++h) ++out_count[layout_from(l, h)];
+  std::vector<int> first(nc, -1);
+  for (int h = 0; h < nh; ++h) {
+    if (first[layout_from(l, h)] < 0) first[layout_from(l, h)] = h;
+  }
+  for (int c = 0; c < nc; ++c) {
+    if (first[c] < 0) return "corner " + std::to_string(c) + " is in no quad";
+    int h = first[c];
+    do {
+      he.out_ccw[c].push_back(h);
+      h = he.opposite[4 * (h / 4) + (h % 4 + 3) % 4];  // next outgoing half-edge counter-clockwise
+    } while (h != first[c] && static_cast<int>(he.out_ccw[c].size()) <= out_count[c]);
+    if (static_cast<int>(he.out_ccw[c].size()) != out_count[c]) {
+      return "the quads around corner " + std::to_string(c) + " do not form one fan (non-manifold layout)";
+    }
+  }
+  return "";
+}
+
+PartitionResult partition_layout(const TriMesh& mesh, const QuadLayout& layout, const LayoutHalfEdges& he,
+                                 const PartitionOptions& options) {
+  Partitioner part(mesh, options);
+  // One path per layout edge, stored from its lower-numbered half-edge's start, shortest corners first.
+  const int ne = he.num_edges;
+  std::vector<int> edge_half(ne, -1);
+  for (int h = 0; h < static_cast<int>(he.edge.size()); ++h) {
+    if (edge_half[he.edge[h]] < 0) edge_half[he.edge[h]] = h;
+  }
+  auto corner_vertex = [&](int c) { return layout.corners[c]; };
+  std::vector<int> order(ne);
+  for (int e = 0; e < ne; ++e) order[e] = e;
+  auto length = [&](int e) {
+    const int h = edge_half[e];
+    return (mesh.positions[corner_vertex(layout_from(layout, h))] -
+            mesh.positions[corner_vertex(layout_to(layout, h))])
+        .norm();
+  };
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return length(a) < length(b); });
+  // A spanning tree of the corners first (Kruskal, shortest first): tree paths cannot close a loop around a
+  // corner that a later path must reach. Then the other edges, shortest first.
+  {
+    std::vector<int> root(layout.corners.size());
+    for (std::size_t c = 0; c < root.size(); ++c) root[c] = static_cast<int>(c);
+    auto find = [&](int c) {
+      while (root[c] != c) c = root[c] = root[root[c]];
+      return c;
+    };
+    std::vector<int> tree, rest;
+    for (int e : order) {
+      const int a = find(layout_from(layout, edge_half[e])), b = find(layout_to(layout, edge_half[e]));
+      if (a != b) {
+        root[a] = b;
+        tree.push_back(e);
+      } else {
+        rest.push_back(e);
+      }
+    }
+    order = tree;
+    order.insert(order.end(), rest.begin(), rest.end());
+  }
+  std::vector<PathSpec> specs;
+  for (int e : order) {
+    const int h = edge_half[e];
+    specs.push_back({corner_vertex(layout_from(layout, h)), corner_vertex(layout_to(layout, h)), -1});
+  }
+  std::vector<int> traced_as(ne, -1);  // edge → index into part.paths()
+  // First mesh step of traced layout half-edge h from its start corner, or -1 when not traced yet.
+  auto first_step = [&](int h) {
+    const int k = traced_as[he.edge[h]];
+    if (k < 0) return -1;
+    const auto& path = part.paths()[k];
+    return h == edge_half[he.edge[h]] ? path[1] : path[path.size() - 2];
+  };
+  // The mesh neighbours of h's start corner strictly between the traced neighbours of h in the layout's
+  // cyclic order (all neighbours when none is traced).
+  auto sector = [&](int h) {
+    const int c = layout_from(layout, h);
+    const std::vector<int>& fan = he.out_ccw[c];
+    const int n = static_cast<int>(fan.size());
+    const int at = static_cast<int>(std::find(fan.begin(), fan.end(), h) - fan.begin());
+    int succ = -1, pred = -1;
+    for (int i = 1; i < n && succ < 0; ++i) succ = first_step(fan[(at + i) % n]);
+    for (int i = 1; i < n && pred < 0; ++i) pred = first_step(fan[(at - i + n) % n]);
+    std::vector<int> ring = part.ring(corner_vertex(c));
+    if (pred < 0) return ring;
+    const int r = static_cast<int>(ring.size());
+    const int start = static_cast<int>(std::find(ring.begin(), ring.end(), pred) - ring.begin());
+    std::vector<int> allowed;
+    for (int i = 1; i < r; ++i) {
+      const int v = ring[(start + i) % r];
+      if (v == succ) break;
+      allowed.push_back(v);
+    }
+    return allowed;
+  };
+  // Called before each attempt at path k, when paths 0..k-1 exist.
+  auto prepare = [&](std::size_t k, PathSpec& spec) {
+    if (k > 0) traced_as[order[k - 1]] = static_cast<int>(k - 1);
+    const int h = edge_half[order[k]];
+    spec.restricted = true;
+    spec.first_ok = sector(h);
+    spec.last_ok = sector(he.opposite[h]);
+  };
+  std::vector<int> special = layout.corners;
+  const char* const kHint =
+      "; check that each quad's corners are counter-clockwise seen from outside and that the corners' cyclic "
+      "order matches the mesh";
+  try {
+    part.trace(specs, special, prepare);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(e.what() + std::string(kHint));
+  }
+  for (int k = 0; k < ne; ++k) traced_as[order[k]] = k;
+
+  PartitionResult& r = part.result();
+  auto fail = [&](const std::string& why) {
+    throw InvalidInput(std::string(kFn) + "the layout's paths do not cut the mesh into its " +
+                       std::to_string(layout.quads.size()) + " quads (" + why + ")" + kHint);
+  };
+  const int nq = static_cast<int>(layout.quads.size());
+  const int regions = part.label_regions();
+  if (regions != nq) fail(std::to_string(regions) + " regions");
+  // Quad q owns the region left of each of its sides, walked in its direction.
+  std::vector<int> quad_of_region(nq, -1), region_of_quad(nq, -1);
+  for (int q = 0; q < nq; ++q) {
+    for (int s = 0; s < 4; ++s) {
+      const int h = 4 * q + s;
+      const int a = corner_vertex(layout_from(layout, h));
+      const int step = first_step(h);
+      const int mh = part.connectivity().find(r.mesh, a, step);
+      const int region = r.face_patch[mh / 3];
+      if (s == 0) region_of_quad[q] = region;
+      if (region != region_of_quad[q])
+        fail("the sides of quad " + std::to_string(q) + " bound different regions");
+    }
+    if (quad_of_region[region_of_quad[q]] >= 0) {
+      fail("quads " + std::to_string(quad_of_region[region_of_quad[q]]) + " and " + std::to_string(q) +
+           " bound the same region");
+    }
+    quad_of_region[region_of_quad[q]] = q;
+  }
+  r.patches.assign(nq, Patch());
+  for (int q = 0; q < nq; ++q) {
+    std::array<int, 4> corners;
+    for (int s = 0; s < 4; ++s) corners[s] = corner_vertex(layout.quads[q][s]);
+    std::string why;
+    const auto cycle = part.disk_boundary(region_of_quad[q], corners[0], why);
+    if (cycle.empty()) fail("quad " + std::to_string(q) + ": " + why);
+    if (!Partitioner::make_sides(cycle, corners, r.patches[q])) {
+      fail("quad " + std::to_string(q) + "'s region does not have its 4 corners in cyclic order");
+    }
+    for (int s = 0; s < 4; ++s) {
+      const int h = 4 * q + s;
+      std::vector<int> path = part.paths()[traced_as[he.edge[h]]];
+      if (h != edge_half[he.edge[h]]) std::reverse(path.begin(), path.end());
+      if (r.patches[q].sides[s].vertices != path) {
+        fail("side " + std::to_string(s) + " of quad " + std::to_string(q) + " is not its traced path");
+      }
+    }
+  }
+  for (int& f : r.face_patch) f = quad_of_region[f];
+  std::string why;
+  if (!link_sides(r, why)) fail(why);
+  collect_faces(r);
+  return std::move(r);
+}
+
+// Checks the mesh preconditions shared by both entry points; returns the genus.
+int checked_genus(const TriMesh& mesh) {
   const TopologyReport topo = analyze_topology(mesh);
   if (!topo.manifold) {
     throw InvalidInput(std::string(kFn) + "the mesh is not manifold (" +
@@ -618,7 +858,70 @@ PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector
                        " degenerate triangles; run repair_mesh first");
   }
   if (!topo.genus) throw InvalidInput(std::string(kFn) + "the mesh is not orientable");
-  const int genus = *topo.genus;
+  return *topo.genus;
+}
+
+}  // namespace
+
+std::string check_quad_layout(const QuadLayout& layout, std::size_t num_vertices, int genus) {
+  for (std::size_t i = 0; i < layout.corners.size(); ++i) {
+    const int v = layout.corners[i];
+    if (v < 0 || static_cast<std::size_t>(v) >= num_vertices) {
+      return "layout corner " + std::to_string(i) + " = " + std::to_string(v) + " is out of range [0," +
+             std::to_string(num_vertices) + ")";
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (layout.corners[j] == v) {
+        return "layout corners " + std::to_string(j) + " and " + std::to_string(i) + " are both " +
+               vertex_name(v);
+      }
+    }
+  }
+  LayoutHalfEdges he;
+  std::string why = layout_half_edges(layout, he);
+  if (!why.empty()) return why;
+  // Uniform remeshing splits each grid quad along a diagonal by the parity of (i + j + patch): an
+  // odd-numbered patch's corner cells have the diagonal that misses the corner. Two such cells meeting at a
+  // corner of only two quads would share their diagonal (an edge of 4 triangles).
+  for (std::size_t c = 0; c < he.out_ccw.size(); ++c) {
+    const auto& fan = he.out_ccw[c];
+    if (fan.size() == 2 && (fan[0] / 4) % 2 == 1 && (fan[1] / 4) % 2 == 1) {
+      return "corner " + std::to_string(c) + " lies in only two quads (" + std::to_string(fan[0] / 4) + " and " +
+             std::to_string(fan[1] / 4) +
+             "), both odd-numbered: their remeshes would fold there; give one of them an even number";
+    }
+  }
+  const long long euler = static_cast<long long>(layout.corners.size()) - he.num_edges +
+                          static_cast<long long>(layout.quads.size());
+  if (euler != 2 - 2LL * genus) {
+    return "the layout has Euler characteristic " + std::to_string(euler) + " (" +
+           std::to_string(layout.corners.size()) + " corners, " + std::to_string(he.num_edges) + " edges, " +
+           std::to_string(layout.quads.size()) + " quads) but the mesh has genus " + std::to_string(genus) +
+           " (Euler characteristic " + std::to_string(2 - 2 * genus) + ")";
+  }
+  return "";
+}
+
+PartitionResult partition_mesh_layout(const TriMesh& closed_manifold, const QuadLayout& layout,
+                                      const PartitionOptions& options) {
+  check_points(closed_manifold, layout.corners, {});
+  const int genus = checked_genus(closed_manifold);
+  const std::string why = check_quad_layout(layout, closed_manifold.positions.size(), genus);
+  if (!why.empty()) throw InvalidInput(std::string(kFn) + why);
+  LayoutHalfEdges he;
+  layout_half_edges(layout, he);
+  return partition_layout(closed_manifold, layout, he, options);
+}
+
+PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector<int>& partition_points,
+                               const std::vector<int>& auxiliary_points, const PartitionOptions& options) {
+  const TriMesh& mesh = closed_manifold;
+  if (partition_points.size() != 4) {
+    throw InvalidInput(std::string(kFn) + "expected 4 partition points, got " +
+                       std::to_string(partition_points.size()));
+  }
+  check_points(mesh, partition_points, auxiliary_points);
+  const int genus = checked_genus(mesh);
   if (genus == 0) {
     if (!auxiliary_points.empty() && auxiliary_points.size() != 4) {
       throw InvalidInput(std::string(kFn) + "a genus-0 mesh takes 0 or 4 auxiliary points, got " +

@@ -4,7 +4,8 @@
 // Genus 0: four partition points P0..P3 are joined by Dijkstra shortest paths P0→P1→P2→P3→P0 (edge graph,
 // Euclidean edge lengths) into one simple closed loop, which cuts the sphere into 2 quadrilateral patches.
 // Genus 1: four partition points are the corners of a periodic 2×2 grid of 4 quadrilateral patches whose
-// 8 edges are each guided through one auxiliary point. Higher genus is rejected.
+// 8 edges are each guided through one auxiliary point. Higher genus is rejected by partition_mesh().
+// Any genus, any number of patches: partition_mesh_layout() traces the edges of a quad layout (QuadLayout).
 //
 // The patches are what the next stages (base mesh by half-edge collapses, mean value embedding on the unit
 // square, §3.3) consume: plain index arrays, no half-edge structure (see ../shared/STYLE.md).
@@ -14,6 +15,7 @@
 
 #include <array>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace geomip {
@@ -52,7 +54,8 @@ struct PartitionResult {
   /// vertices keep their ids and positions; an input triangle that was split keeps its id for its first
   /// piece, the other pieces are appended. Unsplit triangles keep their id and corner order.
   TriMesh mesh;
-  std::vector<Patch> patches;  ///< 2 (genus 0) or 4 (genus 1), ordered as documented in partition_mesh()
+  std::vector<Patch> patches;  ///< 2 (genus 0) or 4 (genus 1) from partition_mesh(); one per quad from
+                               ///< partition_mesh_layout()
   /// Patch id of each triangle of `mesh` (each triangle is in exactly one patch).
   std::vector<int> face_patch;
   /// One entry per (patch, side), patch-major: adjacency[4·p + s] describes side s of patch p.
@@ -137,6 +140,43 @@ struct PartitionOptions {
 PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector<int>& partition_points,
                                const std::vector<int>& auxiliary_points,
                                const PartitionOptions& options = {});
+
+/// A quad base domain (Praun, Sweldens, Schröder 2001, "Consistent mesh parameterizations"): corners on the
+/// mesh and quads between them. Quad q has corners corners[quads[q][0..3]], counter-clockwise seen from
+/// outside the surface (the orientation of the mesh's triangles); its side s runs from quads[q][s] to
+/// quads[q][(s+1)%4]. The quads must form a closed, oriented, manifold surface of the mesh's genus: every
+/// directed layout edge (a, b) appears in exactly one quad and (b, a) in exactly one other, the quads around
+/// each corner form one cycle, and #corners − #edges + #quads = 2 − 2·genus. Two corners share at most one
+/// layout edge (no double edges), and every corner is used. A corner in only two quads must not be in two
+/// odd-numbered ones (uniform_remesh_connectivity()'s diagonal rule would give both corner cells the same
+/// diagonal, an edge of four triangles).
+struct QuadLayout {
+  std::vector<int> corners;               ///< mesh vertex ids, distinct
+  std::vector<std::array<int, 4>> quads;  ///< indices into `corners`
+};
+
+/// Checks `layout` as a closed quad surface (see QuadLayout) whose corners are vertices of a mesh with
+/// `num_vertices` vertices and genus `genus`; returns "" or the first problem found, one line.
+std::string check_quad_layout(const QuadLayout& layout, std::size_t num_vertices, int genus);
+
+/// Partitions `closed_manifold` into one quadrilateral disk patch per quad of `layout`, of any genus.
+///
+/// Layout edges are traced as Dijkstra shortest paths (edge graph, Euclidean lengths): first a spanning
+/// tree of the corners (Kruskal, shortest corner distance first), then the other edges, shortest first. A path never passes through a corner other than its own two, nor through a vertex of an
+/// earlier path. At both of its corners it must leave the corner between the already traced paths that are
+/// its neighbours in the layout's cyclic order around that corner (Praun et al. 2001, §3.3), so that paths
+/// land between the right neighbours and each region between them is bounded by its quad's four paths.
+///
+/// Result: patch q is quad q, with corners[s] = layout.corners[layout.quads[q][s]] and side s the path of its
+/// side s; adjacency, face_patch and split vertices as for partition_mesh(). The validation is the same as
+/// partition_mesh()'s, and each region is matched to its quad by its corner cycle and side paths.
+///
+/// 	hrow InvalidInput with "partition_mesh:" and the reason when the mesh is not one closed, manifold,
+///   consistently oriented component, a corner is out of range or repeated, the layout is not a closed quad
+///   surface of the mesh's genus (check_quad_layout()), a path cannot be traced, or the traced paths do not
+///   cut the mesh into the layout's quads (corner cycles that disagree with the mesh).
+PartitionResult partition_mesh_layout(const TriMesh& closed_manifold, const QuadLayout& layout,
+                                      const PartitionOptions& options = {});
 
 /// Quality figures of a partition, in the mesh's units.
 struct PatchStats {

@@ -51,7 +51,7 @@ int run_convert(const ConvertArgs& args) {
   const bool report = !args.common.quiet && !args.common.json;
   const auto t_start = std::chrono::steady_clock::now();
   const PreparedModels models =
-      prepare_models(args.common.meshes, args.common.points, "geomip convert", !report);
+      prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches);
 
   ProgressBar bar("convert", report);
   ConvertOptions options;

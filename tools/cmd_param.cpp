@@ -66,6 +66,7 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
   const auto& kCorner = unit_square_corners();
   nlohmann::json patches = nlohmann::json::array();
   std::size_t flipped = 0;
+  double smallest = std::numeric_limits<double>::infinity(), largest = 0.0;
   for (std::size_t k = 0; k < m.patches.size(); ++k) {
     const auto& p = m.patches[k];
     nlohmann::json corners = nlohmann::json::array();
@@ -83,9 +84,18 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
                        {"flipped", p.flipped},
                        {"boundary_off_chord", p.boundary_off_chord},
                        {"mvc_fallback", p.mvc_fallback}});
+    double area = 0.0;  // of the patch's surface, in the mesh's units
+    for (const auto& t : p.triangles) {
+      const auto& a = m.mesh.positions[p.vertices[t[0]]];
+      area += 0.5 * (m.mesh.positions[p.vertices[t[1]]] - a).cross(m.mesh.positions[p.vertices[t[2]]] - a).norm();
+    }
+    patches.back()["area"] = area;
+    smallest = std::min(smallest, area);
+    largest = std::max(largest, area);
     flipped += p.flipped;
   }
   j["patches"] = patches;
+  j["area_balance"] = largest > 0 ? smallest / largest : 0.0;  // smallest / largest patch area
   nlohmann::json adjacency = nlohmann::json::array();
   for (const auto& a : m.adjacency) {
     adjacency.push_back({{"patch", a.patch},
@@ -113,7 +123,7 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
 }
 
 int run_param(const ParamArgs& args) {
-  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param", args.common.quiet || args.common.json);
+  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param", args.common.quiet || args.common.json, args.common.patches);
   const std::vector<ParameterizationInput>& inputs = models.inputs;
   const std::vector<std::string>& paths = models.paths;
 
@@ -135,6 +145,7 @@ int run_param(const ParamArgs& args) {
     write_file_atomically(stem + ".param.obj",
                           [&](std::ostream& out) { write_param_obj(out, result[i], paths[i]); });
     nlohmann::json j = param_json(result[i], paths[i], inputs[i].partition_points, inputs[i].auxiliary_points);
+    if (!inputs[i].layout_quads.empty()) j["layout_quads"] = inputs[i].layout_quads;  // corners: partition_points
     j["seconds"]["total_all_models"] = seconds;
     write_file_atomically(stem + ".param.json", [&](std::ostream& out) { out << j.dump(2) << "\n"; });
     if (args.common.json) {

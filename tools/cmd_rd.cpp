@@ -56,6 +56,7 @@ struct RdArgs {
   int level = 8;            // geomip: geometry image level of the pack whose prefixes are measured
   bool no_geomip = false;   // only the baselines
   int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
+  int patches = 2;          // geomip: patches of the automatic layout (--patches)
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -192,9 +193,9 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
 
 /// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only pack),
 /// then one job per prefix size: decode the first N bytes and build the level-N mesh.
-Series geomip_series(const std::string& mesh_path, int level, int normal_mesh_steps, bool quick,
+Series geomip_series(const std::string& mesh_path, int level, int patches, int normal_mesh_steps, bool quick,
                      std::vector<std::uint8_t>& pack_out, ProgressBar& progress) {
-  const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true);
+  const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches);
   ConvertOptions options;
   options.level = level;
   options.normals = false;
@@ -284,7 +285,8 @@ int run_rd(const RdArgs& args) {
   ProgressBar progress("rd", !args.json);
   std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
-  if (!args.no_geomip) plan.push_back(geomip_series(args.mesh, args.level, args.normal_mesh_steps, args.quick, pack, progress));
+  if (!args.no_geomip)
+    plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.normal_mesh_steps, args.quick, pack, progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -437,6 +439,7 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_option("--normal-mesh", args->normal_mesh_steps,
                   "geomip: normal-mesh resampling of the finest STEPS wavelet steps (as `geomip convert`; 0 = off)")
       ->check(CLI::Range(0, 10));
+  add_patches_option(cmd, args->patches);
   return [args] { return run_rd(*args); };
 }
 

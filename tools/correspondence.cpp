@@ -49,6 +49,23 @@ std::vector<ModelSpec> read_correspondence(const std::string& path) {
     fail(path, "expected {\"models\": [ ... ]} with at least one model");
   }
   const std::filesystem::path base = std::filesystem::path(path).parent_path();
+  std::vector<std::array<int, 4>> quads;
+  if (j.contains("layout")) {
+    const auto& layout = j["layout"];
+    if (!layout.is_object() || !layout.contains("quads") || !layout["quads"].is_array() || layout["quads"].empty())
+      fail(path, "\"layout\" must be {\"quads\": [[a,b,c,d], ...]} with at least one quad");
+    for (std::size_t q = 0; q < layout["quads"].size(); ++q) {
+      const auto& quad = layout["quads"][q];
+      std::array<int, 4> ids{};
+      bool ok = quad.is_array() && quad.size() == 4;
+      for (std::size_t c = 0; ok && c < 4; ++c) {
+        ok = quad[c].is_number_integer() && quad[c].get<long long>() >= 0 && quad[c].get<long long>() < (1LL << 30);
+        if (ok) ids[c] = static_cast<int>(quad[c].get<long long>());
+      }
+      if (!ok) fail(path, "layout.quads[" + std::to_string(q) + "] must be 4 corner indices >= 0");
+      quads.push_back(ids);
+    }
+  }
   std::vector<ModelSpec> models;
   for (std::size_t m = 0; m < j["models"].size(); ++m) {
     const auto& model = j["models"][m];
@@ -61,7 +78,17 @@ std::vector<ModelSpec> read_correspondence(const std::string& path) {
     s.partition_points = points(path, model, "partition_points", m);
     s.auxiliary_points = points(path, model, "auxiliary_points", m);
     s.features = points(path, model, "features", m);
-    if (s.partition_points.size() != 4) {
+    s.layout_quads = quads;
+    if (!quads.empty()) {
+      if (s.partition_points.empty())
+        fail(path, "models[" + std::to_string(m) + "] needs partition_points: the layout's corners");
+      if (!s.auxiliary_points.empty())
+        fail(path, "models[" + std::to_string(m) + "] has auxiliary_points; a layout's paths take no guides");
+      if (!models.empty() && s.partition_points.size() != models[0].partition_points.size()) {
+        fail(path, "models[" + std::to_string(m) + "] has " + std::to_string(s.partition_points.size()) +
+                       " layout corners, models[0] has " + std::to_string(models[0].partition_points.size()));
+      }
+    } else if (s.partition_points.size() != 4) {
       fail(path, "models[" + std::to_string(m) + "].partition_points must list 4 points, it lists " +
                      std::to_string(s.partition_points.size()));
     }

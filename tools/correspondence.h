@@ -3,10 +3,15 @@
 //                "features": [P,...]}, ...]}
 // Mesh paths are relative to the JSON file. A point P is a 0-based vertex index of the mesh file as written,
 // or [x,y,z], snapped to the nearest vertex. Features correspond by order across models.
+// Optional, top level: "layout": {"quads": [[a,b,c,d], ...]}, a quad layout shared by all models (see
+// QuadLayout in param/mesh_partition.h): each model's partition_points are then the layout's corners (any
+// number, the same in every model; quads index them, counter-clockwise seen from outside) and
+// auxiliary_points must be empty.
 #pragma once
 
 #include <Eigen/Core>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -21,10 +26,11 @@ struct PointSpec {
 struct ModelSpec {
   std::string mesh;  ///< resolved against the JSON file's directory
   std::vector<PointSpec> partition_points, auxiliary_points, features;
+  std::vector<std::array<int, 4>> layout_quads;  ///< the file's "layout" quads (the same in every model), or empty
 };
 
 /// Parses CORR.json. \throw InvalidInput with the file name and the offending entry for a missing file,
-/// malformed JSON, wrong types, or differing feature counts.
+/// malformed JSON, wrong types, differing feature or corner counts, or a malformed "layout".
 std::vector<ModelSpec> read_correspondence(const std::string& path);
 
 }  // namespace geomip::tools

@@ -5,6 +5,7 @@
 #include "mesh/mesh_repair.h"
 #include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
+#include "param/quad_layout.h"
 #include "tools/correspondence.h"
 
 #include <algorithm>
@@ -115,15 +116,19 @@ std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMe
 }  // namespace
 
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file_arg,
-                              const std::string& command, bool quiet) {
+                              const std::string& command, bool quiet, int patches) {
   PreparedModels models;
   std::vector<ParameterizationInput>& inputs = models.inputs;
   std::vector<std::string>& paths = models.paths;
   std::vector<ModelSpec> specs;
   const std::string& points_file = points_file_arg;
+  if (patches < 2) throw InvalidInput("--patches " + std::to_string(patches) + ": a layout needs at least 2");
   if (!points_file_arg.empty()) {
     if (!meshes.empty()) {
       throw InvalidInput("give either meshes or --points CORR.json (which names the meshes), not both");
+    }
+    if (patches != 2) {
+      throw InvalidInput("--patches chooses an automatic layout; with --points CORR.json the file gives the points");
     }
     specs = read_correspondence(points_file_arg);
   } else {
@@ -131,7 +136,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       throw InvalidInput("several meshes need --points CORR.json: their partition points must correspond");
     }
     if (meshes.empty()) throw InvalidInput("no mesh given (a MESH or --points CORR.json)");
-    specs.push_back(ModelSpec{meshes[0], {}, {}, {}});
+    specs.push_back(ModelSpec{meshes[0], {}, {}, {}, {}});
   }
 
   for (const auto& spec : specs) {
@@ -144,7 +149,13 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
         in.mesh.positions.size() != input.positions.size() || in.mesh.triangles != input.triangles;
     const TriMesh& source = repaired ? input : in.mesh;
     const std::string where = points_file.empty() ? spec.mesh : points_file;
-    if (spec.partition_points.empty()) {
+    if (spec.partition_points.empty() && patches != 2) {
+      QuadLayoutOptions layout_options;
+      layout_options.patches = patches;
+      const QuadLayoutChoice chosen = choose_quad_layout(in.mesh, layout_options);
+      in.partition_points = chosen.layout.corners;
+      in.layout_quads = chosen.layout.quads;
+    } else if (spec.partition_points.empty()) {
       const PartitionPoints chosen = choose_partition_points(in.mesh);
       in.partition_points = chosen.partition_points;
       in.auxiliary_points = chosen.auxiliary_points;
@@ -152,6 +163,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       in.partition_points = resolve_points(spec.partition_points, source, in.mesh, "partition_points", where);
       in.auxiliary_points = resolve_points(spec.auxiliary_points, source, in.mesh, "auxiliary_points", where);
       in.features = resolve_points(spec.features, source, in.mesh, "features", where);
+      in.layout_quads = spec.layout_quads;
     }
     inputs.push_back(std::move(in));
     paths.push_back(spec.mesh);
@@ -171,6 +183,13 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
                   "Curvature sampling exponent g: stretch weights ((eps + |II|^2)/eps)^g give bent regions more "
                   "samples; 0 = plain geometric stretch (default: 1/3 for param, gimage, remesh; 0 for convert)")
       ->check(CLI::Range(0.0, 2.0));
+  add_patches_option(cmd, args.patches);
+}
+
+void add_patches_option(CLI::App* cmd, int& patches) {
+  cmd->add_option("--patches", patches,
+                  "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop; "
+                  "K >= 3 pairs the triangles of a coarse mesh into K quads (any genus: K + 2 - 2g >= 4)");
 }
 
 void apply_sampling(const ModelArgs& args, ParameterizationOptions& options) {

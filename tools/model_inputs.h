@@ -29,6 +29,9 @@ struct ModelArgs {
   bool quiet = false;
   /// Curvature sampling exponent γ (SamplingWeightOptions::exponent); 0 = uniform geometric stretch.
   double sampling_exponent = SamplingWeightOptions{}.exponent;
+  /// --patches K: patches of the automatic layout. 2 = the two-square partition (choose_partition_points());
+  /// another K = a K-quad layout (choose_quad_layout()). Only without CORR.json.
+  int patches = 2;
 };
 
 /// Sets the parameterization's curvature sampling from `--sampling-exponent`.
@@ -38,10 +41,14 @@ void apply_sampling(const ModelArgs& args, ParameterizationOptions& options);
 void add_model_options(CLI::App* cmd, ModelArgs& args);
 
 /// `meshes`: one mesh (automatic partition points) or none when `points_file` names them. `command` prefixes
-/// the repair note ("geomip param"); `quiet` silences it.
+/// the repair note ("geomip param"); `quiet` silences it. `patches`: see ModelArgs::patches.
 /// \throw InvalidInput when both or neither are given, several meshes come without CORR.json, a file is
-///   unreadable, or a point is out of range.
+///   unreadable, a point is out of range, `patches` < 2, `patches` ≠ 2 comes with CORR.json, or no K-quad
+///   layout fits the mesh (choose_quad_layout()).
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file,
-                              const std::string& command, bool quiet);
+                              const std::string& command, bool quiet, int patches = 2);
+
+/// Registers `--patches K` on `cmd` (same name and help in every command).
+void add_patches_option(CLI::App* cmd, int& patches);
 
 }  // namespace geomip::tools

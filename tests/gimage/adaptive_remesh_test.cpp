@@ -161,32 +161,37 @@ TEST(AdaptiveRemesh, FlatRegionNeverSplits) {
   EXPECT_GT(e.errors[0][0][0], 0.01);
 }
 
+// Two patches, and the cube layout's six (a K-patch layout): crack-free, one face list.
 TEST(AdaptiveRemesh, ConsistentPairSharesOneFaceList) {
-  const auto& pair = test::deformed_sphere_pair();
-  std::vector<GeometryImages> images;
-  std::vector<AdaptiveQuadErrors> errors;
-  for (const auto& m : pair) {
-    images.push_back(resample_geometry(m, kLevel, {false, -1}));
-    errors.push_back(adaptive_quad_errors(m, images.back()));
-  }
-  for (double eps : {0.02, 0.005}) {
-    AdaptiveRemeshOptions options;
-    options.epsilon = eps;
-    const AdaptiveQuadtree tree = adaptive_quadtree(errors, images[0].adjacency, options);
-    // The shared tree is at least as deep as each model's own (eq. 6: the maximum error).
-    for (std::size_t k = 0; k < 2; ++k) {
-      const AdaptiveQuadtree own = adaptive_quadtree({errors[k]}, images[k].adjacency, options);
-      for (std::size_t p = 0; p < tree.depth.size(); ++p) {
-        for (std::size_t c = 0; c < tree.depth[p].size(); ++c) ASSERT_GE(tree.depth[p][c], own.depth[p][c]);
-      }
+  for (const auto* pair : {&test::deformed_sphere_pair(), &test::cube_layout_pair()}) {
+    SCOPED_TRACE(std::to_string((*pair)[0].patches.size()) + " patches");
+    std::vector<GeometryImages> images;
+    std::vector<AdaptiveQuadErrors> errors;
+    for (const auto& m : *pair) {
+      images.push_back(resample_geometry(m, kLevel, {false, -1}));
+      errors.push_back(adaptive_quad_errors(m, images.back()));
     }
-    const TriMesh a = adaptive_remesh(images[0], tree);
-    const TriMesh b = adaptive_remesh(images[1], tree);
-    EXPECT_EQ(a.triangles, b.triangles);
-    EXPECT_EQ(a.positions.size(), b.positions.size());
-    EXPECT_NE(a.positions, b.positions);
-    test::expect_watertight_oriented(a, 0, "a");
-    test::expect_watertight_oriented(b, 0, "b");
+    for (double eps : {0.02, 0.005}) {
+      AdaptiveRemeshOptions options;
+      options.epsilon = eps;
+      const AdaptiveQuadtree tree = adaptive_quadtree(errors, images[0].adjacency, options);
+      expect_tiling_and_restricted(tree);
+      EXPECT_EQ(tree.depth.size(), (*pair)[0].patches.size());
+      // The shared tree is at least as deep as each model's own (eq. 6: the maximum error).
+      for (std::size_t k = 0; k < 2; ++k) {
+        const AdaptiveQuadtree own = adaptive_quadtree({errors[k]}, images[k].adjacency, options);
+        for (std::size_t p = 0; p < tree.depth.size(); ++p) {
+          for (std::size_t c = 0; c < tree.depth[p].size(); ++c) ASSERT_GE(tree.depth[p][c], own.depth[p][c]);
+        }
+      }
+      const TriMesh a = adaptive_remesh(images[0], tree);
+      const TriMesh b = adaptive_remesh(images[1], tree);
+      EXPECT_EQ(a.triangles, b.triangles);
+      EXPECT_EQ(a.positions.size(), b.positions.size());
+      EXPECT_NE(a.positions, b.positions);
+      test::expect_watertight_oriented(a, 0, "a");
+      test::expect_watertight_oriented(b, 0, "b");
+    }
   }
 }
 

@@ -29,23 +29,48 @@ inline const ModelParameterization& parameterized(const std::string& which) {
   return cache[which] = parameterize_consistently({automatic_input(mesh, which)}, quick_options())[0];
 }
 
+/// test::sphere(3) and a differently deformed copy of it ("a", "b"), without points.
+inline std::vector<ParameterizationInput> deformed_sphere_inputs() {
+  std::vector<ParameterizationInput> models(2);
+  models[0].mesh = sphere(3);
+  models[1].mesh = models[0].mesh;
+  for (auto& p : models[1].mesh.positions)
+    p = Eigen::Vector3d(1.6 * p.x() + 0.2 * p.y() * p.y(), p.y(), 0.7 * p.z() + 0.3 * p.x() * p.y());
+  models[0].name = "a";
+  models[1].name = "b";
+  return models;
+}
+
 /// Two differently deformed spheres with corresponding partition points (as in
 /// tests/param/consistent_parameterization_test.cpp), parameterized consistently.
 inline const std::vector<ModelParameterization>& deformed_sphere_pair() {
   static std::vector<ModelParameterization> pair;
   if (!pair.empty()) return pair;
-  const TriMesh a = sphere(3);
-  TriMesh b = a;
-  for (auto& p : b.positions)
-    p = Eigen::Vector3d(1.6 * p.x() + 0.2 * p.y() * p.y(), p.y(), 0.7 * p.z() + 0.3 * p.x() * p.y());
-  std::vector<ParameterizationInput> models(2);
-  models[0].mesh = a;
-  models[1].mesh = b;
-  models[0].name = "a";
-  models[1].name = "b";
+  std::vector<ParameterizationInput> models = deformed_sphere_inputs();
   const Eigen::Vector3d corners[4] = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
   for (auto& m : models) {
-    for (const auto& c : corners) m.partition_points.push_back(nearest_vertex(a, c));
+    for (const auto& c : corners) m.partition_points.push_back(nearest_vertex(models[0].mesh, c));
+  }
+  pair = parameterize_consistently(models, quick_options());
+  return pair;
+}
+
+/// The cube's 6 faces as a quad layout over its 8 corners (test::cube()'s vertex ids, which test::sphere()
+/// keeps), counter-clockwise from outside: K = 6 patches on a sphere.
+inline QuadLayout cube_layout() {
+  return QuadLayout{{0, 1, 2, 3, 4, 5, 6, 7},
+                    {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}};
+}
+
+/// Two differently deformed spheres (as in deformed_sphere_pair()) over the cube layout, parameterized
+/// consistently: 6 patches each.
+inline const std::vector<ModelParameterization>& cube_layout_pair() {
+  static std::vector<ModelParameterization> pair;
+  if (!pair.empty()) return pair;
+  std::vector<ParameterizationInput> models = deformed_sphere_inputs();
+  for (auto& m : models) {
+    m.partition_points = cube_layout().corners;
+    m.layout_quads = cube_layout().quads;
   }
   pair = parameterize_consistently(models, quick_options());
   return pair;

@@ -50,6 +50,31 @@ INSTANTIATE_TEST_SUITE_P(
       return std::string(param_info.param).substr(0, std::string(param_info.param).find('.'));
     });
 
+// Automatic K-quad layouts (--patches K, issue 15): 0 flips, bit-identical seams, uniform remeshes watertight
+// with the input's genus and V − E + F = 2 − 2g at every level (V = K·4^L + 2 − 2g).
+TEST(RealRemeshLayouts, KPatchLayoutsAreFlipFreeWatertightAndOfTheRightEulerCharacteristic) {
+  for (const auto& [name, patches] : {std::pair<const char*, int>{"spot.obj", 8}, {"bob.obj", 10}}) {
+    GEOMIP_REQUIRE_SHARED_MESH(path, name);
+    SCOPED_TRACE(std::string(name) + ", " + std::to_string(patches) + " patches");
+    const auto prepared = tools::prepare_models({path}, "", "uniform_remesh_real_test", true, patches);
+    const auto model = parameterize_consistently(prepared.inputs, test::quick_options())[0];
+    ASSERT_EQ(model.patches.size(), static_cast<std::size_t>(patches));
+    for (const auto& patch : model.patches) EXPECT_EQ(patch.flipped, 0u);
+    const int genus = analyze_topology(prepared.inputs[0].mesh).genus.value_or(-1);
+    const GeometryImages g = resample_geometry(model, 5);
+    EXPECT_EQ(g.uncovered_samples, 0u);
+    test::expect_seams_bit_identical(model, g);
+    for (int level = 1; level <= 5; ++level) {
+      const UniformRemeshResult remesh = uniform_remesh(g, level);
+      const std::size_t quads = static_cast<std::size_t>(patches) << (2 * level);
+      EXPECT_EQ(remesh.mesh.triangles.size(), 2 * quads);
+      EXPECT_EQ(static_cast<long long>(remesh.mesh.positions.size()),
+                static_cast<long long>(quads) + 2 - 2 * genus);
+      test::expect_watertight_oriented(remesh.mesh, genus, std::string(name) + " M" + std::to_string(level));
+    }
+  }
+}
+
 // The consistent set of issue #3 (horse, cow, pig, spot; tests/data/animals.corr.json), prepared as the
 // commands do: one face list at every level M1..M8, each remesh watertight, oriented and genus 0.
 TEST(RealRemeshConsistentSet, AnimalsShareOneFaceListAtEveryLevel) {

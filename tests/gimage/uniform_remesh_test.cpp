@@ -72,5 +72,28 @@ TEST(UniformRemesh, ConsistentSetSharesOneFaceList) {
   }
 }
 
+TEST(UniformRemesh, CubeLayoutPairIsWatertightWithSixPatchesAndOneFaceList) {
+  const auto& pair = test::cube_layout_pair();
+  ASSERT_EQ(pair.size(), 2u);
+  std::vector<GeometryImages> images;
+  for (const auto& m : pair) {
+    ASSERT_EQ(m.patches.size(), 6u);
+    for (const auto& patch : m.patches) EXPECT_EQ(patch.flipped, 0u);
+    images.push_back(resample_geometry(m, 5));
+    EXPECT_EQ(images.back().uncovered_samples, 0u);
+    test::expect_seams_bit_identical(m, images.back());
+  }
+  for (int level = 0; level <= 5; ++level) {
+    const UniformRemeshResult a = uniform_remesh(images[0], level);
+    const UniformRemeshResult b = uniform_remesh(images[1], level);
+    const std::size_t quads = 6u << (2 * level);  // 6·4^K
+    EXPECT_EQ(a.mesh.triangles.size(), 2 * quads);
+    EXPECT_EQ(a.mesh.positions.size(), quads + 2);  // Euler characteristic 2: V − 2Q + Q = 2
+    EXPECT_EQ(a.mesh.triangles, b.mesh.triangles);
+    test::expect_watertight_oriented(a.mesh, 0, "a M" + std::to_string(level));
+    test::expect_watertight_oriented(b.mesh, 0, "b M" + std::to_string(level));
+  }
+}
+
 }  // namespace
 }  // namespace geomip

@@ -23,54 +23,6 @@ using test::nearest_vertex;
 using test::sphere;
 using test::subdivide;
 
-// Two tori joined by a tube: genus 2. The tube's winding and matching are searched so that the result is a
-// consistently oriented closed manifold.
-TriMesh double_torus() {
-  const int n = 16, mm = 8;
-  const TriMesh a = test::torus(n, mm);
-  TriMesh b = test::torus(n, mm);
-  for (auto& p : b.positions) p.x() += 3.0;
-  auto id = [&](int i, int j) { return ((i + n) % n) * mm + (j + mm) % mm; };
-  // Remove the quad (i=0, j=0) of A (facing +x) and (i=n/2, j=0) of B (facing -x).
-  const std::array<int, 4> ha = {id(0, 0), id(1, 0), id(1, 1), id(0, 1)};
-  const std::array<int, 4> hb = {id(n / 2, 0), id(n / 2 + 1, 0), id(n / 2 + 1, 1), id(n / 2, 1)};
-  auto without = [&](const TriMesh& t, int i) {
-    TriMesh r = t;
-    r.triangles.erase(r.triangles.begin() + 2 * (i * mm));  // the two triangles of quad (i, 0)
-    r.triangles.erase(r.triangles.begin() + 2 * (i * mm));
-    return r;
-  };
-  const TriMesh base = test::join(without(a, 0), without(b, n / 2));
-  const int off = static_cast<int>(a.positions.size());
-  for (int shift = 0; shift < 4; ++shift) {
-    for (int dir = -1; dir <= 1; dir += 2) {
-      for (int flip = 0; flip < 2; ++flip) {
-        TriMesh m = base;
-        for (int k = 0; k < 4; ++k) {
-          const int a0 = ha[k], a1 = ha[(k + 1) % 4];
-          const int b0 = hb[(shift + dir * k + 8) % 4] + off, b1 = hb[(shift + dir * (k + 1) + 8) % 4] + off;
-          std::array<int, 3> t1 = {a1, a0, b0}, t2 = {a1, b0, b1};
-          if (flip) {
-            std::swap(t1[1], t1[2]);
-            std::swap(t2[1], t2[2]);
-          }
-          m.triangles.push_back(t1);
-          m.triangles.push_back(t2);
-        }
-        const TopologyReport r = analyze_topology(m);
-        std::set<std::pair<int, int>> directed;
-        bool consistent = true;
-        for (const auto& t : m.triangles) {
-          for (int k = 0; k < 3; ++k) consistent &= directed.insert({t[k], t[(k + 1) % 3]}).second;
-        }
-        if (consistent && r.manifold && r.boundary_edges == 0 && r.genus == 2) return m;
-      }
-    }
-  }
-  ADD_FAILURE() << "could not build a double torus";
-  return base;
-}
-
 // Tutte's map of every patch onto the unit square is one-to-one (the use §3.3 makes of the patches).
 std::string embedding_problems(const PartitionResult& r) {
   std::string problems;
@@ -477,7 +429,7 @@ TEST(PartitionErrors, BadMeshesAreRejectedWithAClearMessage) {
   TriMesh flipped = sphere(2);
   std::swap(flipped.triangles[5][0], flipped.triangles[5][1]);
   EXPECT_THROW(partition_mesh(flipped, {0, 3, 20, 30}, {}), InvalidInput);
-  const TriMesh dt = double_torus();
+  const TriMesh dt = test::double_torus();
   expect_invalid(dt, {0, 3, 20, 30}, {}, "genus 2");
   EXPECT_THROW(choose_partition_points(dt), InvalidInput);
   const TorusSetup t = torus_setup(16, 8);
@@ -485,6 +437,103 @@ TEST(PartitionErrors, BadMeshesAreRejectedWithAClearMessage) {
   std::vector<int> aux = t.aux;
   aux[7] = t.p[2];
   expect_invalid(t.mesh, t.p, aux, "must be distinct");
+}
+
+// ------------------------------------------------------------------------------------------- quad layouts
+
+// The cube's 6 faces as quads over its 8 corners (test::cube()'s vertex ids), counter-clockwise from outside.
+const std::vector<std::array<int, 4>> kCubeQuads = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                                    {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+
+// test::sphere() keeps the cube's corners as vertices 0..7 (subdivision appends).
+QuadLayout cube_layout() {
+  return QuadLayout{{0, 1, 2, 3, 4, 5, 6, 7}, kCubeQuads};
+}
+
+void expect_invalid_layout(const TriMesh& m, const QuadLayout& layout, const std::string& fragment) {
+  test::expect_invalid_input([&] { partition_mesh_layout(m, layout); }, "partition_mesh:", fragment);
+}
+
+TEST(PartitionLayout, CubeLayoutOnASphereGivesSixGluedDisks) {
+  const TriMesh m = sphere(4);
+  const QuadLayout layout = cube_layout();
+  const PartitionResult r = partition_mesh_layout(m, layout);
+  EXPECT_EQ(test::check_partition(m, layout.corners, r, &layout), "");
+  EXPECT_EQ(embedding_problems(r), "");
+  // By symmetry every face of the cube gets a sixth of the sphere.
+  const PartitionStats stats = partition_stats(r);
+  EXPECT_GT(stats.area_balance, 0.95);
+}
+
+TEST(PartitionLayout, CornerCyclesAreKeptWhenShortestPathsWouldCross) {
+  // Corners moved off the cube's vertices (towards a neighbouring face centre) and a rotated sphere: the
+  // paths are no longer mesh lines, and each must leave its corners between the right neighbours.
+  TriMesh m = sphere(4);
+  const Eigen::Matrix3d rot =
+      (Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
+  for (auto& p : m.positions) p = rot * p;
+  QuadLayout layout = cube_layout();
+  const TriMesh c = test::cube();
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d corner = c.positions[k] - Eigen::Vector3d::Constant(0.5);
+    const Eigen::Vector3d pushed = corner + Eigen::Vector3d(0.25 * (k % 3 == 0 ? 1 : -1), 0.1 * (k % 2), 0.0);
+    layout.corners[k] = nearest_vertex(m, rot * pushed.normalized());
+  }
+  const PartitionResult r = partition_mesh_layout(m, layout);
+  EXPECT_EQ(test::check_partition(m, layout.corners, r, &layout), "");
+  EXPECT_EQ(embedding_problems(r), "");
+}
+
+TEST(PartitionLayout, TorusGridLayoutOfNineQuads) {
+  const int n = 24, mm = 12;
+  const TriMesh m = test::torus(n, mm);
+  auto id = [&](int i, int j) { return ((i + n) % n) * mm + (j + mm) % mm; };
+  QuadLayout layout;
+  auto corner = [&](int a, int b) { return ((a + 3) % 3) * 3 + (b + 3) % 3; };
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) layout.corners.push_back(id(a * n / 3, b * mm / 3));
+  }
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b)
+      layout.quads.push_back({corner(a, b), corner(a + 1, b), corner(a + 1, b + 1), corner(a, b + 1)});
+  }
+  const PartitionResult r = partition_mesh_layout(m, layout);
+  EXPECT_EQ(test::check_partition(m, layout.corners, r, &layout), "");
+  EXPECT_EQ(embedding_problems(r), "");
+}
+
+TEST(PartitionLayout, BadLayoutsAreRejectedWithOneLine) {
+  const TriMesh m = sphere(3);
+  QuadLayout open = cube_layout();
+  open.quads.pop_back();
+  expect_invalid_layout(m, open, "not closed");
+  QuadLayout flipped = cube_layout();
+  std::reverse(flipped.quads[2].begin(), flipped.quads[2].end());
+  expect_invalid_layout(m, flipped, "same way by two quads");
+  QuadLayout repeated = cube_layout();
+  repeated.quads[0][1] = repeated.quads[0][0];
+  expect_invalid_layout(m, repeated, "repeats corner");
+  QuadLayout out_of_range = cube_layout();
+  out_of_range.quads[0][0] = 8;
+  expect_invalid_layout(m, out_of_range, "outside [0,8)");
+  QuadLayout bad_vertex = cube_layout();
+  bad_vertex.corners[3] = static_cast<int>(m.positions.size());
+  expect_invalid_layout(m, bad_vertex, "out of range");
+  // Inside out (the mirror image): still a cube layout of the sphere, with every corner's cyclic order
+  // reversed; the paths must wind around the corners, and the result is a valid partition.
+  QuadLayout inside_out = cube_layout();
+  for (auto& q : inside_out.quads) std::reverse(q.begin(), q.end());
+  const PartitionResult mirrored = partition_mesh_layout(m, inside_out);
+  EXPECT_EQ(test::check_partition(m, inside_out.corners, mirrored, &inside_out), "");
+  // A sphere's layout on a torus: wrong Euler characteristic.
+  const TriMesh t = test::torus(16, 8);
+  expect_invalid_layout(t, cube_layout(), "Euler characteristic 2");
+  EXPECT_EQ(check_quad_layout(cube_layout(), 8, 0), "");
+  // Two-quad corners: the 2-patch loop as a layout is fine (quads 0 and 1); a pillow in quads 1 and 3 is not
+  // (both odd: their remesh corner cells would share a diagonal).
+  EXPECT_EQ(check_quad_layout(QuadLayout{{0, 1, 2, 3}, {{0, 1, 2, 3}, {0, 3, 2, 1}}}, 4, 0), "");
+  const QuadLayout odd_pillow{{0, 1, 2, 3, 4, 5, 6, 7}, {{4, 5, 6, 7}, {0, 1, 2, 3}, {4, 7, 6, 5}, {0, 3, 2, 1}}};
+  EXPECT_NE(check_quad_layout(odd_pillow, 8, 0).find("both odd-numbered"), std::string::npos);
 }
 
 }  // namespace

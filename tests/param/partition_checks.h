@@ -2,11 +2,13 @@
 // from the triangles), shared by the unit and real-mesh tests of partition_mesh().
 #pragma once
 
+#include "mesh/errors.h"
 #include "mesh/mesh.h"
-#include "param/mesh_partition.h"
 #include "mesh/mesh_topology.h"
 #include "mesh/predicates.h"
+#include "param/mesh_partition.h"
 
+#include <gtest/gtest.h>
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
@@ -20,6 +22,21 @@
 #include <vector>
 
 namespace geomip::test {
+
+/// `call()` must throw InvalidInput with a one-line message holding `prefix` (the function's name) and
+/// `fragment` (the reason).
+template <class Call>
+void expect_invalid_input(Call&& call, const std::string& prefix, const std::string& fragment) {
+  try {
+    call();
+    ADD_FAILURE() << "no exception; expected one mentioning '" << fragment << "'";
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(prefix), std::string::npos) << what;
+    EXPECT_NE(what.find(fragment), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
 
 inline double surface_area(const TriMesh& m) {
   double a = 0.0;
@@ -107,8 +124,10 @@ inline SquareEmbedding tutte_square_embedding(const PartitionResult& r, int p) {
 
 /// Every documented property of `r` = partition_mesh(input, points, aux), and Floater's condition for a
 /// one-to-one square embedding. Returns "" when all hold, else a description of the problems.
+/// With `layout` (a result of partition_mesh_layout()): one patch per quad, patch q's corners those of quad
+/// q.
 inline std::string check_partition(const TriMesh& input, const std::vector<int>& points,
-                                   const PartitionResult& r) {
+                                   const PartitionResult& r, const QuadLayout* layout = nullptr) {
   std::ostringstream err;
   const TriMesh& m = r.mesh;
   const int nf = static_cast<int>(m.triangles.size());
@@ -130,7 +149,7 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
   if (std::abs(a0 - a1) > 1e-9 * a0) err << "area changed " << a0 << " -> " << a1 << "; ";
 
   const std::size_t np = r.patches.size();
-  const std::size_t expected = in_topo.genus == 0 ? 2 : 4;
+  const std::size_t expected = layout ? layout->quads.size() : in_topo.genus == 0 ? 2 : 4;
   if (np != expected) {
     err << np << " patches, expected " << expected << "; ";
     return err.str();
@@ -157,7 +176,13 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
 
   // Corners.
   const std::set<int> point_set(points.begin(), points.end());
-  for (std::size_t p = 0; p < np; ++p) {
+  for (std::size_t p = 0; layout && p < np; ++p) {
+    for (int s = 0; s < 4; ++s) {
+      if (r.patches[p].corners[s] != layout->corners[layout->quads[p][s]])
+        err << "patch " << p << " corner " << s << " is not its quad's; ";
+    }
+  }
+  for (std::size_t p = 0; !layout && p < np; ++p) {
     const auto& c = r.patches[p].corners;
     if (std::set<int>(c.begin(), c.end()) != point_set)
       err << "patch " << p << " corners are not the 4 points; ";
@@ -165,7 +190,7 @@ inline std::string check_partition(const TriMesh& input, const std::vector<int>&
     const int first = in_topo.genus == 0 ? points[0] : points[p / 2 + 2 * (p % 2)];
     if (c[0] != first) err << "patch " << p << " corner 0 is not the documented one; ";
   }
-  if (in_topo.genus == 0) {
+  if (!layout && in_topo.genus == 0) {
     const std::array<int, 4> c0 = {points[0], points[1], points[2], points[3]};
     const std::array<int, 4> c1 = {points[0], points[3], points[2], points[1]};
     if (r.patches[0].corners != c0 || r.patches[1].corners != c1) err << "genus-0 corner convention; ";

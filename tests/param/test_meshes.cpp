@@ -1,8 +1,13 @@
 #include "tests/param/test_meshes.h"
 
+#include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
 
+#include <gtest/gtest.h>
+
+#include <array>
 #include <cmath>
+#include <set>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -159,6 +164,54 @@ std::string temp_dir(const std::string& tag) {
                    ("geomip-" + tag + "-" + std::to_string(rd()) + std::to_string(rd()));
   std::filesystem::create_directories(dir);
   return dir.string();
+}
+
+// Two tori joined by a tube: genus 2. The tube's winding and matching are searched so that the result is a
+// consistently oriented closed manifold.
+TriMesh double_torus() {
+  const int n = 16, mm = 8;
+  const TriMesh a = test::torus(n, mm);
+  TriMesh b = test::torus(n, mm);
+  for (auto& p : b.positions) p.x() += 3.0;
+  auto id = [&](int i, int j) { return ((i + n) % n) * mm + (j + mm) % mm; };
+  // Remove the quad (i=0, j=0) of A (facing +x) and (i=n/2, j=0) of B (facing -x).
+  const std::array<int, 4> ha = {id(0, 0), id(1, 0), id(1, 1), id(0, 1)};
+  const std::array<int, 4> hb = {id(n / 2, 0), id(n / 2 + 1, 0), id(n / 2 + 1, 1), id(n / 2, 1)};
+  auto without = [&](const TriMesh& t, int i) {
+    TriMesh r = t;
+    r.triangles.erase(r.triangles.begin() + 2 * (i * mm));  // the two triangles of quad (i, 0)
+    r.triangles.erase(r.triangles.begin() + 2 * (i * mm));
+    return r;
+  };
+  const TriMesh base = test::join(without(a, 0), without(b, n / 2));
+  const int off = static_cast<int>(a.positions.size());
+  for (int shift = 0; shift < 4; ++shift) {
+    for (int dir = -1; dir <= 1; dir += 2) {
+      for (int flip = 0; flip < 2; ++flip) {
+        TriMesh m = base;
+        for (int k = 0; k < 4; ++k) {
+          const int a0 = ha[k], a1 = ha[(k + 1) % 4];
+          const int b0 = hb[(shift + dir * k + 8) % 4] + off, b1 = hb[(shift + dir * (k + 1) + 8) % 4] + off;
+          std::array<int, 3> t1 = {a1, a0, b0}, t2 = {a1, b0, b1};
+          if (flip) {
+            std::swap(t1[1], t1[2]);
+            std::swap(t2[1], t2[2]);
+          }
+          m.triangles.push_back(t1);
+          m.triangles.push_back(t2);
+        }
+        const TopologyReport r = analyze_topology(m);
+        std::set<std::pair<int, int>> directed;
+        bool consistent = true;
+        for (const auto& t : m.triangles) {
+          for (int k = 0; k < 3; ++k) consistent &= directed.insert({t[k], t[(k + 1) % 3]}).second;
+        }
+        if (consistent && r.manifold && r.boundary_edges == 0 && r.genus == 2) return m;
+      }
+    }
+  }
+  ADD_FAILURE() << "could not build a double torus";
+  return base;
 }
 
 ParameterizationInput automatic_input(const TriMesh& mesh, const std::string& name) {

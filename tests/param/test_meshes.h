@@ -1,8 +1,8 @@
 // Small synthetic meshes for property tests, and access to ../shared/meshes.
 #pragma once
 
-#include "param/consistent_parameterization.h"
 #include "mesh/mesh.h"
+#include "param/consistent_parameterization.h"
 
 #include <string>
 
@@ -22,8 +22,11 @@ TriMesh grid(int n);
 TriMesh subdivide(const TriMesh& mesh, int levels);
 /// Two tetrahedra sharing one vertex (a "pinch"): 7 referenced vertices, 8 faces, vertex 4 unreferenced.
 TriMesh pinched_tetrahedra();
-/// Unit sphere around the origin: a cube subdivided `levels` times (1-to-4) and projected, 12·4^levels triangles.
+/// Unit sphere around the origin: a cube subdivided `levels` times (1-to-4) and projected, 12·4^levels
+/// triangles.
 TriMesh sphere(int levels);
+/// Two tori (test::torus(16, 8)) joined by a tube: a closed, consistently oriented genus-2 mesh.
+TriMesh double_torus();
 /// Index of the vertex nearest to `p` (brute force).
 int nearest_vertex(const TriMesh& mesh, const Eigen::Vector3d& p);
 /// Concatenation of two meshes (indices of `b` shifted).
@@ -46,6 +49,6 @@ ParameterizationInput automatic_input(const TriMesh& mesh, const std::string& na
 }  // namespace geomip::test
 
 /// Skips the current test when ../shared/meshes is not beside the checkout.
-#define GEOMIP_REQUIRE_SHARED_MESH(var, name)                                  \
-  const std::string var = ::geomip::test::shared_mesh(name);                  \
+#define GEOMIP_REQUIRE_SHARED_MESH(var, name)                \
+  const std::string var = ::geomip::test::shared_mesh(name); \
   if (var.empty()) GTEST_SKIP() << "../shared/meshes/" << name << " not found"

@@ -432,6 +432,35 @@ TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
   EXPECT_TRUE(fs::exists(out + "/b.normals.exr"));
 }
 
+// A user layout in CORR.json: the cube's 6 faces over test::sphere()'s corners 0..7 (kept by write_mesh), one
+// face list for both models; a bad layout exits 2 with one line and writes nothing.
+TEST_F(CliGimage, CorrespondenceLayoutGivesSixPatchesAndOneFaceList) {
+  sphere_pair();
+  const std::string quads = "[[0,3,2,1],[4,5,6,7],[0,1,5,4],[1,2,6,5],[2,3,7,6],[3,0,4,7]]";
+  const std::string models = "\"models\": [{\"mesh\": \"a.obj\", \"partition_points\": [0,1,2,3,4,5,6,7]}, "
+                             "{\"mesh\": \"b.obj\", \"partition_points\": [0,1,2,3,4,5,6,7]}]";
+  const std::string corr = file("cube.json", "{\"layout\": {\"quads\": " + quads + "}, " + models + "}");
+  const std::string out = dir_ + "/out";
+  const Outcome r = geomip("remesh --quiet --points '" + corr + "' --level 3 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const TriMesh a = read_mesh(out + "/a.M3.obj");
+  const TriMesh b = read_mesh(out + "/b.M3.obj");
+  EXPECT_EQ(a.triangles.size(), 6u * 2 * 64);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(analyze_topology(a).genus, 0);
+  const std::string bad = dir_ + "/bad";
+  for (const std::string& layout : {std::string("[[0,3,2,1],[4,5,6,7]]"),  // not closed
+                                    std::string("[[0,0,2,1],[4,5,6,7],[0,1,5,4],[1,2,6,5],[2,3,7,6],[3,0,4,7]]"),
+                                    std::string("[[0,3,2]]")}) {
+    const std::string c = file("bad.json", "{\"layout\": {\"quads\": " + layout + "}, " + models + "}");
+    const Outcome e = geomip("remesh --points '" + c + "' --level 2 -o '" + bad + "'");
+    EXPECT_FALSE(e.crashed) << layout;
+    EXPECT_EQ(e.exit_code, 2) << layout << "\n" << e.err;
+    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << layout << "\n" << e.err;
+  }
+  EXPECT_FALSE(fs::exists(bad));
+}
+
 TEST_F(CliGimage, BadInputsExitTwo) {
   const std::string out = dir_ + "/out";
   for (const std::string& args : {"gimage '" + spot_ + "' --level 11 -o '" + out + "'",
@@ -653,6 +682,46 @@ TEST_F(CliPack, NormalMeshRefusedForSeveralMeshes) {
   EXPECT_NE(r.err.find("one mesh"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(pack));
   expect_bad_input("convert -q '" + spot_ + "' --normal-mesh 9 --level 8 -o '" + pack + "'", "--normal-mesh");
+}
+
+// --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch
+// count): watertight, genus 0, K·2·4^L faces, V = K·4^L + 2; bad K exit 2 with one line and nothing written.
+TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
+  const std::string out = dir_ + "/k6";
+  Outcome r = geomip("remesh --quiet '" + spot_ + "' --patches 6 --level 3 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const TriMesh m = read_mesh(out + "/spot.M3.obj");
+  EXPECT_EQ(m.triangles.size(), 6u * 2 * 64);
+  EXPECT_EQ(m.positions.size(), 6u * 64 + 2);
+  TopologyReport t = analyze_topology(m);
+  EXPECT_EQ(t.boundary_loops, 0u);
+  EXPECT_TRUE(t.manifold);
+  EXPECT_EQ(t.genus, 0);
+  r = geomip("param --quiet '" + spot_ + "' --patches 6 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto param = nlohmann::json::parse(slurp(out + "/spot.param.json"));
+  EXPECT_EQ(param["patches"].size(), 6u);
+  EXPECT_EQ(param["layout_quads"].size(), 6u);
+  EXPECT_EQ(param["flipped_triangles"], 0);
+  const std::string pack = dir_ + "/spot6.gip";
+  r = geomip("convert --quiet '" + spot_ + "' --patches 6 --level 4 --no-normals -o '" + pack + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = geomip("decode --json '" + pack + "' -o '" + dir_ + "/spot6.obj'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["models"][0]["faces"], 6 * 2 * 16 * 16);
+  t = analyze_topology(read_mesh(dir_ + "/spot6.obj"));
+  EXPECT_EQ(t.boundary_loops, 0u);
+  EXPECT_EQ(t.genus, 0);
+  const std::string bad = dir_ + "/bad";
+  for (const std::string& args : {"remesh '" + spot_ + "' --patches 1 --level 2 -o '" + bad + "'",
+                                  "remesh '" + spot_ + "' --patches 4000 --level 2 -o '" + bad + "'",
+                                  "convert '" + spot_ + "' --patches 4000 -o '" + bad + "/x.gip'"}) {
+    r = geomip(args);
+    EXPECT_FALSE(r.crashed) << args;
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(bad));
 }
 
 // `geomip info PACK`: the chunk table as a reader receives it (cumulative sizes end at the file's size, in

@@ -1,0 +1,481 @@
+#include "param/quad_layout.h"
+
+#include "mesh/errors.h"
+#include "mesh/mesh_topology.h"
+#include "mesh/predicates.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+#include <vector>
+
+namespace geomip {
+namespace {
+
+const char* const kFn = "choose_quad_layout: ";
+
+// Half-edge collapses on a closed manifold triangle mesh, shortest edge first, vertices never moved.
+class Simplifier {
+ public:
+  // `centroid_rule`: of two merged vertices the one nearer their area's centroid stays; else the one that
+  // stands for more area.
+  Simplifier(const TriMesh& mesh, bool centroid_rule) : m_(mesh), centroid_rule_(centroid_rule) {
+    vf_.resize(m_.positions.size());
+    for (int f = 0; f < static_cast<int>(m_.triangles.size()); ++f) {
+      for (int v : m_.triangles[f]) vf_[v].push_back(f);
+    }
+    face_alive_.assign(m_.triangles.size(), 1);
+    stamp_.assign(m_.positions.size(), 0);
+    carried_.assign(m_.positions.size(), 0.0);
+    moment_.assign(m_.positions.size(), Eigen::Vector3d::Zero());
+    for (const auto& t : m_.triangles) {
+      for (int v : t) {
+        carried_[v] += normal(t).norm() / 6.0;
+        moment_[v] += normal(t).norm() / 6.0 * m_.positions[v];
+      }
+    }
+    for (int v = 0; v < static_cast<int>(vf_.size()); ++v) {
+      if (!vf_[v].empty()) ++alive_;
+    }
+  }
+
+  // Collapses until `target` vertices remain; false when no legal collapse is left before that. When only
+  // collapses that turn a normal by 90° or more are left, they are allowed (the coarse mesh only guides the
+  // layout; the link condition keeps it a closed manifold).
+  bool simplify_to(std::size_t target) {
+    for (int v = 0; v < static_cast<int>(vf_.size()); ++v) push_edges(v);
+    while (alive_ > target) {
+      if (heap_.empty() && check_normals_) {
+        check_normals_ = false;
+        for (int v = 0; v < static_cast<int>(vf_.size()); ++v) push_edges(v);
+      }
+      if (heap_.empty()) return false;
+      const Entry e = heap_.top();
+      heap_.pop();
+      if (e.stamp_u != stamp_[e.u] || e.stamp_v != stamp_[e.v] || vf_[e.u].empty() || vf_[e.v].empty())
+        continue;
+      if (!legal(e.u, e.v)) continue;  // re-pushed when a neighbour changes
+      collapse(e.u, e.v);
+    }
+    return true;
+  }
+
+  // The coarse mesh: its triangles (original vertex ids), counter-clockwise.
+  std::vector<std::array<int, 3>> triangles() const {
+    std::vector<std::array<int, 3>> t;
+    for (std::size_t f = 0; f < m_.triangles.size(); ++f) {
+      if (face_alive_[f]) t.push_back(m_.triangles[f]);
+    }
+    return t;
+  }
+
+ private:
+  struct Entry {
+    double cost;
+    int u, v;  // collapse u into v
+    std::uint32_t stamp_u, stamp_v;
+    bool operator<(const Entry& o) const {  // max-heap: invert for the cheapest, ties by ids
+      return std::tie(cost, u, v) > std::tie(o.cost, o.u, o.v);
+    }
+  };
+
+  std::vector<int> neighbours(int u) const {
+    std::vector<int> n;
+    for (int f : vf_[u]) {
+      for (int w : m_.triangles[f]) {
+        if (w != u) n.push_back(w);
+      }
+    }
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+    return n;
+  }
+
+  Eigen::Vector3d normal(const std::array<int, 3>& t) const {
+    const auto& p = m_.positions;
+    return (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]);
+  }
+
+  // The link condition (u and v share exactly the two wing vertices) and no normal turned by ≥ 90°.
+  bool legal(int u, int v) const {
+    const std::vector<int> nu = neighbours(u), nv = neighbours(v);
+    if (!std::binary_search(nu.begin(), nu.end(), v)) return false;
+    std::vector<int> common;
+    std::set_intersection(nu.begin(), nu.end(), nv.begin(), nv.end(), std::back_inserter(common));
+    if (common.size() != 2) return false;
+    for (int f : vf_[u]) {
+      if (!check_normals_) break;
+      std::array<int, 3> t = m_.triangles[f];
+      if (std::find(t.begin(), t.end(), v) != t.end()) continue;
+      const Eigen::Vector3d before = normal(t);
+      for (int& w : t) {
+        if (w == u) w = v;
+      }
+      const Eigen::Vector3d after = normal(t);
+      if (!(after.dot(before) > 0.0)) return false;
+    }
+    return true;
+  }
+
+  void collapse(int u, int v) {
+    for (int f : vf_[u]) {
+      auto& t = m_.triangles[f];
+      if (std::find(t.begin(), t.end(), v) != t.end()) {
+        face_alive_[f] = 0;
+        for (int w : t) {
+          if (w == u) continue;
+          auto& list = vf_[w];
+          list.erase(std::remove(list.begin(), list.end(), f), list.end());
+        }
+      } else {
+        for (int& w : t) {
+          if (w == u) w = v;
+        }
+        vf_[v].push_back(f);
+      }
+    }
+    vf_[u].clear();
+    carried_[v] += carried_[u];
+    moment_[v] += moment_[u];
+    --alive_;
+    const std::vector<int> around = neighbours(v);
+    ++stamp_[v];
+    for (int w : around) ++stamp_[w];
+    push_edges(v);
+    for (int w : around) push_edges(w);
+  }
+
+  // Cost of merging u into v: the surface area the two vertices then stand for (each vertex starts with a
+  // third of its star's area and inherits the area of the vertices merged into it). Merging the smallest
+  // pair first is greedy clustering into equal areas: every coarse vertex stands for a similar share of
+  // the surface, so the coarse triangles, hence the patches, get similar areas. The vertex nearer the
+  // merged area's centroid stays, so coarse vertices sit near the middle of what they stand for.
+  void push_edges(int u) {
+    for (int v : neighbours(u)) {
+      const double merged = carried_[u] + carried_[v];
+      const Eigen::Vector3d centre = (moment_[u] + moment_[v]) / merged;
+      const double du = (m_.positions[u] - centre).squaredNorm(),
+                   dv = (m_.positions[v] - centre).squaredNorm();
+      if (centroid_rule_) {
+        if (dv > du || (dv == du && v > u)) continue;  // the vertex nearer the merged area's centroid stays
+      } else if (carried_[u] > carried_[v] || (carried_[u] == carried_[v] && v > u)) {
+        continue;  // the vertex that stands for more area stays
+      }
+      heap_.push({merged, u, v, stamp_[u], stamp_[v]});
+    }
+  }
+
+  TriMesh m_;
+  std::vector<std::vector<int>> vf_;
+  std::vector<char> face_alive_;
+  std::vector<std::uint32_t> stamp_;
+  std::vector<double> carried_;          // surface area each vertex stands for
+  std::vector<Eigen::Vector3d> moment_;  // Σ area · position over that area
+  std::size_t alive_ = 0;
+  bool check_normals_ = true;
+  bool centroid_rule_ = true;
+  std::priority_queue<Entry> heap_;
+};
+
+// Delaunay edge flips on the coarse mesh (in 3D: an edge is flipped when the two angles opposite it sum to
+// more than π and the new edge does not exist yet), so that its edges, later traced as shortest paths, join
+// near corners and its triangles are not slivers. At most 50 flips per triangle (3D angles need not
+// converge as in the plane).
+void delaunay_flips(const std::vector<Eigen::Vector3d>& p, std::vector<std::array<int, 3>>& t) {
+  auto angle = [&](int at, int a, int b) {
+    const Eigen::Vector3d u = p[a] - p[at], v = p[b] - p[at];
+    return std::atan2(u.cross(v).norm(), u.dot(v));
+  };
+  const std::size_t budget = 50 * t.size() + 100;
+  for (std::size_t flips = 0; flips < budget;) {
+    std::unordered_map<std::uint64_t, int> by_edge;
+    for (int f = 0; f < static_cast<int>(t.size()); ++f) {
+      for (int j = 0; j < 3; ++j) by_edge[directed_edge_key(t[f][j], t[f][(j + 1) % 3])] = f;
+    }
+    bool flipped = false;
+    for (int f = 0; f < static_cast<int>(t.size()) && !flipped; ++f) {
+      for (int j = 0; j < 3 && !flipped; ++j) {
+        const int x = t[f][j], y = t[f][(j + 1) % 3], z = t[f][(j + 2) % 3];
+        const auto it = by_edge.find(directed_edge_key(y, x));
+        if (it == by_edge.end()) continue;
+        const int g = it->second;
+        int w = -1;
+        for (int v : t[g]) {
+          if (v != x && v != y) w = v;
+        }
+        if (w < 0 || w == z || by_edge.count(directed_edge_key(z, w))) continue;
+        if (angle(z, x, y) + angle(w, y, x) <= M_PI + 1e-9) continue;
+        t[f] = {x, w, z};
+        t[g] = {w, y, z};
+        flipped = true;
+        ++flips;
+      }
+    }
+    if (!flipped) break;
+  }
+}
+
+// Maximum matching in a general graph: Edmonds' blossom algorithm, completing `match` (−1 = unmatched) by
+// augmenting paths. O(V³).
+class BlossomMatcher {
+ public:
+  BlossomMatcher(const std::vector<std::vector<int>>& graph, std::vector<int>& match)
+      : g_(graph), match_(match), n_(static_cast<int>(graph.size())) {}
+
+  void run() {
+    for (int root = 0; root < n_; ++root) {
+      if (match_[root] >= 0) continue;
+      int v = find_path(root);
+      while (v >= 0) {  // augment along parent links
+        const int pv = parent_[v], ppv = match_[pv];
+        match_[v] = pv;
+        match_[pv] = v;
+        v = ppv;
+      }
+    }
+  }
+
+ private:
+  int lca(int a, int b) {
+    std::vector<char> seen(n_, 0);
+    for (;;) {
+      a = base_[a];
+      seen[a] = 1;
+      if (match_[a] < 0) break;
+      a = parent_[match_[a]];
+    }
+    for (;;) {
+      b = base_[b];
+      if (seen[b]) return b;
+      b = parent_[match_[b]];
+    }
+  }
+
+  void mark_path(int v, int b, int child) {
+    while (base_[v] != b) {
+      blossom_[base_[v]] = blossom_[base_[match_[v]]] = 1;
+      parent_[v] = child;
+      child = match_[v];
+      v = parent_[match_[v]];
+    }
+  }
+
+  int find_path(int root) {
+    used_.assign(n_, 0);
+    parent_.assign(n_, -1);
+    base_.resize(n_);
+    for (int i = 0; i < n_; ++i) base_[i] = i;
+    used_[root] = 1;
+    std::queue<int> q;
+    q.push(root);
+    while (!q.empty()) {
+      const int v = q.front();
+      q.pop();
+      for (int to : g_[v]) {
+        if (base_[v] == base_[to] || match_[v] == to) continue;
+        if (to == root || (match_[to] >= 0 && parent_[match_[to]] >= 0)) {
+          const int b = lca(v, to);
+          blossom_.assign(n_, 0);
+          mark_path(v, b, to);
+          mark_path(to, b, v);
+          for (int i = 0; i < n_; ++i) {
+            if (blossom_[base_[i]]) {
+              base_[i] = b;
+              if (!used_[i]) {
+                used_[i] = 1;
+                q.push(i);
+              }
+            }
+          }
+        } else if (parent_[to] < 0) {
+          parent_[to] = v;
+          if (match_[to] < 0) return to;
+          used_[match_[to]] = 1;
+          q.push(match_[to]);
+        }
+      }
+    }
+    return -1;
+  }
+
+  const std::vector<std::vector<int>>& g_;
+  std::vector<int>& match_;
+  int n_;
+  std::vector<int> parent_, base_;
+  std::vector<char> used_, blossom_;
+};
+
+// The quad of triangles a and b, which share an edge: the shared edge x→y of a, a's third vertex z, b's w.
+std::array<int, 4> quad_of(const std::array<int, 3>& a, const std::array<int, 3>& b) {
+  for (int k = 0; k < 3; ++k) {
+    const int x = a[k], y = a[(k + 1) % 3], z = a[(k + 2) % 3];
+    for (int j = 0; j < 3; ++j) {
+      if (b[j] == y && b[(j + 1) % 3] == x) return {x, b[(j + 2) % 3], y, z};
+    }
+  }
+  return {-1, -1, -1, -1};
+}
+
+// Renumbers the quads so that quads at a corner of only two quads come first in even slots, as
+// check_quad_layout() asks (the remesh's diagonal rule); best effort, the check decides.
+void even_quads_at_two_quad_corners(QuadLayout& layout) {
+  std::vector<int> count(layout.corners.size(), 0);
+  for (const auto& q : layout.quads) {
+    for (int c : q) ++count[c];
+  }
+  std::vector<std::array<int, 4>> marked, rest;
+  for (const auto& q : layout.quads) {
+    const bool at_two = std::any_of(q.begin(), q.end(), [&](int c) { return count[c] == 2; });
+    (at_two ? marked : rest).push_back(q);
+  }
+  if (marked.empty()) return;
+  std::vector<std::array<int, 4>> order(layout.quads.size());
+  std::vector<char> used(order.size(), 0);
+  std::size_t slot = 0;
+  for (const auto& q : marked) {
+    if (slot >= order.size()) slot = 1;  // more marked quads than even slots: odd slots too
+    order[slot] = q;
+    used[slot] = 1;
+    slot += 2;
+  }
+  std::size_t next = 0;
+  for (const auto& q : rest) {
+    while (used[next]) ++next;
+    order[next] = q;
+    used[next] = 1;
+  }
+  layout.quads = std::move(order);
+}
+
+// Pairs `coarse` (closed, 2k triangles over mesh vertices) into k quads by each greedy score completed to a
+// perfect matching; every pairing that partitions `mesh` is measured and kept in `best` if more balanced.
+void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int, 3>>& coarse, long long k,
+                           QuadLayoutChoice& best, std::string& last_error) {
+  const int nf = static_cast<int>(coarse.size());
+  // Dual graph: triangles sharing an edge.
+  std::unordered_map<std::uint64_t, int> by_edge;
+  for (int f = 0; f < nf; ++f) {
+    for (int j = 0; j < 3; ++j) by_edge[directed_edge_key(coarse[f][j], coarse[f][(j + 1) % 3])] = f;
+  }
+  std::vector<std::vector<int>> dual(nf);
+  for (int f = 0; f < nf; ++f) {
+    for (int j = 0; j < 3; ++j) {
+      const auto it = by_edge.find(directed_edge_key(coarse[f][(j + 1) % 3], coarse[f][j]));
+      if (it != by_edge.end()) dual[f].push_back(it->second);
+    }
+  }
+  const auto& p = mesh.positions;
+  auto normal = [&](const std::array<int, 3>& t) {
+    return Eigen::Vector3d((p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]));
+  };
+  double total_area = 0.0;
+  for (const auto& t : coarse) total_area += 0.5 * normal(t).norm();
+  const double mean_quad = total_area / static_cast<double>(k);
+  // Scores of pairing f with g (lower first): flatness, area near the mean, longest shared edge.
+  const std::array<std::function<double(int, int)>, 3> scores = {
+      [&](int f, int g) { return -normal(coarse[f]).normalized().dot(normal(coarse[g]).normalized()); },
+      [&](int f, int g) {
+        return std::abs(0.5 * (normal(coarse[f]).norm() + normal(coarse[g]).norm()) - mean_quad);
+      },
+      [&](int f, int g) {
+        const auto q = quad_of(coarse[f], coarse[g]);
+        return -(p[q[0]] - p[q[2]]).norm();
+      }};
+  for (const auto& score : scores) {
+    std::vector<std::tuple<double, int, int>> pairs;
+    for (int f = 0; f < nf; ++f) {
+      for (int g : dual[f]) {
+        if (f < g) pairs.emplace_back(score(f, g), f, g);
+      }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    std::vector<int> match(nf, -1);
+    for (const auto& [s, f, g] : pairs) {
+      if (match[f] < 0 && match[g] < 0) {
+        match[f] = g;
+        match[g] = f;
+      }
+    }
+    BlossomMatcher(dual, match).run();
+    if (std::count(match.begin(), match.end(), -1) > 0) {
+      last_error = "the coarse mesh's triangles cannot all be paired";
+      continue;
+    }
+    QuadLayout layout;
+    std::unordered_map<int, int> corner_of;
+    for (int f = 0; f < nf; ++f) {
+      if (match[f] < f) continue;
+      std::array<int, 4> q = quad_of(coarse[f], coarse[match[f]]);
+      for (int& v : q) {
+        const auto [it, fresh] = corner_of.emplace(v, static_cast<int>(layout.corners.size()));
+        if (fresh) layout.corners.push_back(v);
+        v = it->second;
+      }
+      layout.quads.push_back(q);
+    }
+    even_quads_at_two_quad_corners(layout);
+    try {
+      const double balance = partition_stats(partition_mesh_layout(mesh, layout)).area_balance;
+      ++best.candidates;
+      if (balance > best.area_balance) {
+        best.layout = std::move(layout);
+        best.area_balance = balance;
+      }
+    } catch (const InvalidInput& e) {
+      last_error = e.what();
+    }
+  }
+}
+
+}  // namespace
+
+QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions& options) {
+  const TopologyReport topo = analyze_topology(mesh);
+  if (!topo.manifold || topo.boundary_edges > 0 || topo.components != 1 || !topo.genus ||
+      topo.degenerate_faces > 0) {
+    throw InvalidInput(std::string(kFn) +
+                       "the mesh must be one closed, manifold, oriented component without degenerate "
+                       "triangles; run repair_mesh first");
+  }
+  const int genus = *topo.genus;
+  const long long k = options.patches;
+  const long long target = k + 2 - 2LL * genus;
+  const long long vertices = static_cast<long long>(mesh.positions.size() - topo.unreferenced_vertices);
+  if (k < 2)
+    throw InvalidInput(std::string(kFn) + "a layout needs at least 2 patches, got " + std::to_string(k));
+  if (target < 4) {
+    throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches are too few for genus " +
+                       std::to_string(genus) + " (K + 2 - 2g = " + std::to_string(target) +
+                       " coarse vertices; at least 4 are needed)");
+  }
+  if (target > vertices) {
+    throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches need " + std::to_string(target) +
+                       " corners but the mesh has " + std::to_string(vertices) + " vertices");
+  }
+  QuadLayoutChoice best;
+  best.area_balance = -1.0;
+  std::string last_error;
+  for (const bool centroid_rule : {true, false}) {
+    Simplifier simplifier(mesh, centroid_rule);
+    if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
+      last_error = "cannot simplify the mesh to " + std::to_string(target) + " vertices without folding it";
+      continue;
+    }
+    std::vector<std::array<int, 3>> coarse = simplifier.triangles();
+    delaunay_flips(mesh.positions, coarse);
+    pair_coarse_triangles(mesh, coarse, k, best, last_error);
+  }
+  if (best.candidates == 0) {
+    throw InvalidInput(std::string(kFn) + "no layout of " + std::to_string(k) +
+                       " patches partitions the mesh (" + last_error + "); try another number of patches");
+  }
+  return best;
+}
+
+}  // namespace geomip

@@ -1,0 +1,48 @@
+// Automatic quad layouts for one model (issue 15, item 3): a coarse triangle mesh made of the mesh's own
+// vertices, its triangles paired into quads. The result feeds partition_mesh_layout() (one patch per quad,
+// each patch one (2^n+1)² geometry image). Like choose_partition_points(), for one model on its own: layouts
+// of different models chosen this way do not correspond.
+#pragma once
+
+#include "mesh/mesh.h"
+#include "param/mesh_partition.h"
+
+#include <cstddef>
+
+namespace geomip {
+
+struct QuadLayoutOptions {
+  /// K, the number of quads (patches), ≥ 2. The coarse mesh has 2K triangles and K + 2 − 2·genus vertices.
+  int patches = 8;
+};
+
+/// What choose_quad_layout() measured on the layout it returns.
+struct QuadLayoutChoice {
+  QuadLayout layout;
+  double area_balance = 0.0;   ///< smallest / largest patch area of its partition (PartitionStats)
+  std::size_t candidates = 0;  ///< pairings tried that partition the mesh
+};
+
+/// Chooses a K-quad layout for `closed_manifold` (same preconditions as partition_mesh_layout()):
+/// 1. simplify the mesh by half-edge collapses to K + 2 − 2g vertices (g the genus), the pair of vertices
+///    that stands for the least surface area first (each vertex starts with a third of its star's area and
+///    inherits the area of the vertices merged into it): greedy clustering into equal areas, so the coarse
+///    triangles, hence the patches, get similar areas (every patch gets the same grid). A collapse keeps the
+///    surviving vertex where it is (so the coarse vertices are mesh vertices), respects the link condition
+///    (the coarse mesh stays a closed manifold of the same genus) and, while it can, never turns a
+///    triangle's normal by 90° or more;
+/// 2. pair the 2K coarse triangles into K quads: a perfect matching of the dual graph, which is cubic and
+///    bridgeless on a closed triangle mesh, so one exists (Petersen 1891). A greedy matching by one of three
+///    scores (flattest pairs, pairs closest to the mean quad area, pairs across the longest edge) is
+///    completed by augmenting paths with blossom contraction (Edmonds 1965);
+/// 3. every pairing that partition_mesh_layout() accepts is measured and the one with the best area balance
+///    (PartitionStats::area_balance) is returned.
+/// Cost: O(F log F) for the simplification plus one partition per pairing.
+///
+/// \throw InvalidInput with "choose_quad_layout:" when the mesh is not one closed, manifold, oriented
+///   component, K < 2, K + 2 − 2g < 4 (K too small for the genus), K + 2 − 2g exceeds the mesh's vertices
+///   (K larger than the mesh can hold), the simplification gets stuck above K + 2 − 2g vertices, or no
+///   pairing partitions the mesh.
+QuadLayoutChoice choose_quad_layout(const TriMesh& closed_manifold, const QuadLayoutOptions& options = {});
+
+}  // namespace geomip

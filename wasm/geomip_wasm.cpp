@@ -1,8 +1,9 @@
 // The C API that the WASM build exports (scripts/build-wasm; used by web/geomip.js, which is the API for
 // JavaScript). A decoder object owns the bytes received so far; decoding reads them through codec/'s public
-// pack API (codec::decode_pack, codec::read_pack_info) and morph/'s decode_scene, exactly as the native tools
+// pack API (codec::PackDecoder, codec::read_pack_info) and morph/'s SceneDecoder, exactly as the native tools
 // and viewer do, so the grids are bit-identical to theirs (tests/web/wasm_decoder_test.mjs checks every byte
-// prefix). Every pointer returned points into the decoder's own storage and stays valid until the next call
+// prefix). Decoding is incremental: each decoder keeps codec state between calls, so every received byte is
+// decoded once (a new state is started only when the decode settings change). Every pointer returned points into the decoder's own storage and stays valid until the next call
 // that decodes or appends on the same decoder (the WASM heap may also move when it grows: JavaScript copies
 // out at once). Nothing here throws on bytes; bad bytes give a status, as in codec/status.h.
 #include <emscripten/emscripten.h>
@@ -11,6 +12,7 @@
 #include <cstring>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -27,6 +29,11 @@ struct Decoder {
   std::vector<std::uint8_t> bytes;
   geomip::codec::PackInfo info;
   Status info_status = Status::kTruncated;
+  // Incremental state of gip_decode (grids) and gip_decode_scene, with the settings each was made for.
+  std::unique_ptr<geomip::codec::PackDecoder> grids;
+  bool grids_normals = false;
+  std::unique_ptr<geomip::morph::SceneDecoder> scenes;
+  int scenes_bands = 0, scenes_align = -1;
   geomip::codec::PackDecodeResult result;
   std::vector<geomip::morph::SceneModel> scene;
   Status scene_status = Status::kTruncated;
@@ -135,10 +142,15 @@ EMSCRIPTEN_KEEPALIVE double gip_chunk(const Decoder* d, int c, int f) {
 /// Decodes every byte received so far (codec::decode_pack, one thread). Returns the codec::Status.
 EMSCRIPTEN_KEEPALIVE int gip_decode(Decoder* d, int normals) {
   if (d == nullptr) return static_cast<int>(Status::kInvalidArgument);
-  geomip::codec::PackDecodeOptions options;
-  options.normals = normals != 0;
-  options.max_threads = 1;
-  d->result = geomip::codec::decode_pack(d->bytes, options);
+  if (!d->grids || d->grids_normals != (normals != 0)) {
+    geomip::codec::PackDecodeOptions options;
+    options.normals = normals != 0;
+    options.max_threads = 1;
+    d->grids = std::make_unique<geomip::codec::PackDecoder>(options);
+    d->grids_normals = normals != 0;
+  }
+  d->grids->update(d->bytes);
+  d->result = d->grids->result();
   return static_cast<int>(d->result.status);
 }
 EMSCRIPTEN_KEEPALIVE double gip_bytes_used(const Decoder* d) {
@@ -202,14 +214,19 @@ EMSCRIPTEN_KEEPALIVE const std::uint8_t* gip_hole_mask(const Decoder* d, int m, 
 /// `align`. Returns the codec::Status (no models yet: kTruncated).
 EMSCRIPTEN_KEEPALIVE int gip_decode_scene(Decoder* d, int bands, int align) {
   if (d == nullptr || bands < 1 || bands > 8) return static_cast<int>(Status::kInvalidArgument);
-  geomip::morph::DecodeSettings settings;
-  settings.bands = bands;
-  settings.align = align != 0;
+  if (!d->scenes || d->scenes_bands != bands || d->scenes_align != (align != 0)) {
+    geomip::morph::DecodeSettings settings;
+    settings.bands = bands;
+    settings.align = align != 0;
+    d->scenes = std::make_unique<geomip::morph::SceneDecoder>(settings);
+    d->scenes_bands = bands;
+    d->scenes_align = align != 0;
+  }
   d->scene.clear();
   d->scene_status = Status::kTruncated;
   d->scene_bytes_used = 0;
   try {
-    d->scene = geomip::morph::decode_scene(d->bytes, settings, d->scene_status, d->scene_bytes_used);
+    d->scene = d->scenes->update(d->bytes, d->scene_status, d->scene_bytes_used);
   } catch (const std::exception&) {  // models of different layouts (make_scene_model's preconditions)
     d->scene.clear();
     d->scene_status = Status::kCorrupt;

@@ -13,8 +13,8 @@
 // model units), `normals` (same layout at the normal-map level, or []), `holeMask` (one Uint8Array per patch,
 // 4^L bytes, 1 = quad left out; [] = no holes) — bit-identical to the native codec::decode_pack
 // (tests/web/wasm_decoder_test.mjs checks every byte prefix). Arrays are copies: they stay valid after
-// further push()/decode() calls. Each decode() decodes all bytes received so far (the codec's one-shot
-// decoder); status is 'ok' (every chunk), 'truncated' (more bytes to come: models hold what the prefix
+// further push()/decode() calls. Each decode() decodes the bytes received since the last one (the codec's
+// incremental PackDecoder) and rebuilds the grids; status is 'ok' (every chunk), 'truncated' (more bytes to come: models hold what the prefix
 // gives, none before the manifest), 'corrupt' (CRC or impossible bytes: models hold the last good level) or
 // 'unsupported-version'.
 

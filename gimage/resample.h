@@ -11,8 +11,9 @@
 // Seams: a sample on a side shared by two patches (SideLink) is computed once, from the patch of the link
 // whose (patch, side) is smaller, by walking that side's polyline in its one varying (u,v) coordinate, and
 // copied, reversed as the link says, into the other patch. Corners are the corner vertices' exact positions.
-// So shared samples are bit-identical in every image that holds them, whatever the layout (genus 0: 2
-// patches, the second mirrored; genus 1: 4 patches glued periodically).
+// So shared samples are bit-identical in every image that holds them, whatever the layout (genus 0 by
+// default: 2 patches, the second mirrored; genus 1: 4 patches glued periodically; a quad layout: any number
+// of patches, any genus).
 #pragma once
 
 #include "param/consistent_parameterization.h"

@@ -1,7 +1,9 @@
 // Uniform consistent remeshing (§4 of ../shared/seed/consistent-mesh-parameterizations.txt, "Uniform
 // remeshing"; Gu et al. 2002's geometry image triangulation): the level-K grid of every patch triangulated,
-// (2^K)² quads per patch (genus 0: 2·4^K quads), each split in two along a fixed diagonal rule, seam samples
-// welded by the patch layout (SideLinks), not by position.
+// (2^K)² quads per patch (the default genus-0 layout: 2·4^K quads; a quad layout of P patches: P·4^K), each
+// split in two along a fixed diagonal rule, seam samples welded by the patch layout (SideLinks), not by
+// position. Any layout works (param/mesh_partition.h QuadLayout, any genus); check_quad_layout() refuses the
+// layouts whose corners would get an edge of four triangles under the diagonal rule.
 //
 // The face list and the vertex numbering depend only on K and the layout (number of patches and their
 // adjacency): every model of a consistent set gets the identical face list.

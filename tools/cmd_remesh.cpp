@@ -1,4 +1,4 @@
-// geomip remesh MESH... [--points CORR.json] [--level K] [--adaptive EPS [--max-depth N]] -o DIR [--ply]:
+// geomip remesh MESH... [--points CORR.json] [--level K] [--adaptive EPS [--max-depth N]] -o DIR [--ply] [--glb]:
 // consistent parameterization (as `geomip param`), then the uniform level-K remesh of every model,
 // DIR/<stem>.M<K>.obj (and .ply) (gimage/uniform_remesh.h), and/or the adaptive remesh
 // DIR/<stem>.adaptive.obj (gimage/adaptive_remesh.h): watertight, consistently oriented, one face list for
@@ -8,10 +8,12 @@
 #include "gimage/uniform_remesh.h"
 #include "param/consistent_parameterization.h"
 #include "mesh/errors.h"
+#include "mesh/gltf_io.h"
 #include "mesh/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/model_inputs.h"
+#include "tools/pack_models.h"
 #include "tools/progress.h"
 
 #include <nlohmann/json.hpp>
@@ -32,6 +34,7 @@ struct RemeshArgs {
   int max_depth = 8;
   bool measure_samples = false;
   bool ply = false;
+  bool glb = false;
 };
 
 int run_remesh(const RemeshArgs& args) {
@@ -67,9 +70,9 @@ int run_remesh(const RemeshArgs& args) {
   for (std::size_t i = 0; i < result.size() && uniform; ++i) {
     t0 = std::chrono::steady_clock::now();
     ResampleOptions resample;
-    resample.normals = false;
-    const UniformRemeshResult remesh =
-        uniform_remesh(resample_geometry(result[i], args.level, resample), args.level);
+    resample.normals = args.glb;  // the GLB's normals come from the normal maps
+    const GeometryImages images = resample_geometry(result[i], args.level, resample);
+    const UniformRemeshResult remesh = uniform_remesh(images, args.level);
     const double remesh_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() +
@@ -80,6 +83,12 @@ int run_remesh(const RemeshArgs& args) {
       write_file_atomically(stem + ".ply",
                             [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kPly); });
     }
+    if (args.glb) {
+      const TexturedMesh textured = textured_mesh(images);
+      write_file_atomically(stem + ".glb", [&](std::ostream& out) {
+        write_gltf(textured.mesh, textured.attributes, out, {.binary = true});
+      });
+    }
     if (args.common.json) {
       nlohmann::json j{{"mesh", models.paths[i]},
                        {"obj", stem + ".obj"},
@@ -88,6 +97,7 @@ int run_remesh(const RemeshArgs& args) {
                        {"faces", remesh.mesh.triangles.size()},
                        {"remesh_seconds", remesh_seconds}};
       if (args.ply) j["ply"] = stem + ".ply";
+      if (args.glb) j["glb"] = stem + ".glb";
       summary.push_back(j);
     } else if (!args.common.quiet) {
       std::printf("remesh %s → %s.obj: %zu vertices, %zu faces (resampled and remeshed in %.3f s)\n",
@@ -174,6 +184,9 @@ CommandRunner add_remesh_command(CLI::App& app) {
                 "Adaptive: measure each quad's geometry image samples too, not only the mesh vertices in it "
                 "(stricter than the paper's eq. 4-5)");
   cmd->add_flag("--ply", args->ply, "Also write DIR/<stem>.M<K>.ply (binary)");
+  cmd->add_flag("--glb", args->glb,
+                "Also write DIR/<stem>.M<K>.glb: glTF with each patch's (u,v) as TEXCOORD_0 and the normal "
+                "maps' normals (seam vertices once per patch)");
   return [args] { return run_remesh(*args); };
 }
 

@@ -150,4 +150,13 @@ TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level) 
   return result;
 }
 
+TexturedMesh textured_mesh(const GeometryImages& images) {
+  const codec::PackModelInput input = pack_model_input("", images, nullptr, !images.normals.empty());
+  codec::DecodedModel model;
+  model.geometry = input.geometry;
+  model.normals = input.normals;
+  model.seams = input.seams;
+  return decoded_textured_mesh(model);
+}
+
 }  // namespace geomip::tools

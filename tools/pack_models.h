@@ -38,4 +38,8 @@ struct TexturedMesh {
 /// surface does not crack.
 TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level = -1);
 
+/// The same for geometry images that were not coded (`geomip remesh --glb`): decoded_textured_mesh() of the
+/// images as they are, at their own level; normals from their normal maps when they have them.
+TexturedMesh textured_mesh(const GeometryImages& images);
+
 }  // namespace geomip::tools

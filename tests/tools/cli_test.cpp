@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -397,11 +399,25 @@ TEST_F(CliGimage, GimageWritesOnePyramidPerPatch) {
   }
 }
 
-TEST_F(CliGimage, RemeshWritesWatertightObjAndPly) {
+// OBJ, PLY and GLB of the same remesh: the same watertight genus-0 surface (geomip's glTF reader merges the
+// GLB's per-patch seam vertices again); the GLB carries NORMAL and TEXCOORD_0 for every vertex.
+TEST_F(CliGimage, RemeshWritesWatertightObjPlyAndGlb) {
   const std::string out = dir_ + "/out";
-  const Outcome r = geomip("remesh --quiet '" + spot_ + "' --level 3 -o '" + out + "' --ply");
+  const Outcome r = geomip("remesh --quiet '" + spot_ + "' --level 3 -o '" + out + "' --ply --glb");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* ext : {".obj", ".ply"}) {
+  const std::string glb = slurp(out + "/spot.M3.glb");
+  ASSERT_GT(glb.size(), 20u);
+  std::uint32_t json_bytes = 0;
+  std::memcpy(&json_bytes, glb.data() + 12, 4);
+  ASSERT_LE(20u + json_bytes, glb.size());
+  const auto gltf = nlohmann::json::parse(glb.substr(20, json_bytes));
+  const auto& attributes = gltf["meshes"][0]["primitives"][0]["attributes"];
+  ASSERT_TRUE(attributes.contains("NORMAL") && attributes.contains("TEXCOORD_0")) << attributes.dump();
+  const auto count = [&](const char* name) { return gltf["accessors"][attributes[name].get<int>()]["count"]; };
+  EXPECT_EQ(count("POSITION"), 2 * 9 * 9);  // 2 patches of (2^3+1)² samples, seams not welded
+  EXPECT_EQ(count("NORMAL"), count("POSITION"));
+  EXPECT_EQ(count("TEXCOORD_0"), count("POSITION"));
+  for (const char* ext : {".obj", ".ply", ".glb"}) {
     const TriMesh m = read_mesh(out + "/spot.M3" + ext);
     EXPECT_EQ(m.triangles.size(), 256u) << ext;  // 2 patches · 4^3 quads · 2
     const TopologyReport t = analyze_topology(m);

@@ -115,9 +115,12 @@ TEST(IncrementalDecode, FixtureHasPerPatchStreams) {
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   for (const PackModelInfo& m : info.models) {
     // Segments after joint_segments are per-patch streams: they must exist and hold bytes.
-    const int passes = m.geometry.top_bitplane + 1;
-    EXPECT_LT(m.geometry.joint_segments, passes - 4) << m.name;
-    EXPECT_LT(m.normals.joint_segments, m.normals.top_bitplane + 1) << m.name;
+    // Counts of segments (not times): the shared ones must leave room for per-patch ones.
+    const int geometry_plane_count = m.geometry.top_bitplane + 1;
+    const int normal_plane_count = m.normals.top_bitplane + 1;
+    const int geometry_shared_count = m.geometry.joint_segments, normal_shared_count = m.normals.joint_segments;
+    EXPECT_LT(geometry_shared_count, geometry_plane_count - 4) << m.name;
+    EXPECT_LT(normal_shared_count, normal_plane_count) << m.name;
   }
   std::size_t per_patch_bytes = 0;
   for (const ChunkInfo& c : info.chunks) {

@@ -798,17 +798,17 @@ TEST_F(CliPack, PrefixesWithoutALevelOfDetailExitTwoWithoutOutput) {
   const std::size_t at = r.err.find(needs);
   ASSERT_NE(at, std::string::npos) << r.err;
   EXPECT_NE(r.err.find("the first " + just_manifest + " bytes"), std::string::npos) << r.err;
-  const std::size_t first_level_bytes = std::stoul(r.err.substr(at + needs.size()));  // a size, not a time
-  EXPECT_GT(first_level_bytes, manifest_end + 1);
-  EXPECT_LT(first_level_bytes, bytes.size());
+  const std::size_t level_one_size = std::stoul(r.err.substr(at + needs.size()));  // bytes, not a time
+  EXPECT_GT(level_one_size, manifest_end + 1);
+  EXPECT_LT(level_one_size, bytes.size());
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(
-      geomip("decode -q '" + pack + "' --bytes " + std::to_string(first_level_bytes - 1) + " -o '" + out + "'")
+      geomip("decode -q '" + pack + "' --bytes " + std::to_string(level_one_size - 1) + " -o '" + out + "'")
           .exit_code,
       2);
   EXPECT_FALSE(fs::exists(out));
   // From there on, a coarse model with an extent.
-  r = geomip("decode -q '" + pack + "' --bytes " + std::to_string(first_level_bytes) + " -o '" + out + "'");
+  r = geomip("decode -q '" + pack + "' --bytes " + std::to_string(level_one_size) + " -o '" + out + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_GT(analyze_topology(read_mesh(out)).bbox_diagonal, 0.1);
 

@@ -67,6 +67,15 @@ struct ViewRun {
   long max_rss_kb = 0;    // peak resident memory of geomip-view (measured runs)
 };
 
+/// The captured standard output and error of a run.
+void read_outputs(ViewRun& r, const fs::path& out, const fs::path& err) {
+  std::stringstream so, se;
+  so << std::ifstream(out).rdbuf();
+  se << std::ifstream(err).rdbuf();
+  r.out = so.str();
+  r.err = se.str();
+}
+
 ViewRun view(const std::string& args) {
   static int counter = 0;
   const fs::path out = work_dir() / ("out" + std::to_string(counter) + ".txt");
@@ -75,11 +84,7 @@ ViewRun view(const std::string& args) {
   const int status = std::system(cmd.c_str());
   ViewRun r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::stringstream so, se;
-  so << std::ifstream(out).rdbuf();
-  se << std::ifstream(err).rdbuf();
-  r.out = so.str();
-  r.err = se.str();
+  read_outputs(r, out, err);
   return r;
 }
 
@@ -103,11 +108,7 @@ ViewRun view_measured(const std::string& args) {
   r.max_rss_kb = usage.ru_maxrss;
   r.signaled = WIFSIGNALED(status);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::stringstream so, se;
-  so << std::ifstream(out).rdbuf();
-  se << std::ifstream(err).rdbuf();
-  r.out = so.str();
-  r.err = se.str();
+  read_outputs(r, out, err);
   return r;
 }
 

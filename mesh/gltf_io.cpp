@@ -9,6 +9,15 @@
 #define TINYGLTF_NO_EXTERNAL_IMAGE
 #include <tiny_gltf.h>
 
+#include <nlohmann/json.hpp>
+
+#include <draco/attributes/geometry_attribute.h>
+#include <draco/compression/decode.h>
+#include <draco/compression/encode.h>
+#include <draco/core/decoder_buffer.h>
+#include <draco/core/encoder_buffer.h>
+#include <draco/mesh/mesh.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -16,6 +25,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <unordered_map>
@@ -53,6 +63,107 @@ int add_accessor(tinygltf::Model& model, std::size_t offset, std::size_t bytes, 
 
 void pad4(std::vector<unsigned char>& buffer) {
   while (buffer.size() % 4) buffer.push_back(0);
+}
+
+// KHR_draco_mesh_compression: the primitive's attributes and triangles as one Draco mesh (one point per glTF
+// vertex, identity mapping), encoded, decoded back in-process and described by accessors without buffer views
+// whose counts and bounds are those of the decode.
+constexpr const char* kDracoExtension = "KHR_draco_mesh_compression";
+
+struct DracoAttribute {
+  const char* gltf_name;
+  draco::GeometryAttribute::Type type;
+  int components;
+  const float* values;  // components per vertex, tightly packed
+  int bits;
+};
+
+void add_draco_primitive(tinygltf::Model& model, tinygltf::Primitive& prim, std::size_t num_vertices,
+                         const std::vector<std::uint32_t>& indices, const std::vector<DracoAttribute>& attributes) {
+  draco::Mesh mesh;
+  const auto n = static_cast<draco::PointIndex::ValueType>(num_vertices);
+  mesh.set_num_points(n);
+  std::vector<int> ids;
+  for (const DracoAttribute& a : attributes) {
+    draco::GeometryAttribute ga;
+    ga.Init(a.type, nullptr, static_cast<std::int8_t>(a.components), draco::DT_FLOAT32, false,
+            static_cast<std::int64_t>(sizeof(float)) * a.components, 0);
+    const int id = mesh.AddAttribute(ga, /*identity_mapping=*/true, n);
+    draco::PointAttribute* att = mesh.attribute(id);
+    for (draco::PointIndex::ValueType v = 0; v < n; ++v)
+      att->SetAttributeValue(draco::AttributeValueIndex(v), a.values + static_cast<std::size_t>(a.components) * v);
+    ids.push_back(id);
+  }
+  for (std::size_t t = 0; t < indices.size(); t += 3)
+    mesh.AddFace({draco::PointIndex(indices[t]), draco::PointIndex(indices[t + 1]), draco::PointIndex(indices[t + 2])});
+
+  draco::Encoder encoder;
+  for (const DracoAttribute& a : attributes) encoder.SetAttributeQuantization(a.type, a.bits);
+  encoder.SetSpeedOptions(3, 3);  // compression level 7, as draco_encoder's default
+  encoder.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);
+  draco::EncoderBuffer encoded;
+  const draco::Status status = encoder.EncodeMeshToBuffer(mesh, &encoded);
+  if (!status.ok()) throw SolverFailure("write_gltf: Draco failed to encode the mesh: " + status.error_msg_string());
+
+  // What every glTF loader will see: Draco's own decode of these bytes.
+  draco::DecoderBuffer in;
+  in.Init(encoded.data(), encoded.size());
+  draco::Decoder decoder;
+  auto decoded_or = decoder.DecodeMeshFromBuffer(&in);
+  if (!decoded_or.ok()) throw SolverFailure("write_gltf: Draco cannot decode its own bytes: " + decoded_or.status().error_msg_string());
+  const std::unique_ptr<draco::Mesh> decoded = std::move(decoded_or).value();
+  if (3 * static_cast<std::size_t>(decoded->num_faces()) != indices.size())
+    throw SolverFailure("write_gltf: Draco's decode has " + std::to_string(decoded->num_faces()) + " triangles, not " +
+                        std::to_string(indices.size() / 3));
+
+  std::vector<unsigned char>& buffer = model.buffers[0].data;
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = buffer.size();
+  view.byteLength = encoded.size();
+  append_bytes(buffer, encoded.data(), encoded.size());
+  pad4(buffer);
+  model.bufferViews.push_back(view);
+
+  tinygltf::Value::Object ids_by_name;
+  for (std::size_t k = 0; k < attributes.size(); ++k) {
+    const DracoAttribute& a = attributes[k];
+    const draco::PointAttribute* att = decoded->GetAttributeByUniqueId(mesh.attribute(ids[k])->unique_id());
+    if (att == nullptr || att->num_components() != a.components)
+      throw SolverFailure(std::string("write_gltf: Draco's decode lost the ") + a.gltf_name + " attribute");
+    ids_by_name[a.gltf_name] = tinygltf::Value(static_cast<int>(att->unique_id()));
+    tinygltf::Accessor accessor;
+    accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+    accessor.count = decoded->num_points();
+    accessor.type = a.components == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC2;
+    if (a.type == draco::GeometryAttribute::POSITION) {
+      std::array<float, 3> p{};
+      accessor.minValues.assign(3, kFloatMax);
+      accessor.maxValues.assign(3, -kFloatMax);
+      for (draco::PointIndex::ValueType v = 0; v < decoded->num_points(); ++v) {
+        att->ConvertValue<float>(att->mapped_index(draco::PointIndex(v)), 3, p.data());
+        for (int c = 0; c < 3; ++c) {
+          accessor.minValues[c] = std::min(accessor.minValues[c], static_cast<double>(p[c]));
+          accessor.maxValues[c] = std::max(accessor.maxValues[c], static_cast<double>(p[c]));
+        }
+      }
+    }
+    model.accessors.push_back(accessor);
+    prim.attributes[a.gltf_name] = static_cast<int>(model.accessors.size() - 1);
+  }
+  tinygltf::Accessor index_accessor;
+  index_accessor.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  index_accessor.count = indices.size();
+  index_accessor.type = TINYGLTF_TYPE_SCALAR;
+  model.accessors.push_back(index_accessor);
+  prim.indices = static_cast<int>(model.accessors.size() - 1);
+
+  tinygltf::Value::Object extension;
+  extension["bufferView"] = tinygltf::Value(static_cast<int>(model.bufferViews.size() - 1));
+  extension["attributes"] = tinygltf::Value(std::move(ids_by_name));
+  prim.extensions[kDracoExtension] = tinygltf::Value(std::move(extension));
+  model.extensionsUsed.emplace_back(kDracoExtension);
+  model.extensionsRequired.emplace_back(kDracoExtension);
 }
 
 // ---- reading ----
@@ -140,8 +251,10 @@ class Reader {
 
   void add_primitive(const tinygltf::Primitive& prim, const Matrix4& xf, TriMesh& out) const {
     if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) return;  // points, lines, strips, fans: skipped
-    if (prim.extensions.count("KHR_draco_mesh_compression"))
-      fail("Draco-compressed primitives (KHR_draco_mesh_compression) are not read; decompress the file first");
+    if (const auto draco = prim.extensions.find(kDracoExtension); draco != prim.extensions.end()) {
+      add_draco_primitive(draco->second, xf, out);
+      return;
+    }
     const auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) fail("a triangle primitive has no POSITION");
     const View p = check_accessor(pos->second, TINYGLTF_TYPE_VEC3, "POSITION");
@@ -173,6 +286,50 @@ class Reader {
       if (p.count % 3) fail("a non-indexed primitive's vertex count is not a multiple of 3");
       for (std::size_t i = 0; i < p.count; i += 3)
         out.triangles.push_back({static_cast<int>(first + i), static_cast<int>(first + i + 1), static_cast<int>(first + i + 2)});
+    }
+  }
+
+  // KHR_draco_mesh_compression: positions and triangles from Draco's decode of the extension's buffer view
+  // (the primitive's accessors only describe the decoded arrays).
+  void add_draco_primitive(const tinygltf::Value& ext, const Matrix4& xf, TriMesh& out) const {
+    const tinygltf::Value& view_index = ext.Get("bufferView");
+    const tinygltf::Value& position_id = ext.Get("attributes").Get("POSITION");
+    if (!view_index.IsNumber() || !position_id.IsNumber()) fail("a Draco primitive lacks its bufferView or POSITION id");
+    const int vi = view_index.GetNumberAsInt();
+    if (vi < 0 || static_cast<std::size_t>(vi) >= model_.bufferViews.size()) fail("a Draco buffer view does not exist");
+    const tinygltf::BufferView& v = model_.bufferViews[vi];
+    if (v.buffer < 0 || static_cast<std::size_t>(v.buffer) >= model_.buffers.size()) fail("a Draco buffer view has no buffer");
+    const std::vector<unsigned char>& data = model_.buffers[v.buffer].data;
+    if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset) fail("a Draco buffer view reaches past its buffer");
+    draco::DecoderBuffer in;
+    in.Init(reinterpret_cast<const char*>(data.data() + v.byteOffset), v.byteLength);
+    draco::Decoder decoder;
+    auto decoded_or = decoder.DecodeMeshFromBuffer(&in);
+    if (!decoded_or.ok()) fail("Draco cannot decode a primitive (" + decoded_or.status().error_msg_string() + ")");
+    const std::unique_ptr<draco::Mesh> mesh = std::move(decoded_or).value();
+    const draco::PointAttribute* att =
+        mesh->GetAttributeByUniqueId(static_cast<std::uint32_t>(position_id.GetNumberAsInt()));
+    if (att == nullptr || att->num_components() != 3) fail("a Draco primitive has no 3-component POSITION");
+    const std::size_t first = out.positions.size();
+    const std::size_t np = mesh->num_points();
+    if (np > static_cast<std::size_t>(std::numeric_limits<int>::max()) - first) fail("too many vertices");
+    std::array<float, 3> f{};
+    for (draco::PointIndex::ValueType i = 0; i < mesh->num_points(); ++i) {
+      if (!att->ConvertValue<float>(att->mapped_index(draco::PointIndex(i)), 3, f.data()))
+        fail("a Draco POSITION value cannot be read");
+      const Eigen::Vector3d q = (xf * Eigen::Vector4d(f[0], f[1], f[2], 1.0)).head<3>();
+      if (!q.allFinite() || q.cwiseAbs().maxCoeff() > kFloatMax)
+        fail("vertex " + std::to_string(i) + " has a coordinate that is not finite or beyond float range");
+      out.positions.push_back(q);
+    }
+    for (draco::FaceIndex::ValueType t = 0; t < mesh->num_faces(); ++t) {
+      const draco::Mesh::Face& face = mesh->face(draco::FaceIndex(t));
+      std::array<int, 3> tri{};
+      for (int k = 0; k < 3; ++k) {
+        if (face[k].value() >= np) fail("a Draco triangle index is beyond its vertices");
+        tri[k] = static_cast<int>(first + face[k].value());
+      }
+      out.triangles.push_back(tri);
     }
   }
 
@@ -211,6 +368,9 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
     throw InvalidInput("write_gltf: " + std::to_string(attributes.normals.size()) + " normals for " + std::to_string(n) + " vertices");
   if (!attributes.uv.empty() && attributes.uv.size() != n)
     throw InvalidInput("write_gltf: " + std::to_string(attributes.uv.size()) + " texture coordinates for " + std::to_string(n) + " vertices");
+  if (options.draco_position_bits < 0 || options.draco_position_bits > 30)
+    throw InvalidInput("write_gltf: Draco position bits must be in 1..30 (0 = no Draco), got " +
+                       std::to_string(options.draco_position_bits));
 
   tinygltf::Model model;
   model.asset.version = "2.0";
@@ -239,31 +399,41 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
 
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
-  std::size_t offset = buffer.size();
-  append_bytes(buffer, positions.data(), positions.size());
-  prim.attributes["POSITION"] = add_accessor(model, offset, buffer.size() - offset, n, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                             TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
-  model.accessors.back().minValues.assign(lo.begin(), lo.end());
-  model.accessors.back().maxValues.assign(hi.begin(), hi.end());
-  if (!attributes.normals.empty()) {
+  if (options.draco_position_bits != 0) {
+    std::vector<DracoAttribute> draco_attributes{
+        {"POSITION", draco::GeometryAttribute::POSITION, 3, positions.data(), options.draco_position_bits}};
+    if (!attributes.normals.empty())
+      draco_attributes.push_back({"NORMAL", draco::GeometryAttribute::NORMAL, 3, attributes.normals.front().data(), 10});
+    if (!attributes.uv.empty())
+      draco_attributes.push_back({"TEXCOORD_0", draco::GeometryAttribute::TEX_COORD, 2, attributes.uv.front().data(), 12});
+    add_draco_primitive(model, prim, n, indices, draco_attributes);
+  } else {
+    std::size_t offset = buffer.size();
+    append_bytes(buffer, positions.data(), positions.size());
+    prim.attributes["POSITION"] = add_accessor(model, offset, buffer.size() - offset, n, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                               TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    model.accessors.back().minValues.assign(lo.begin(), lo.end());
+    model.accessors.back().maxValues.assign(hi.begin(), hi.end());
+    if (!attributes.normals.empty()) {
+      offset = buffer.size();
+      for (const auto& nv : attributes.normals) append_bytes(buffer, nv.data(), 3);
+      prim.attributes["NORMAL"] = add_accessor(model, offset, buffer.size() - offset, n, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                               TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    }
+    if (!attributes.uv.empty()) {
+      offset = buffer.size();
+      for (const auto& t : attributes.uv) append_bytes(buffer, t.data(), 2);
+      prim.attributes["TEXCOORD_0"] = add_accessor(model, offset, buffer.size() - offset, n,
+                                                   TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2,
+                                                   TINYGLTF_TARGET_ARRAY_BUFFER);
+    }
+    pad4(buffer);
     offset = buffer.size();
-    for (const auto& nv : attributes.normals) append_bytes(buffer, nv.data(), 3);
-    prim.attributes["NORMAL"] = add_accessor(model, offset, buffer.size() - offset, n, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                                             TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER);
+    append_bytes(buffer, indices.data(), indices.size());
+    prim.indices = add_accessor(model, offset, buffer.size() - offset, indices.size(),
+                                TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
   }
-  if (!attributes.uv.empty()) {
-    offset = buffer.size();
-    for (const auto& t : attributes.uv) append_bytes(buffer, t.data(), 2);
-    prim.attributes["TEXCOORD_0"] = add_accessor(model, offset, buffer.size() - offset, n,
-                                                 TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2,
-                                                 TINYGLTF_TARGET_ARRAY_BUFFER);
-  }
-  pad4(buffer);
-  offset = buffer.size();
-  append_bytes(buffer, indices.data(), indices.size());
-  prim.indices = add_accessor(model, offset, buffer.size() - offset, indices.size(),
-                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                              TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
 
   model.meshes.emplace_back().primitives.push_back(prim);
   tinygltf::Node node;
@@ -305,10 +475,68 @@ void weld_identical_positions(TriMesh& mesh) {
   mesh.positions = std::move(kept);
 }
 
+/// TinyGLTF (as Debian builds it, without Draco) refuses an index accessor without a buffer view, which is
+/// how KHR_draco_mesh_compression files describe their indices. Such accessors get the primitive's Draco
+/// buffer view (never read through them: add_draco_primitive() decodes the view itself). Returns the bytes
+/// unchanged when no primitive needs it; GLB or JSON alike.
+std::string point_draco_indices_at_their_view(std::string_view bytes, const std::string& name) {
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  std::string_view json_text = bytes;
+  std::size_t json_end = bytes.size();
+  if (binary) {  // header (magic, version, length) + JSON chunk (length, "JSON", text) + the rest
+    if (bytes.size() < 20 || std::memcmp(bytes.data() + 16, "JSON", 4) != 0) return std::string(bytes);
+    std::uint32_t json_bytes = 0;
+    std::memcpy(&json_bytes, bytes.data() + 12, 4);
+    if (json_bytes > bytes.size() - 20) return std::string(bytes);  // TinyGLTF says what is wrong
+    json_text = bytes.substr(20, json_bytes);
+    json_end = 20 + json_bytes;
+  }
+  nlohmann::json j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("meshes") || !j.contains("accessors")) return std::string(bytes);
+  nlohmann::json& accessors = j["accessors"];
+  bool changed = false;
+  for (nlohmann::json& mesh : j["meshes"]) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (nlohmann::json& prim : mesh["primitives"]) {
+      if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object() ||
+          !prim["extensions"].contains(kDracoExtension) || !prim.contains("indices"))
+        continue;
+      const nlohmann::json& ext = prim["extensions"][kDracoExtension];
+      const nlohmann::json& ix = prim["indices"];
+      if (!ext.is_object() || !ext.contains("bufferView") || !ext["bufferView"].is_number_unsigned() ||
+          !ix.is_number_unsigned() || ix.get<std::uint64_t>() >= accessors.size())
+        continue;
+      nlohmann::json& accessor = accessors[ix.get<std::size_t>()];
+      if (accessor.is_object() && !accessor.contains("bufferView")) {
+        accessor["bufferView"] = ext["bufferView"];
+        changed = true;
+      }
+    }
+  }
+  if (!changed) return std::string(bytes);
+  std::string text = j.dump();
+  if (!binary) return text;
+  while (text.size() % 4) text.push_back(' ');
+  if (text.size() > std::numeric_limits<std::uint32_t>::max() - bytes.size())
+    throw InvalidInput(name + ": too large for glTF (4 GiB)");
+  std::string out(bytes.substr(0, 12));
+  const auto json_bytes = static_cast<std::uint32_t>(text.size());
+  out.append(reinterpret_cast<const char*>(&json_bytes), 4);
+  out.append("JSON", 4);
+  out += text;
+  out.append(bytes.substr(json_end));
+  const auto total = static_cast<std::uint32_t>(out.size());
+  std::memcpy(out.data() + 8, &total, 4);
+  return out;
+}
+
 }  // namespace
 
-TriMesh read_gltf_from_memory(std::string_view bytes, const std::string& name, const std::string& base_dir) {
-  if (bytes.size() > std::numeric_limits<unsigned int>::max()) throw InvalidInput(name + ": too large for glTF (4 GiB)");
+TriMesh read_gltf_from_memory(std::string_view original, const std::string& name, const std::string& base_dir) {
+  if (original.size() > std::numeric_limits<unsigned int>::max()) throw InvalidInput(name + ": too large for glTF (4 GiB)");
+  std::string patched;
+  if (original.find(kDracoExtension) != std::string_view::npos) patched = point_draco_indices_at_their_view(original, name);
+  const std::string_view bytes = patched.empty() ? original : std::string_view(patched);
   tinygltf::TinyGLTF gltf;
   gltf.SetImageLoader(&skip_images, nullptr);
   tinygltf::Model model;

@@ -2,7 +2,10 @@
 // (Debian's libtinygltf-dev): what three.js's GLTFLoader, Blender, assimp and every glTF viewer open.
 //
 // Output: one mesh, one triangle primitive: POSITION (float VEC3, with the min/max the specification
-// requires), optional NORMAL (float VEC3, unit length) and TEXCOORD_0 (float VEC2), 32-bit indices.
+// requires), optional NORMAL (float VEC3, unit length) and TEXCOORD_0 (float VEC2), 32-bit indices; or, with
+// GltfWriteOptions::draco_position_bits, the same primitive compressed by Draco (KHR_draco_mesh_compression,
+// listed in extensionsRequired: accessors without buffer views, one buffer view of Draco bytes), which
+// three.js (DRACOLoader), Blender, Babylon.js and gltf-transform decode.
 // Input: every triangle primitive (mode TRIANGLES, indexed or not) of every mesh reachable from the default
 // scene (all nodes when the file has no scene), node transforms applied, merged into one TriMesh, vertices at
 // bit-identical positions merged into one (glTF splits a vertex wherever an attribute changes — texture
@@ -30,12 +33,18 @@ struct MeshAttributes {
 struct GltfWriteOptions {
   bool binary = true;          ///< GLB (one file) or JSON .gltf with the buffer as a base64 data URI
   std::string generator = "geomip";
+  /// 0: plain accessors. 1..30: KHR_draco_mesh_compression with positions quantized to this many bits over
+  /// the bounding box (normals 10 bits, texture coordinates 12), Draco's edgebreaker at compression level 7.
+  int draco_position_bits = 0;
 };
 
 /// Writes `mesh` (positions as float32) with `attributes` as glTF 2.0 to `out`. Does not open or rename
 /// files: tools/ write to a temporary file and rename (atomic output).
-/// \throw InvalidInput for an empty mesh, attributes of the wrong size, an index out of range or a
-///   coordinate outside float range; IoError when the stream fails.
+/// With Draco the accessors' counts and POSITION min/max are those of Draco's own decode of the bytes written
+/// (checked in-process before a byte is written: same triangle count, every attribute present).
+/// \throw InvalidInput for an empty mesh, attributes of the wrong size, an index out of range, a coordinate
+///   outside float range or draco_position_bits outside 0..30; SolverFailure when Draco fails to encode or
+///   its decode disagrees; IoError when the stream fails.
 void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostream& out,
                 const GltfWriteOptions& options = {});
 

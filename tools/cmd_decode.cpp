@@ -1,5 +1,5 @@
-// geomip decode PACK [--bytes N] [--level K] -o MESH: decodes a .gip pack (or only its first N bytes, as if
-// only they had arrived) and writes each model as a mesh.
+// geomip decode PACK [--bytes N] [--level K] [--draco[=BITS]] -o MESH: decodes a .gip pack (or only its first
+// N bytes, as if only they had arrived) and writes each model as a mesh (glTF optionally Draco-compressed).
 #include "codec/pack.h"
 #include "mesh/errors.h"
 #include "mesh/gltf_io.h"
@@ -26,6 +26,7 @@ struct DecodeArgs {
   std::string output;
   long long bytes = -1;
   int level = -1;
+  int draco = 0;  // glTF output: Draco position bits, 0 = no Draco
   bool json = false;
   bool quiet = false;
 };
@@ -54,6 +55,12 @@ MeshFormat format_of(const std::string& path) {
 }
 
 int run_decode(const DecodeArgs& args) {
+  const MeshFormat format = format_of(args.output);
+  const bool gltf = format == MeshFormat::kGltf || format == MeshFormat::kGlb;
+  if (args.draco != 0 && !gltf)
+    throw InvalidInput("--draco compresses glTF output: -o must end in .glb or .gltf, not " + args.output);
+  if (args.draco < 0 || args.draco > 30)
+    throw InvalidInput("--draco=" + std::to_string(args.draco) + ": position bits must be in 1..30");
   const std::vector<std::uint8_t> bytes = read_pack_file(args.pack);
   std::size_t manifest_end = 0;
   const codec::Status header = codec::read_pack_header(bytes, manifest_end);
@@ -107,7 +114,6 @@ int run_decode(const DecodeArgs& args) {
   // One model → OUTPUT is the mesh file; several → OUTPUT's stem gets each model's name.
   std::vector<std::string> paths;
   const std::filesystem::path out(args.output);
-  const MeshFormat format = format_of(args.output);
   for (const auto& model : decoded.models) {
     paths.push_back(decoded.models.size() == 1
                         ? args.output
@@ -118,13 +124,13 @@ int run_decode(const DecodeArgs& args) {
   for (std::size_t m = 0; m < decoded.models.size(); ++m) {
     // glTF carries per-patch texture coordinates and the normal maps' normals (seams not welded); the
     // other formats get the welded mesh.
-    const bool gltf = format == MeshFormat::kGltf || format == MeshFormat::kGlb;
     const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level) : TexturedMesh{};
     const TriMesh mesh = gltf ? TriMesh{} : decoded_mesh(decoded.models[m], args.level);
     const TriMesh& written = gltf ? textured.mesh : mesh;
     write_file_atomically(paths[m], [&](std::ostream& o) {
       if (gltf)
-        write_gltf(textured.mesh, textured.attributes, o, {.binary = format == MeshFormat::kGlb});
+        write_gltf(textured.mesh, textured.attributes, o,
+                   {.binary = format == MeshFormat::kGlb, .draco_position_bits = args.draco});
       else
         write_mesh(mesh, o, format);
     });
@@ -165,7 +171,7 @@ int run_decode(const DecodeArgs& args) {
 CommandRunner add_decode_command(CLI::App& app) {
   auto args = std::make_shared<DecodeArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "decode", "Decode a .gip pack (or its first N bytes) to a mesh per model (OBJ, PLY or OFF by extension).");
+      "decode", "Decode a .gip pack (or its first N bytes) to a mesh per model (OBJ, PLY, OFF, glTF or GLB by extension).");
   cmd->add_option("pack", args->pack, "The .gip pack")->required();
   cmd->add_option("-o,--output", args->output,
                   "Output mesh; with several models, <stem>.<model>.<ext> beside it")
@@ -174,6 +180,9 @@ CommandRunner add_decode_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--level", args->level, "Output grid level K (default: the pack's level)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--draco{14}", args->draco,
+                "glTF output compressed by Draco (KHR_draco_mesh_compression): positions quantized to BITS bits "
+                "(--draco=BITS, 1..30; default 14), normals 10, texture coordinates 12");
   cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No report");
   return [args] { return run_decode(*args); };

@@ -1,4 +1,4 @@
-// geomip remesh MESH... [--points CORR.json] [--level K] [--adaptive EPS [--max-depth N]] -o DIR [--ply] [--glb]:
+// geomip remesh MESH... [--points CORR.json] [--level K] [--adaptive EPS [--max-depth N]] -o DIR [--ply] [--glb [--draco[=BITS]]]:
 // consistent parameterization (as `geomip param`), then the uniform level-K remesh of every model,
 // DIR/<stem>.M<K>.obj (and .ply) (gimage/uniform_remesh.h), and/or the adaptive remesh
 // DIR/<stem>.adaptive.obj (gimage/adaptive_remesh.h): watertight, consistently oriented, one face list for
@@ -35,6 +35,7 @@ struct RemeshArgs {
   bool measure_samples = false;
   bool ply = false;
   bool glb = false;
+  int draco = 0;  ///< the GLB's Draco position bits, 0 = no Draco
 };
 
 int run_remesh(const RemeshArgs& args) {
@@ -45,6 +46,9 @@ int run_remesh(const RemeshArgs& args) {
                                         : "--level " + std::to_string(args.level) + " is outside [0, " +
                                               std::to_string(kMaxGeometryImageLevel) + "]");
   }
+  if (args.draco != 0 && !args.glb) throw InvalidInput("--draco compresses the GLB: give --glb too");
+  if (args.draco < 0 || args.draco > 30)
+    throw InvalidInput("--draco=" + std::to_string(args.draco) + ": position bits must be in 1..30");
   if (adaptive && (args.max_depth < 0 || args.max_depth > kMaxGeometryImageLevel)) {
     throw InvalidInput("--max-depth " + std::to_string(args.max_depth) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
@@ -86,7 +90,7 @@ int run_remesh(const RemeshArgs& args) {
     if (args.glb) {
       const TexturedMesh textured = textured_mesh(images);
       write_file_atomically(stem + ".glb", [&](std::ostream& out) {
-        write_gltf(textured.mesh, textured.attributes, out, {.binary = true});
+        write_gltf(textured.mesh, textured.attributes, out, {.binary = true, .draco_position_bits = args.draco});
       });
     }
     if (args.common.json) {
@@ -187,6 +191,9 @@ CommandRunner add_remesh_command(CLI::App& app) {
   cmd->add_flag("--glb", args->glb,
                 "Also write DIR/<stem>.M<K>.glb: glTF with each patch's (u,v) as TEXCOORD_0 and the normal "
                 "maps' normals (seam vertices once per patch)");
+  cmd->add_flag("--draco{14}", args->draco,
+                "With --glb: compress it with Draco (KHR_draco_mesh_compression), positions quantized to BITS bits "
+                "(--draco=BITS, 1..30; default 14), normals 10, texture coordinates 12");
   return [args] { return run_remesh(*args); };
 }
 

@@ -1,6 +1,8 @@
 // glTF 2.0 through TinyGLTF: exact float round trips (GLB and JSON), attributes written with the sizes and
 // bounds the specification requires, node transforms applied on input, and crafted files refused with a
-// message instead of a crash (accessors past their buffers, indices out of range, garbage).
+// message instead of a crash (accessors past their buffers, indices out of range, garbage). Draco
+// (KHR_draco_mesh_compression): positions within the quantization step, the same triangles, a smaller file,
+// the extension declared as required, damaged Draco bytes refused.
 #include "mesh/errors.h"
 #include "mesh/gltf_io.h"
 #include "mesh/mesh_io.h"
@@ -10,15 +12,19 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <sstream>
 
 namespace geomip {
 namespace {
 
-std::string to_gltf(const TriMesh& mesh, const MeshAttributes& attributes, bool binary) {
+std::string to_gltf(const TriMesh& mesh, const MeshAttributes& attributes, bool binary, int draco_bits = 0) {
   std::ostringstream out;
   GltfWriteOptions o;
   o.binary = binary;
+  o.draco_position_bits = draco_bits;
   write_gltf(mesh, attributes, out, o);
   return out.str();
 }
@@ -160,6 +166,100 @@ TEST(GltfIo, CraftedFilesAreRefusedWithAMessage) {
   j = good;
   j["nodes"][0]["children"] = {0};  // a cycle
   expect_refused(j.dump(), "deeper than 64");
+}
+
+// Largest distance from a vertex of `a` to its corresponding vertex in `b`, matching triangles by their
+// corner positions (Draco's edgebreaker reorders vertices and triangles): for every triangle of `a`, the
+// triangle of `b` whose corners are nearest, as a multiset compared corner by corner in cyclic order.
+double worst_corner_distance(const TriMesh& a, const TriMesh& b) {
+  double worst = 0;
+  for (const auto& ta : a.triangles) {
+    double best = 1e300;
+    for (const auto& tb : b.triangles)
+      for (int r = 0; r < 3; ++r) {
+        double d = 0;
+        for (int k = 0; k < 3; ++k) d = std::max(d, (a.positions[ta[k]] - b.positions[tb[(k + r) % 3]]).norm());
+        best = std::min(best, d);
+      }
+    worst = std::max(worst, best);
+  }
+  return worst;
+}
+
+TEST(GltfIo, DracoGlbKeepsTrianglesWithinTheQuantizationStep) {
+  const TriMesh torus = float_rounded(test::torus(12, 7));
+  MeshAttributes a;
+  for (const auto& p : torus.positions) {
+    a.normals.push_back(p.normalized().cast<float>());
+    a.uv.emplace_back(static_cast<float>(0.5 + 0.25 * p.x()), static_cast<float>(0.5 + 0.25 * p.y()));
+  }
+  const std::string plain = to_gltf(torus, a, true);
+  std::string packed;
+  for (int bits : {8, 14}) {
+    const std::string bytes = to_gltf(torus, a, true, bits);
+    if (bits == 14) packed = bytes;
+    const TriMesh back = read_gltf_from_memory(bytes, "torus.glb", "");
+    ASSERT_EQ(back.triangles.size(), torus.triangles.size()) << bits;
+    ASSERT_EQ(back.positions.size(), torus.positions.size()) << bits;
+    double extent = 0;
+    for (int c = 0; c < 3; ++c) {
+      double lo = 1e300, hi = -1e300;
+      for (const auto& p : torus.positions) lo = std::min(lo, p[c]), hi = std::max(hi, p[c]);
+      extent = std::max(extent, hi - lo);
+    }
+    // Draco quantizes every coordinate to a grid of 2^bits - 1 steps over the largest extent.
+    const double step = extent / ((1 << bits) - 1);
+    EXPECT_LE(worst_corner_distance(torus, back), std::sqrt(3.0) * 0.5 * step * 1.001) << bits;
+    EXPECT_GT(worst_corner_distance(torus, back), 0) << bits << ": quantized positions cannot all be exact";
+  }
+  EXPECT_LT(packed.size(), plain.size() / 2);
+  // The same from JSON glTF (the Draco bytes in a base64 data URI).
+  const TriMesh from_json = read_gltf_from_memory(to_gltf(torus, a, false, 14), "torus.gltf", "");
+  EXPECT_EQ(from_json.triangles.size(), torus.triangles.size());
+  EXPECT_LE(worst_corner_distance(torus, from_json), worst_corner_distance(torus, read_gltf_from_memory(packed, "t", "")));
+
+  // The JSON: the extension required, accessors without buffer views (counts and bounds of the decode).
+  const std::string& glb = packed;
+  std::uint32_t json_size = 0;
+  std::memcpy(&json_size, glb.data() + 12, 4);
+  const auto j = nlohmann::json::parse(glb.substr(20, json_size));
+  EXPECT_EQ(j["extensionsRequired"], nlohmann::json::array({"KHR_draco_mesh_compression"}));
+  const auto& prim = j["meshes"][0]["primitives"][0];
+  const auto& ext = prim["extensions"]["KHR_draco_mesh_compression"];
+  ASSERT_TRUE(ext.contains("bufferView"));
+  for (const char* name : {"POSITION", "NORMAL", "TEXCOORD_0"}) {
+    ASSERT_TRUE(ext["attributes"].contains(name)) << name;
+    const auto& accessor = j["accessors"][prim["attributes"][name].get<int>()];
+    EXPECT_FALSE(accessor.contains("bufferView")) << name;
+    EXPECT_EQ(accessor["count"], torus.positions.size()) << name;
+  }
+  EXPECT_EQ(j["accessors"][prim["indices"].get<int>()]["count"], 3 * torus.triangles.size());
+}
+
+TEST(GltfIo, DamagedDracoBytesAndBadBitsAreRefusedWithAMessage) {
+  const TriMesh torus = float_rounded(test::torus(12, 7));
+  EXPECT_THROW(to_gltf(torus, {}, true, 31), InvalidInput);
+  EXPECT_THROW(to_gltf(torus, {}, true, -1), InvalidInput);
+  const std::string glb = to_gltf(torus, {}, true, 12);
+  std::uint32_t json_size = 0;
+  std::memcpy(&json_size, glb.data() + 12, 4);
+  const std::size_t bin = 20 + json_size + 8;  // the Draco bytes start the binary chunk
+  int refused = 0, read = 0;
+  for (std::size_t k = 0; k < 64; ++k) {  // garbage over the Draco header and the start of its stream
+    std::string bad = glb;
+    for (std::size_t i = bin + k; i < std::min(bad.size(), bin + k + 4); ++i) bad[i] = static_cast<char>(0xA5 ^ i);
+    try {
+      const TriMesh m = read_gltf_from_memory(bad, "bad.glb", "");
+      for (const auto& t : m.triangles)
+        for (int v : t) ASSERT_LT(static_cast<std::size_t>(v), m.positions.size());
+      ++read;
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.glb"), std::string::npos) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_EQ(refused + read, 64);
 }
 
 TEST(GltfIo, IndicesBeyondTheVertexCountAreRefused) {

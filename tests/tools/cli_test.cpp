@@ -425,6 +425,22 @@ TEST_F(CliGimage, RemeshWritesWatertightObjPlyAndGlb) {
     EXPECT_TRUE(t.manifold) << ext;
     EXPECT_EQ(t.genus, 0) << ext;
   }
+  // --draco: the same surface through KHR_draco_mesh_compression, in a smaller GLB; without --glb, refused.
+  const Outcome d = geomip("remesh --quiet '" + spot_ + "' --level 3 -o '" + dir_ + "/draco' --glb --draco=12");
+  ASSERT_EQ(d.exit_code, 0) << d.err;
+  const std::string dglb = slurp(dir_ + "/draco/spot.M3.glb");
+  EXPECT_LT(dglb.size(), glb.size());
+  EXPECT_NE(dglb.find("\"extensionsRequired\":[\"KHR_draco_mesh_compression\"]"), std::string::npos);
+  const TriMesh m = read_mesh(dir_ + "/draco/spot.M3.glb");
+  EXPECT_EQ(m.triangles.size(), 256u);
+  const TopologyReport t = analyze_topology(m);
+  EXPECT_EQ(t.boundary_loops, 0u);
+  EXPECT_TRUE(t.manifold);
+  EXPECT_EQ(t.genus, 0);
+  const Outcome refused = geomip("remesh --quiet '" + spot_ + "' --level 3 -o '" + dir_ + "/nodraco' --draco");
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("--glb"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/nodraco"));
 }
 
 TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
@@ -687,6 +703,15 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
     EXPECT_EQ(info_of(dir_ + name), obj_info) << name;
   }
   expect_bad_input("decode -q '" + pack + "' -o '" + dir_ + "/x.stl'", "x.stl");
+  // --draco: KHR_draco_mesh_compression GLB, read back with the OBJ's counts and topology (positions quantized).
+  r = geomip("decode -q --draco '" + pack + "' -o '" + dir_ + "/draco.glb'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_LT(fs::file_size(dir_ + "/draco.glb"), fs::file_size(dir_ + "/full.glb") / 2);
+  const nlohmann::json draco_info = info_of(dir_ + "/draco.glb");
+  for (const char* key : {"vertices", "faces", "edges", "boundary_loops", "genus", "manifold"})
+    EXPECT_EQ(draco_info[key], obj_info[key]) << key;
+  expect_bad_input("decode -q --draco '" + pack + "' -o '" + dir_ + "/x.obj'", "--draco");
+  expect_bad_input("decode -q --draco=31 '" + pack + "' -o '" + dir_ + "/x.glb'", "--draco=31");
 }
 
 // Normal-mesh resampling is for one mesh: asked for with a consistent set it is refused before any work,

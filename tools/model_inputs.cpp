@@ -113,6 +113,31 @@ std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMe
   return ids;
 }
 
+// Genus ≥ 2 has no two-square (or 2×2 periodic) layout: quad layouts of increasing K, from the smallest the
+// genus allows (K + 2 − 2g = 4 coarse vertices), until one partitions the mesh.
+QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std::string& name,
+                                       const std::string& command, bool quiet) {
+  std::vector<int> ks;
+  for (int k : {2 * genus + 2, 4 * genus, 6 * genus, 8 * genus, 12 * genus, 16 * genus, 24 * genus, 32 * genus})
+    if (k + 2 - 2 * genus <= static_cast<int>(mesh.positions.size()) && (ks.empty() || k > ks.back())) ks.push_back(k);
+  std::string tried;
+  for (int k : ks) {
+    try {
+      QuadLayoutOptions options;
+      options.patches = k;
+      QuadLayoutChoice chosen = choose_quad_layout(mesh, options);
+      if (!quiet)
+        std::cerr << command << ": " << name << " has genus " << genus << ": automatic layout of " << k
+                  << " patches (--patches K chooses another)\n";
+      return chosen;
+    } catch (const InvalidInput&) {
+      tried += (tried.empty() ? "" : ", ") + std::to_string(k);
+    }
+  }
+  throw InvalidInput(name + ": genus " + std::to_string(genus) + ", and no automatic quad layout of " + tried +
+                     " patches partitions it; give its layout in a --points CORR.json");
+}
+
 }  // namespace
 
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file_arg,
@@ -149,7 +174,12 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
         in.mesh.positions.size() != input.positions.size() || in.mesh.triangles != input.triangles;
     const TriMesh& source = repaired ? input : in.mesh;
     const std::string where = points_file.empty() ? spec.mesh : points_file;
-    if (spec.partition_points.empty() && patches != 2) {
+    const int genus = spec.partition_points.empty() && patches == 2 ? analyze_topology(in.mesh).genus.value_or(0) : 0;
+    if (genus >= 2) {
+      const QuadLayoutChoice chosen = layout_for_high_genus(in.mesh, genus, spec.mesh, command, quiet);
+      in.partition_points = chosen.layout.corners;
+      in.layout_quads = chosen.layout.quads;
+    } else if (spec.partition_points.empty() && patches != 2) {
       QuadLayoutOptions layout_options;
       layout_options.patches = patches;
       const QuadLayoutChoice chosen = choose_quad_layout(in.mesh, layout_options);
@@ -188,7 +218,8 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
 
 void add_patches_option(CLI::App* cmd, int& patches) {
   cmd->add_option("--patches", patches,
-                  "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop; "
+                  "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop "
+                  "(genus 1: a 2x2 periodic grid; genus >= 2: the first K = 2g+2, 4g, 6g, ... quad layout that fits); "
                   "K >= 3 pairs the triangles of a coarse mesh into K quads (any genus: K + 2 - 2g >= 4)");
 }
 

@@ -29,8 +29,10 @@ struct ModelArgs {
   bool quiet = false;
   /// Curvature sampling exponent γ (SamplingWeightOptions::exponent); 0 = uniform geometric stretch.
   double sampling_exponent = SamplingWeightOptions{}.exponent;
-  /// --patches K: patches of the automatic layout. 2 = the two-square partition (choose_partition_points());
-  /// another K = a K-quad layout (choose_quad_layout()). Only without CORR.json.
+  /// --patches K: patches of the automatic layout. 2 = the two-square partition (choose_partition_points();
+  /// genus 1: the 2×2 periodic grid; genus ≥ 2, which has neither: the first K-quad layout, K = 2g+2, 4g, 6g,
+  /// 8g, 12g, … that partitions the mesh); another K = a K-quad layout (choose_quad_layout()). Only without
+  /// CORR.json.
   int patches = 2;
 };
 

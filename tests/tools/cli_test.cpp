@@ -765,6 +765,41 @@ TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
   EXPECT_FALSE(fs::exists(bad));
 }
 
+// Genus 2 (test::double_torus(): two tori joined by a tube) has no two-square layout: without --patches, remesh
+// and convert choose a K-quad layout themselves (and say so); remesh, the decoded pack and a prefix of it are
+// watertight with genus 2. --patches too small for the genus exits 2 with one line.
+TEST_F(CliPack, GenusTwoThroughRemeshConvertAndDecode) {
+  const std::string mesh = dir_ + "/double_torus.obj";
+  {
+    std::ofstream out(mesh);
+    write_mesh(test::double_torus(), out, MeshFormat::kObj);
+  }
+  ASSERT_EQ(analyze_topology(read_mesh(mesh)).genus, 2);
+  const std::string out = dir_ + "/g2";
+  Outcome r = geomip("remesh '" + mesh + "' --level 3 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("genus 2: automatic layout of "), std::string::npos) << r.err;
+  TopologyReport t = analyze_topology(read_mesh(out + "/double_torus.M3.obj"));
+  EXPECT_EQ(t.boundary_loops, 0u);
+  EXPECT_TRUE(t.manifold);
+  EXPECT_EQ(t.genus, 2);
+  const std::string pack = dir_ + "/g2.gip";
+  r = geomip("convert --quiet '" + mesh + "' --level 4 --no-normals -o '" + pack + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const std::string& bytes : {std::string(), " --bytes " + std::to_string(fs::file_size(pack) / 4)}) {
+    r = geomip("decode --quiet '" + pack + "'" + bytes + " -o '" + dir_ + "/g2.obj'");
+    ASSERT_EQ(r.exit_code, 0) << bytes << "\n" << r.err;
+    t = analyze_topology(read_mesh(dir_ + "/g2.obj"));
+    EXPECT_EQ(t.boundary_loops, 0u) << bytes;
+    EXPECT_TRUE(t.manifold) << bytes;
+    EXPECT_EQ(t.genus, 2) << bytes;
+  }
+  r = geomip("remesh '" + mesh + "' --patches 4 --level 2 -o '" + dir_ + "/bad'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/bad"));
+}
+
 // `geomip info PACK`: the chunk table as a reader receives it (cumulative sizes end at the file's size, in
 // file order), the first level's byte count is one `decode --bytes` accepts, and a non-pack is refused.
 TEST_F(CliPack, InfoDescribesAPack) {

@@ -20,7 +20,7 @@
 //     ordered coarse → fine across all models (pass 0 of every model, then pass 1, ...; normal-map passes
 //     trail the geometry passes), so any byte prefix of the file is a coarser level of detail of every model.
 //     Version 4: consecutive chunks form CRC groups — a chunk whose payload has at least crc_group_bytes
-//     (a manifest field; the writer's default 256) is a group of its own, smaller neighbours are gathered
+//     (a manifest field; the writer's default 64) is a group of its own, smaller neighbours are gathered
 //     until their payloads reach it (so the tiny top-plane chunks share one CRC) — and the last chunk of a
 //     group ends with a u32 CRC32 of the group's payloads (the file bytes from the group's first payload up
 //     to that trailer). ChunkInfo::size counts that trailer, so chunks still tile the file.
@@ -136,8 +136,9 @@ struct PackWriteOptions {
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// CRC groups (format version 4, see the layout above): chunks with smaller payloads share one CRC32
   /// trailer until their payloads reach this many bytes; ≥ 1. A prefix that ends inside a group uses only
-  /// its first chunk (as a partial chunk), so this bounds what a prefix can lose to ~this many bytes.
-  std::size_t crc_group_bytes = 256;
+  /// its first chunk (as a partial chunk), so this bounds what a prefix can lose to about this many bytes;
+  /// larger values save 4 bytes per merged chunk (trade-off measured in docs/codec-v3.md, "Header diet").
+  std::size_t crc_group_bytes = 64;
   /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.
   int normals_delay = 4;
   /// Hole masks: the manifest carries them this many levels coarser (fewer bytes before the first model);

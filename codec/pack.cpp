@@ -344,8 +344,8 @@ std::uint64_t samples_of(const GeometryCodecHeader& h) {
 }
 
 // CRC groups of format version 4 (pack.h): a chunk whose payload has at least `group_bytes` bytes is a group
-// of its own; smaller consecutive chunks are gathered until their payloads reach group_bytes. closes[c]: chunk
-// c ends its group (its CRC32 trailer follows its payload).
+// of its own; smaller consecutive chunks are gathered until their payloads reach group_bytes. closes[c]:
+// chunk c ends its group (its CRC32 trailer follows its payload).
 std::vector<bool> crc_group_ends(std::span<const std::uint64_t> payload_sizes, std::uint64_t group_bytes) {
   std::vector<bool> closes(payload_sizes.size(), false);
   std::uint64_t gathered = 0;
@@ -396,9 +396,8 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     model.has_normals = has_normals == 1;
     if (model.has_normals) {
       if (!read_codec_header(r, model.normals, out.version) || !codec_version_ok(model.normals.version) ||
-          model.normals.level > kMaxPackLevel ||
-          model.normals.num_patches != model.geometry.num_patches || passes_of(model.normals) < 1 ||
-          passes_of(model.normals) > static_cast<int>(kMaxPasses))
+          model.normals.level > kMaxPackLevel || model.normals.num_patches != model.geometry.num_patches ||
+          passes_of(model.normals) < 1 || passes_of(model.normals) > static_cast<int>(kMaxPasses))
         return Status::kCorrupt;
       samples += samples_of(model.normals);
     }
@@ -427,7 +426,8 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
       chunk_order(geometry_passes, normal_passes, fine_mask, static_cast<int>(normals_delay),
                   static_cast<int>(mask_stage));
   std::uint64_t group_bytes = 0, chunk_count;
-  if (out.version >= 4 && (!r.bounded(group_bytes, kMaxChunkSize) || group_bytes == 0)) return Status::kCorrupt;
+  if (out.version >= 4 && (!r.bounded(group_bytes, kMaxChunkSize) || group_bytes == 0))
+    return Status::kCorrupt;
   if (!r.varint(chunk_count) || chunk_count != order.size()) return Status::kCorrupt;
   std::vector<std::uint64_t> sizes(order.size());
   out.chunks.resize(order.size());
@@ -490,9 +490,12 @@ Status read_fixed_header(std::span<const std::uint8_t> bytes, FixedHeader& out) 
     std::size_t pos = sizeof kMagic + 2;
     std::uint64_t size = 0;
     switch (detail::read_varint(bytes, pos, size, 4, true)) {
-      case detail::VarintRead::kTruncated: return Status::kTruncated;
-      case detail::VarintRead::kCorrupt: return Status::kCorrupt;
-      case detail::VarintRead::kOk: break;
+      case detail::VarintRead::kTruncated:
+        return Status::kTruncated;
+      case detail::VarintRead::kCorrupt:
+        return Status::kCorrupt;
+      case detail::VarintRead::kOk:
+        break;
     }
     if (size > kMaxManifestSize) return Status::kCorrupt;
     if (bytes.size() < pos + 4) return Status::kTruncated;
@@ -630,7 +633,8 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
   std::vector<std::uint64_t> sizes;
   for (const ChunkKey& key : order) {
     sizes.push_back(segment(key).size());
-    if (sizes.back() > kMaxChunkSize - kCrcBytes) throw std::invalid_argument("write_pack: a chunk over 2 GiB");
+    if (sizes.back() > kMaxChunkSize - kCrcBytes)
+      throw std::invalid_argument("write_pack: a chunk over 2 GiB");
   }
   manifest.varint(options.crc_group_bytes);
   manifest.varint(order.size());
@@ -672,19 +676,23 @@ struct PackDecoder::State {
     bool has_fine_mask = false;
     std::vector<std::vector<std::uint8_t>> fine_mask;
     Status geometry_status = Status::kOk, normals_status = Status::kOk;
+    // The last update fed the stream bytes not yet verified (the open CRC group, see update()).
+    bool tentative_geometry = false, tentative_normals = false;
   };
   std::vector<Model> models;
-  std::ptrdiff_t tail_chunk = -1;  // the chunk whose prefix was decoded last (−1: none)
 
   std::span<const std::uint8_t> payload(std::span<const std::uint8_t> data, std::size_t c) const {
     return data.subspan(static_cast<std::size_t>(info.chunks[c].offset), info.chunks[c].payload_size());
   }
-  /// Feeds one model's stream (geometry or normals) its verified chunks and `tail`.
-  void feed(std::span<const std::uint8_t> data, Model& m, bool geometry, std::span<const std::uint8_t> tail) {
+  /// Feeds one model's stream (geometry or normals) its verified chunks, then the complete chunks `extra`
+  /// and `tail` (a byte prefix of the chunk after them).
+  void feed(std::span<const std::uint8_t> data, Model& m, bool geometry, std::span<const std::size_t> extra,
+            std::span<const std::uint8_t> tail) {
     const auto& list = geometry ? m.geometry_chunks : m.normal_chunks;
     std::vector<std::span<const std::uint8_t>> segments;
-    segments.reserve(list.size());
+    segments.reserve(list.size() + extra.size());
     for (std::size_t c : list) segments.push_back(payload(data, c));
+    for (std::size_t c : extra) segments.push_back(payload(data, c));
     (geometry ? m.geometry_status : m.normals_status) =
         (geometry ? m.geometry : m.normals).update(segments, tail);
   }
@@ -734,9 +742,9 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
       if (end.offset + end.size > data.size()) break;
       bool crc_ok = true;
       if (info.version >= 4) {
-        const auto group = data.subspan(static_cast<std::size_t>(info.chunks[first].offset),
-                                        static_cast<std::size_t>(end.offset + end.payload_size() -
-                                                                 info.chunks[first].offset));
+        const auto group = data.subspan(
+            static_cast<std::size_t>(info.chunks[first].offset),
+            static_cast<std::size_t>(end.offset + end.payload_size() - info.chunks[first].offset));
         ByteReader trailer(data.subspan(static_cast<std::size_t>(end.offset + end.payload_size()), 4));
         std::uint32_t crc = 0;
         crc_ok = end.crc_bytes == kCrcBytes && trailer.u32(crc) && (!kCheckCrc || crc32(group) == crc);
@@ -744,17 +752,7 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
         crc_ok = !kCheckCrc || crc32(st.payload(data, first)) == end.crc32;
       }
       if (!crc_ok) {
-        st.crc_failed = true;
-        // A prefix of the group's first chunk was decoded as a partial tail: decode its stream again
-        // without it.
-        const ChunkInfo& chunk = info.chunks[first];
-        if (st.tail_chunk == static_cast<std::ptrdiff_t>(first) && chunk.kind != ChunkKind::kHoleMask) {
-          const bool geometry = chunk.kind == ChunkKind::kGeometry;
-          State::Model& m = st.models[static_cast<std::size_t>(chunk.model)];
-          st.reset_stream(m, static_cast<std::size_t>(chunk.model), geometry);
-          st.feed(data, m, geometry, {});
-        }
-        st.tail_chunk = -1;
+        st.crc_failed = true;  // streams fed bytes of this group tentatively start over below
         break;
       }
       for (std::size_t c = first; c <= last; ++c) {
@@ -773,34 +771,48 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
       }
       st.next_chunk = last + 1;
     }
-    // The first chunk not verified (incomplete, or its group's trailer missing): a byte prefix of an
-    // embedded stream, at most its payload.
+    // The open group (the first one not verified: incomplete, or its trailer missing), with
+    // options.partial_chunks: its complete chunks and a byte prefix of the first incomplete one, unverified,
+    // as embedded streams (versions 1–3: the first incomplete chunk only). Hole masks wait for their CRC.
+    // Should the group's CRC fail once complete, the streams fed from it decode again without it.
     st.bytes_used = st.next_chunk == 0 ? info.manifest_end
                                        : static_cast<std::size_t>(info.chunks[st.next_chunk - 1].offset +
                                                                   info.chunks[st.next_chunk - 1].size);
     st.status = st.crc_failed ? Status::kCorrupt : Status::kOk;
-    std::ptrdiff_t tail = -1;
+    struct Open {
+      std::vector<std::size_t> complete;
+      std::span<const std::uint8_t> tail;
+    };
+    std::vector<Open> open_geometry(st.models.size()), open_normals(st.models.size());
     if (!st.crc_failed && st.next_chunk < info.chunks.size()) {
       st.status = Status::kTruncated;
-      const ChunkInfo& chunk = info.chunks[st.next_chunk];
-      if (options.partial_chunks && chunk.offset < data.size() && chunk.kind != ChunkKind::kHoleMask &&
-          (chunk.kind == ChunkKind::kGeometry || options.normals)) {
-        tail = static_cast<std::ptrdiff_t>(st.next_chunk);
-        st.bytes_used = static_cast<std::size_t>(
-            std::min<std::uint64_t>(data.size(), chunk.offset + chunk.payload_size()));
+      for (std::size_t c = st.next_chunk; options.partial_chunks && c < info.chunks.size(); ++c) {
+        const ChunkInfo& chunk = info.chunks[c];
+        if (chunk.offset >= data.size()) break;
+        const bool complete = chunk.offset + chunk.payload_size() <= data.size();
+        if (chunk.kind != ChunkKind::kHoleMask && (chunk.kind == ChunkKind::kGeometry || options.normals)) {
+          Open& open =
+              (chunk.kind == ChunkKind::kGeometry ? open_geometry
+                                                  : open_normals)[static_cast<std::size_t>(chunk.model)];
+          if (complete)
+            open.complete.push_back(c);
+          else
+            open.tail = data.subspan(static_cast<std::size_t>(chunk.offset));
+          st.bytes_used = static_cast<std::size_t>(
+              std::min<std::uint64_t>(data.size(), chunk.offset + chunk.payload_size()));
+        }
+        if (!complete || chunk.crc_bytes > 0 || info.version < 4) break;  // the group (v1–3: chunk) ends
       }
     }
-    st.tail_chunk = tail;
     for (std::size_t m = 0; m < st.models.size(); ++m) {
       State::Model& model = st.models[m];
-      const auto tail_of = [&](ChunkKind kind) {
-        if (tail < 0) return std::span<const std::uint8_t>{};
-        const ChunkInfo& chunk = info.chunks[static_cast<std::size_t>(tail)];
-        if (chunk.model != static_cast<int>(m) || chunk.kind != kind) return std::span<const std::uint8_t>{};
-        return data.subspan(static_cast<std::size_t>(chunk.offset)).first(st.bytes_used - chunk.offset);
+      const auto stream = [&](bool geometry, const Open& open, bool& tentative) {
+        if (st.crc_failed && tentative) st.reset_stream(model, m, geometry);
+        st.feed(data, model, geometry, open.complete, open.tail);
+        tentative = !open.complete.empty() || !open.tail.empty();
       };
-      st.feed(data, model, true, tail_of(ChunkKind::kGeometry));
-      if (model.with_normals) st.feed(data, model, false, tail_of(ChunkKind::kNormals));
+      stream(true, open_geometry[m], model.tentative_geometry);
+      if (model.with_normals) stream(false, open_normals[m], model.tentative_normals);
     }
   } catch (const std::exception&) {
     // The decoders do not throw on bytes; a failed allocation on a hostile manifest lands here.
@@ -839,11 +851,7 @@ PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
       if (sm.geometry_status != Status::kOk) result.status = Status::kCorrupt;
       model.geometry = std::move(decoded.patches);
       model.detail_level = decoded.detail_level;
-      const bool any_normals =
-          !sm.normal_chunks.empty() ||
-          (st.tail_chunk >= 0 &&
-           st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].model == static_cast<int>(m) &&
-           st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].kind == ChunkKind::kNormals);
+      const bool any_normals = !sm.normal_chunks.empty() || sm.tentative_normals;
       if (sm.with_normals && any_normals) {
         if (sm.normals_status != Status::kOk) result.status = Status::kCorrupt;
         if (normals) {

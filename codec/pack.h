@@ -9,18 +9,18 @@
 //                (kPackHeaderSize = 20 bytes)
 //   [manifest, manifest-size bytes]
 //     models (name, normalization transform, geometry / normal codec headers, hole masks), seams, and the
-//     chunk table: for each chunk (a model, kind and bit-plane pass, implied by the canonical order) its size.
-//     Chunk offsets follow from the sizes: chunk 0 starts right after the manifest.
-//     Version 4 (the header diet, docs/codec-v3.md): the table holds payload sizes only; the CRC32s trail the
-//     chunks (below). Doubles (normalization, codec origin and step) are stored as float32 where that is
-//     exact, behind one bit each; the codec header is stored without its 32 bytes of float64 origin/step,
-//     which follow compactly. Versions 1–3: each table entry is size + CRC32 of the chunk; doubles as
-//     float64; the codec header as GeometryCodecHeader::serialize() gives it.
+//     chunk table: for each chunk (a model, kind and bit-plane pass, implied by the canonical order) its
+//     size. Chunk offsets follow from the sizes: chunk 0 starts right after the manifest. Version 4 (the
+//     header diet, docs/codec-v3.md): the table holds payload sizes only; the CRC32s trail the chunks
+//     (below). Doubles (normalization, codec origin and step) are stored as float32 where that is exact,
+//     behind one bit each; the codec header is stored without its 32 bytes of float64 origin/step, which
+//     follow compactly. Versions 1–3: each table entry is size + CRC32 of the chunk; doubles as float64; the
+//     codec header as GeometryCodecHeader::serialize() gives it.
 //   [chunks, in table order]
 //     ordered coarse → fine across all models (pass 0 of every model, then pass 1, ...; normal-map passes
 //     trail the geometry passes), so any byte prefix of the file is a coarser level of detail of every model.
 //     Version 4: consecutive chunks form CRC groups — a chunk whose payload has at least crc_group_bytes
-//     (a manifest field; the writer's default 64) is a group of its own, smaller neighbours are gathered
+//     (a manifest field; the writer's default 256) is a group of its own, smaller neighbours are gathered
 //     until their payloads reach it (so the tiny top-plane chunks share one CRC) — and the last chunk of a
 //     group ends with a u32 CRC32 of the group's payloads (the file bytes from the group's first payload up
 //     to that trailer). ChunkInfo::size counts that trailer, so chunks still tile the file.
@@ -135,10 +135,9 @@ struct PackWriteOptions {
                                     .orientation_weights = false};
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// CRC groups (format version 4, see the layout above): chunks with smaller payloads share one CRC32
-  /// trailer until their payloads reach this many bytes; ≥ 1. A prefix that ends inside a group uses only
-  /// its first chunk (as a partial chunk), so this bounds what a prefix can lose to about this many bytes;
-  /// larger values save 4 bytes per merged chunk (trade-off measured in docs/codec-v3.md, "Header diet").
-  std::size_t crc_group_bytes = 64;
+  /// trailer until their payloads reach this many bytes; ≥ 1. Larger values save 4 bytes per merged chunk;
+  /// a viewer that decodes verified chunks only (partial_chunks = false) waits for a whole group.
+  std::size_t crc_group_bytes = 256;
   /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.
   int normals_delay = 4;
   /// Hole masks: the manifest carries them this many levels coarser (fewer bytes before the first model);
@@ -158,10 +157,12 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
 struct PackDecodeOptions {
   /// Use only the first max_bytes bytes of the buffer (as if only they had arrived).
   std::size_t max_bytes = std::numeric_limits<std::size_t>::max();
-  bool normals = true;         ///< decode normal maps when the pack has them
-  bool partial_chunks = true;  ///< also use a byte prefix of the first incomplete chunk (embedded streams)
-  int drop_finest_steps = 0;   ///< see GeometryDecodeOptions
-  int max_threads = 0;         ///< per-patch decoding threads, see GeometryDecodeOptions
+  bool normals = true;  ///< decode normal maps when the pack has them
+  /// Also use the bytes not yet verified: a byte prefix of the first incomplete chunk (embedded streams)
+  /// and, in version 4, the complete chunks of its CRC group before it.
+  bool partial_chunks = true;
+  int drop_finest_steps = 0;  ///< see GeometryDecodeOptions
+  int max_threads = 0;        ///< per-patch decoding threads, see GeometryDecodeOptions
 };
 
 struct DecodedModel {
@@ -180,8 +181,10 @@ struct PackDecodeResult {
   /// kOk: every chunk decoded. kTruncated: the bytes end early; `models` hold what the prefix gives (empty if
   /// it ends inside the manifest). kCorrupt: a chunk (version 4: a CRC group) failed its CRC (decoding
   /// stopped at the last good pass of every model) or the manifest is damaged. kUnsupportedVersion: another
-  /// format version. Version 4: the complete chunks of a group whose trailer has not arrived are not used,
-  /// except the group's first chunk as a partial chunk (options.partial_chunks).
+  /// format version. With options.partial_chunks, the chunks of the first group not verified (version 4:
+  /// its trailer has not arrived; versions 1–3: the first incomplete chunk) are used as far as they have
+  /// arrived, unverified, as a partial chunk always was; if that group's CRC fails once it is complete, its
+  /// streams decode again without it.
   Status status = Status::kOk;
   PackInfo info;
   std::vector<DecodedModel> models;
@@ -196,8 +199,8 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
 /// the longer prefix received so far and decodes only what is new in it (GeometryDecoder per model and
 /// stream: each byte is decoded once), result() gives the models. After any sequence of updates, result()
 /// equals decode_pack() of the last update's bytes with the same options bit for bit (for packs of the
-/// encoder; a chunk whose CRC fails after a prefix of it was decoded makes its model decode again from its
-/// verified chunks, as decode_pack() would).
+/// encoder; a chunk or CRC group that fails its CRC after unverified bytes of it were decoded makes the
+/// streams fed from it decode again from their verified chunks, as decode_pack() would).
 class PackDecoder {
  public:
   explicit PackDecoder(const PackDecodeOptions& options = {});

@@ -250,7 +250,8 @@ TEST(Pack, HoleMaskIsCoarseUntilItsChunkArrives) {
       EXPECT_EQ(coarse[static_cast<std::size_t>(cj * 8 + ci)], count >= 8 ? 1 : 0) << ci << "," << cj;
     }
   // The fine masks are used once their CRC group (version 4) is complete.
-  const auto group_end = std::find_if(chunk, info.chunks.end(), [](const ChunkInfo& c) { return c.crc_bytes > 0; });
+  const auto group_end =
+      std::find_if(chunk, info.chunks.end(), [](const ChunkInfo& c) { return c.crc_bytes > 0; });
   ASSERT_NE(group_end, info.chunks.end());
   const PackDecodeResult after =
       decode_pack(pack, {.max_bytes = static_cast<std::size_t>(group_end->offset + group_end->size)});
@@ -327,7 +328,8 @@ TEST(Pack, CrcGroupsGatherSmallChunksAndTileTheFile) {
       ++groups;
       gathered = 0;
       // The trailer is the CRC32 of the group's payloads.
-      const std::uint64_t begin = info.chunks[chunk.group_first].offset, end = chunk.offset + chunk.payload_size();
+      const std::uint64_t begin = info.chunks[chunk.group_first].offset,
+                          end = chunk.offset + chunk.payload_size();
       std::uint32_t stored = 0;
       for (int k = 0; k < 4; ++k) stored |= static_cast<std::uint32_t>(pack[end + k]) << (8 * k);
       EXPECT_EQ(stored, crc32(std::span(pack).subspan(begin, end - begin))) << c;
@@ -337,10 +339,56 @@ TEST(Pack, CrcGroupsGatherSmallChunksAndTileTheFile) {
   EXPECT_LT(groups, info.chunks.size()) << "the tiny top planes share a CRC";
 }
 
+// The open CRC group (its trailer not yet arrived) is used unverified, as a partial chunk is: the first
+// passes of every model decode before the first trailer; once complete and verified it gives the same
+// models; if its CRC fails, the incremental decoder drops what it took from it (as the one-shot decode).
+TEST(Pack, OpenCrcGroupIsUsedUntilItsCrcFails) {
+  const std::vector<std::uint8_t> pack =
+      write_pack({pillow_model(4, "a"), pillow_model(4, "b", 1.5)}, geometry_only());
+  PackInfo info;
+  ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
+  const auto end = std::find_if(info.chunks.begin(), info.chunks.end(),
+                                [](const ChunkInfo& c) { return c.crc_bytes > 0; });
+  ASSERT_NE(end, info.chunks.end());
+  ASSERT_GE(end - info.chunks.begin(), 2) << "the first group holds pass 0 of both models";
+  const std::size_t before_trailer = static_cast<std::size_t>(end->offset + end->payload_size());
+  const PackDecodeResult open = decode_pack(pack, {.max_bytes = before_trailer});
+  const PackDecodeResult verified =
+      decode_pack(pack, {.max_bytes = before_trailer + 4, .partial_chunks = false});
+  ASSERT_EQ(open.status, Status::kTruncated);
+  EXPECT_EQ(open.chunks_decoded, 0u);
+  EXPECT_EQ(verified.chunks_decoded, static_cast<std::size_t>(end - info.chunks.begin()) + 1);
+  ASSERT_EQ(open.models.size(), 2u);
+  for (std::size_t m = 0; m < 2; ++m) {
+    EXPECT_GT(
+        rms_error(open.models[m].geometry, std::vector<Grid3>(2, Grid3{4, std::vector<float>(17 * 17 * 3)})),
+        0)
+        << "model " << m << " has a shape before the trailer";
+    for (std::size_t p = 0; p < 2; ++p)
+      EXPECT_EQ(open.models[m].geometry[p].values, verified.models[m].geometry[p].values) << m;
+  }
+  // The same group damaged: before its trailer the damage is not seen; with it, everything from the group
+  // on is dropped, incrementally as one-shot.
+  std::vector<std::uint8_t> bad = pack;
+  bad[before_trailer - 1] ^= 0x10;
+  PackDecoder decoder;
+  decoder.update(std::span(bad).first(before_trailer));
+  EXPECT_EQ(decoder.result().status, Status::kTruncated);
+  decoder.update(bad);
+  const PackDecodeResult incremental = decoder.result(), one_shot = decode_pack(bad);
+  EXPECT_EQ(one_shot.status, Status::kCorrupt);
+  EXPECT_EQ(incremental.status, Status::kCorrupt);
+  EXPECT_EQ(incremental.chunks_decoded, 0u);
+  ASSERT_EQ(incremental.models.size(), 2u);
+  for (std::size_t m = 0; m < 2; ++m)
+    for (std::size_t p = 0; p < 2; ++p)
+      EXPECT_EQ(incremental.models[m].geometry[p].values, one_shot.models[m].geometry[p].values) << m;
+}
+
 // Doubles of version 4 are float32 only where that is exact: any normalization round-trips bit for bit.
 TEST(Pack, NormalizationRoundTripsBitForBit) {
   const std::array<double, 16> transforms[] = {
-      {0.25, 0, 0, -1.5, 0, 0.25, 0, 2, 0, 0, 0.25, -0.0, 0, 0, 0, 1},                       // float32-exact
+      {0.25, 0, 0, -1.5, 0, 0.25, 0, 2, 0, 0, 0.25, -0.0, 0, 0, 0, 1},                 // float32-exact
       {1.0 / 3, 0, 0, 0.1, 0, 1.0 / 3, 0, -1e-300, 0, 0, 1.0 / 3, 1e300, 0, 0, 0, 1},  // not
       {1, 2, 3, 4, 5, 6, 7, 8.5, 0.1, 0.2, 0.3, 0.4, 0, 0, 0, 1},                      // full, mixed
   };
@@ -366,7 +414,8 @@ std::vector<std::uint8_t> per_patch_pack(std::vector<PackModelInput>* models_out
     for (int j = 1; j + 1 < size; ++j)
       for (int i = 1; i + 1 < size; ++i)
         for (int c = 0; c < 3; ++c) {
-          const unsigned hash = (static_cast<unsigned>(i) * 73856093u) ^ (static_cast<unsigned>(j) * 19349663u) ^
+          const unsigned hash = (static_cast<unsigned>(i) * 73856093u) ^
+                                (static_cast<unsigned>(j) * 19349663u) ^
                                 (static_cast<unsigned>(c) * 83492791u);
           g.values[3 * (static_cast<std::size_t>(j) * size + i) + c] +=
               0.003f * (static_cast<float>(hash % 1001) / 500.0f - 1.0f);
@@ -416,7 +465,8 @@ TEST(PackPerPatch, EveryBytePrefixDecodesWatertight) {
     ASSERT_EQ(m.geometry.size(), 2u) << n;
     ASSERT_EQ(seam_mismatches(m.geometry, m.seams), 0u) << "prefix " << n;
     for (const Grid3& g : m.geometry)
-      ASSERT_TRUE(std::all_of(g.values.begin(), g.values.end(), [](float v) { return std::isfinite(v); })) << n;
+      ASSERT_TRUE(std::all_of(g.values.begin(), g.values.end(), [](float v) { return std::isfinite(v); }))
+          << n;
     EXPECT_GE(m.detail_level, detail_level) << "a longer prefix never gives a coarser level: " << n;
     detail_level = m.detail_level;
   }
@@ -437,7 +487,8 @@ TEST(PackPerPatch, EverySingleBitFlipIsRefusedOrACoarserModel) {
   const std::size_t stride = std::max<std::size_t>(1, chunk_bits / 2000) | 1;  // odd: every bit position
   for (std::size_t b = 8 * info.manifest_end; b < 8 * pack.size(); b += stride) bits.push_back(b);
   for (const ChunkInfo& c : info.chunks)  // every trailer's first and last bit
-    if (c.crc_bytes) bits.insert(bits.end(), {8 * (c.offset + c.payload_size()), 8 * (c.offset + c.size) - 1});
+    if (c.crc_bytes)
+      bits.insert(bits.end(), {8 * (c.offset + c.payload_size()), 8 * (c.offset + c.size) - 1});
   std::map<std::size_t, PackDecodeResult> coarser;  // by group: the prefix that ends before it
   for (std::size_t bit : bits) {
     std::vector<std::uint8_t> bad = pack;
@@ -457,12 +508,13 @@ TEST(PackPerPatch, EverySingleBitFlipIsRefusedOrACoarserModel) {
     EXPECT_EQ(r.chunks_decoded, first) << "bit " << bit;
     auto expected = coarser.find(first);
     if (expected == coarser.end())
-      expected = coarser
-                     .emplace(first, decode_pack(pack, {.max_bytes = static_cast<std::size_t>(
-                                                            info.chunks[first].offset),
-                                                        .partial_chunks = false,
-                                                        .max_threads = 1}))
-                     .first;
+      expected =
+          coarser
+              .emplace(first,
+                       decode_pack(pack, {.max_bytes = static_cast<std::size_t>(info.chunks[first].offset),
+                                          .partial_chunks = false,
+                                          .max_threads = 1}))
+              .first;
     ASSERT_EQ(r.models.size(), 1u) << "bit " << bit;
     const DecodedModel& m = r.models[0];
     EXPECT_EQ(seam_mismatches(m.geometry, m.seams), 0u) << "bit " << bit;
@@ -472,9 +524,8 @@ TEST(PackPerPatch, EverySingleBitFlipIsRefusedOrACoarserModel) {
 }
 
 // The committed golden packs (tests/data/golden-pillow.gip written by format version 1, golden-pillow-v2.gip
-// by version 2, golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4) must keep decoding to the pillow they were made from:
-// decoders of old streams do not silently
-// change.
+// by version 2, golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4) must keep decoding to
+// the pillow they were made from: decoders of old streams do not silently change.
 class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
 
 TEST_P(GoldenPack, Decodes) {

@@ -54,7 +54,8 @@ inline std::vector<std::uint8_t> craft_pack(std::span<const std::uint8_t> pack,
   edit(sizes);
   std::vector<std::uint8_t> manifest(pack.begin() + static_cast<std::ptrdiff_t>(header_size),
                                      pack.begin() + static_cast<std::ptrdiff_t>(table_at));
-  put_varint(manifest, static_cast<std::uint64_t>(static_cast<std::int64_t>(info.chunks.size()) + count_delta));
+  put_varint(manifest,
+             static_cast<std::uint64_t>(static_cast<std::int64_t>(info.chunks.size()) + count_delta));
   for (std::size_t c = 0; c < sizes.size(); ++c) {
     put_varint(manifest, sizes[c]);
     if (v4) continue;

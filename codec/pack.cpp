@@ -3,7 +3,10 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <stdexcept>
 #include <tuple>
 
@@ -46,35 +49,121 @@ bool is_scale_translate(const std::array<double, 16>& m) {
          m[13] == 0 && m[14] == 0 && m[15] == 1 && m[0] == m[5] && m[0] == m[10];
 }
 
-void write_normalization(ByteWriter& w, const std::array<double, 16>& m) {
+// Doubles of format version 4: one bit per value (in ⌈n/8⌉ bytes, value k in bit k % 8 of byte k / 8) says
+// it is stored as float32 (4 bytes; only where that is exact, −0 and all), else as float64 (8 bytes). Older
+// versions store float64 throughout.
+bool exact_as_float(double v) {
+  return std::isfinite(v) && std::abs(v) <= std::numeric_limits<float>::max() &&
+         std::bit_cast<std::uint64_t>(static_cast<double>(static_cast<float>(v))) ==
+             std::bit_cast<std::uint64_t>(v);
+}
+
+void write_doubles(ByteWriter& w, std::span<const double> values, std::uint16_t version) {
+  if (version < 4) {
+    for (double v : values) w.f64(v);
+    return;
+  }
+  for (std::size_t k = 0; k < values.size(); k += 8) {
+    std::uint8_t bits = 0;
+    for (std::size_t i = k; i < std::min(values.size(), k + 8); ++i)
+      if (exact_as_float(values[i])) bits |= static_cast<std::uint8_t>(1u << (i - k));
+    w.u8(bits);
+  }
+  for (double v : values) {
+    if (exact_as_float(v))
+      w.u32(std::bit_cast<std::uint32_t>(static_cast<float>(v)));
+    else
+      w.f64(v);
+  }
+}
+
+bool read_doubles(ByteReader& r, std::span<double> values, std::uint16_t version) {
+  if (version < 4) return std::all_of(values.begin(), values.end(), [&](double& v) { return r.f64(v); });
+  std::vector<std::uint8_t> bits((values.size() + 7) / 8);
+  for (std::uint8_t& b : bits)
+    if (!r.u8(b)) return false;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (bits[i / 8] >> (i % 8) & 1) {
+      std::uint32_t f;
+      if (!r.u32(f)) return false;
+      values[i] = static_cast<double>(std::bit_cast<float>(f));
+    } else if (!r.f64(values[i])) {
+      return false;
+    }
+  }
+  return true;
+}
+
+void write_normalization(ByteWriter& w, const std::array<double, 16>& m, std::uint16_t version) {
   if (is_identity(m)) {
     w.u8(kIdentity);
   } else if (is_scale_translate(m)) {
     w.u8(kScaleTranslate);
-    for (double v : {m[0], m[3], m[7], m[11]}) w.f64(v);
+    const double values[4] = {m[0], m[3], m[7], m[11]};
+    write_doubles(w, values, version);
   } else {
     w.u8(kFull);
-    for (double v : m) w.f64(v);
+    write_doubles(w, m, version);
   }
 }
 
-bool read_normalization(ByteReader& r, std::array<double, 16>& m) {
+bool read_normalization(ByteReader& r, std::array<double, 16>& m, std::uint16_t version) {
   std::uint8_t form;
   if (!r.u8(form)) return false;
   m = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   if (form == kIdentity) return true;
   if (form == kScaleTranslate) {
-    double s, tx, ty, tz;
-    if (!(r.f64(s) && r.f64(tx) && r.f64(ty) && r.f64(tz))) return false;
-    m[0] = m[5] = m[10] = s;
-    m[3] = tx, m[7] = ty, m[11] = tz;
+    double v[4];
+    if (!read_doubles(r, v, version)) return false;
+    m[0] = m[5] = m[10] = v[0];
+    m[3] = v[1], m[7] = v[2], m[11] = v[3];
   } else if (form == kFull) {
-    for (double& v : m)
-      if (!r.f64(v)) return false;
+    if (!read_doubles(r, m, version)) return false;
   } else {
     return false;
   }
   return std::all_of(m.begin(), m.end(), [](double v) { return std::isfinite(v); });
+}
+
+// Codec headers of format version 4: GeometryCodecHeader::serialize() without the 32 bytes of its float64
+// origin[3] and step (little-endian, in that order) — varint size of the rest, varint offset where the 32
+// bytes were cut, the rest — followed by origin and step as compact doubles. The reader puts the 32 bytes
+// back and parses; the origin and step it then reads must be the compact ones. Older versions store
+// serialize()'s bytes as they are (varint size + bytes).
+void write_codec_header(ByteWriter& w, const GeometryCodecHeader& h, std::uint16_t version) {
+  std::vector<std::uint8_t> bytes = h.serialize();
+  if (version < 4) {
+    w.bytes(bytes);
+    return;
+  }
+  const double values[4] = {h.origin[0], h.origin[1], h.origin[2], h.step};
+  ByteWriter f64s;
+  for (double v : values) f64s.f64(v);
+  const auto at = std::search(bytes.begin(), bytes.end(), f64s.data().begin(), f64s.data().end());
+  if (at == bytes.end()) throw std::logic_error("write_pack: codec header without its float64 origin/step");
+  const auto offset = static_cast<std::size_t>(at - bytes.begin());
+  bytes.erase(at, at + 32);
+  w.varint(offset);
+  w.bytes(bytes);
+  write_doubles(w, values, version);
+}
+
+bool read_codec_header(ByteReader& r, GeometryCodecHeader& h, std::uint16_t version) {
+  std::vector<std::uint8_t> bytes;
+  if (version < 4) return r.bytes(bytes, 1 << 20) && GeometryCodecHeader::parse(bytes, h) == Status::kOk;
+  std::uint64_t offset;
+  double values[4];
+  if (!r.bounded(offset, 1 << 20) || !r.bytes(bytes, 1 << 20) || offset > bytes.size() ||
+      !read_doubles(r, values, version))
+    return false;
+  ByteWriter f64s;
+  for (double v : values) f64s.f64(v);
+  bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(offset), f64s.data().begin(), f64s.data().end());
+  if (GeometryCodecHeader::parse(bytes, h) != Status::kOk) return false;
+  const double parsed[4] = {h.origin[0], h.origin[1], h.origin[2], h.step};
+  return std::equal(parsed, parsed + 4, values, [](double a, double b) {
+    return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+  });
 }
 
 // Hole mask of one patch, `side` × `side` quads: a flag byte (0 = no masked quad), then the bits in raster
@@ -254,6 +343,33 @@ std::uint64_t samples_of(const GeometryCodecHeader& h) {
   return n * n * static_cast<std::uint64_t>(h.num_patches);
 }
 
+// CRC groups of format version 4 (pack.h): a chunk whose payload has at least `group_bytes` bytes is a group
+// of its own; smaller consecutive chunks are gathered until their payloads reach group_bytes. closes[c]:
+// chunk c ends its group (its CRC32 trailer follows its payload).
+std::vector<bool> crc_group_ends(std::span<const std::uint64_t> payload_sizes, std::uint64_t group_bytes) {
+  std::vector<bool> closes(payload_sizes.size(), false);
+  std::uint64_t gathered = 0;
+  bool open = false;
+  for (std::size_t c = 0; c < payload_sizes.size(); ++c) {
+    if (payload_sizes[c] >= group_bytes) {
+      if (open) closes[c - 1] = true;
+      closes[c] = true;
+      gathered = 0, open = false;
+      continue;
+    }
+    gathered += payload_sizes[c], open = true;
+    if (gathered >= group_bytes) {
+      closes[c] = true;
+      gathered = 0, open = false;
+    }
+  }
+  if (open) closes.back() = true;
+  return closes;
+}
+
+constexpr std::uint32_t kCrcBytes = 4;
+constexpr std::uint64_t kMaxChunkSize = 0x7fffffff;
+
 Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_end, PackInfo& out) {
   ByteReader r(bytes);
   std::uint64_t model_count, normals_delay, mask_stage;
@@ -265,24 +381,23 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
   std::vector<bool> fine_mask;
   std::uint64_t samples = 0;
   for (PackModelInfo& model : out.models) {
-    std::vector<std::uint8_t> header;
     std::uint8_t has_normals;
-    if (!r.string(model.name, kMaxNameSize) || !read_normalization(r, model.normalization) ||
-        !r.bytes(header, 1 << 20) || GeometryCodecHeader::parse(header, model.geometry) != Status::kOk ||
-        !r.u8(has_normals) || has_normals > 1)
+    if (!r.string(model.name, kMaxNameSize) || !read_normalization(r, model.normalization, out.version) ||
+        !read_codec_header(r, model.geometry, out.version) || !r.u8(has_normals) || has_normals > 1)
       return Status::kCorrupt;
-    // Pack version v holds codec headers of version v (1: joint streams, 2: per-patch ones, 3: local frames).
-    if (model.geometry.version != out.version) return Status::kCorrupt;
+    // Pack version v ≤ 3 holds codec headers of version v (1: joint streams, 2: per-patch ones, 3: local
+    // frames); version 4 (a container change) those of version 3 or later.
+    const auto codec_version_ok = [&](int v) { return out.version >= 4 ? v >= 3 : v == out.version; };
+    if (!codec_version_ok(model.geometry.version)) return Status::kCorrupt;
     if (model.geometry.level > kMaxPackLevel || passes_of(model.geometry) < 1 ||
         passes_of(model.geometry) > static_cast<int>(kMaxPasses))
       return Status::kCorrupt;
     samples += samples_of(model.geometry);
     model.has_normals = has_normals == 1;
     if (model.has_normals) {
-      if (!r.bytes(header, 1 << 20) || GeometryCodecHeader::parse(header, model.normals) != Status::kOk ||
-          model.normals.version != out.version || model.normals.level > kMaxPackLevel ||
-          model.normals.num_patches != model.geometry.num_patches || passes_of(model.normals) < 1 ||
-          passes_of(model.normals) > static_cast<int>(kMaxPasses))
+      if (!read_codec_header(r, model.normals, out.version) || !codec_version_ok(model.normals.version) ||
+          model.normals.level > kMaxPackLevel || model.normals.num_patches != model.geometry.num_patches ||
+          passes_of(model.normals) < 1 || passes_of(model.normals) > static_cast<int>(kMaxPasses))
         return Status::kCorrupt;
       samples += samples_of(model.normals);
     }
@@ -310,20 +425,33 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
   const std::vector<ChunkKey> order =
       chunk_order(geometry_passes, normal_passes, fine_mask, static_cast<int>(normals_delay),
                   static_cast<int>(mask_stage));
-  std::uint64_t chunk_count;
+  std::uint64_t group_bytes = 0, chunk_count;
+  if (out.version >= 4 && (!r.bounded(group_bytes, kMaxChunkSize) || group_bytes == 0))
+    return Status::kCorrupt;
   if (!r.varint(chunk_count) || chunk_count != order.size()) return Status::kCorrupt;
+  std::vector<std::uint64_t> sizes(order.size());
   out.chunks.resize(order.size());
+  for (std::size_t c = 0; c < order.size(); ++c) {
+    // Version 4: the payload, the chunk with its trailer < 2^31 too.
+    if (!r.bounded(sizes[c], out.version >= 4 ? kMaxChunkSize - kCrcBytes : kMaxChunkSize))
+      return Status::kCorrupt;
+    if (out.version < 4 && !r.u32(out.chunks[c].crc32)) return Status::kCorrupt;
+  }
+  const std::vector<bool> closes =
+      out.version >= 4 ? crc_group_ends(sizes, group_bytes) : std::vector<bool>(order.size(), true);
   std::uint64_t offset = manifest_end;
+  std::size_t group_first = 0;
   for (std::size_t c = 0; c < order.size(); ++c) {
     ChunkInfo& chunk = out.chunks[c];
-    std::uint64_t size;
-    if (!r.bounded(size, 0x7fffffff) || !r.u32(chunk.crc32)) return Status::kCorrupt;
     chunk.model = order[c].model;
     chunk.kind = static_cast<ChunkKind>(order[c].kind);
     chunk.pass = order[c].pass;
     chunk.offset = offset;
-    chunk.size = static_cast<std::uint32_t>(size);
-    offset += size;
+    chunk.crc_bytes = out.version >= 4 && closes[c] ? kCrcBytes : 0;
+    chunk.size = static_cast<std::uint32_t>(sizes[c] + chunk.crc_bytes);
+    chunk.group_first = group_first;
+    if (closes[c]) group_first = c + 1;
+    offset += chunk.size;
   }
   if (r.remaining() != 0) return Status::kCorrupt;
   return Status::kOk;
@@ -342,33 +470,68 @@ std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
   return static_cast<std::uint32_t>(crc);
 }
 
-Status read_pack_header(std::span<const std::uint8_t> bytes, std::size_t& manifest_end) {
+namespace {
+
+struct FixedHeader {
+  std::uint16_t version = 0;
+  std::size_t size = 0;  // bytes of the fixed header: the manifest starts here
+  std::uint32_t manifest_size = 0, manifest_crc = 0;
+};
+
+Status read_fixed_header(std::span<const std::uint8_t> bytes, FixedHeader& out) {
   const std::size_t n = std::min(bytes.size(), sizeof kMagic);
   if (!std::equal(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n), kMagic))
     return Status::kCorrupt;
-  if (bytes.size() < kPackHeaderSize) return Status::kTruncated;
+  if (bytes.size() < sizeof kMagic + 2) return Status::kTruncated;
   ByteReader r(bytes.subspan(sizeof kMagic));
-  std::uint16_t version = 0, flags = 0;
-  std::uint32_t manifest_size = 0, manifest_crc = 0;
-  r.u16(version), r.u16(flags), r.u32(manifest_size), r.u32(manifest_crc);
-  if (version < kOldestPackVersion || version > kPackVersion) return Status::kUnsupportedVersion;
-  if (flags != 0 || manifest_size > kMaxManifestSize) return Status::kCorrupt;
-  manifest_end = kPackHeaderSize + manifest_size;
+  r.u16(out.version);
+  if (out.version < kOldestPackVersion || out.version > kPackVersion) return Status::kUnsupportedVersion;
+  if (out.version >= 4) {
+    std::size_t pos = sizeof kMagic + 2;
+    std::uint64_t size = 0;
+    switch (detail::read_varint(bytes, pos, size, 4, true)) {
+      case detail::VarintRead::kTruncated:
+        return Status::kTruncated;
+      case detail::VarintRead::kCorrupt:
+        return Status::kCorrupt;
+      case detail::VarintRead::kOk:
+        break;
+    }
+    if (size > kMaxManifestSize) return Status::kCorrupt;
+    if (bytes.size() < pos + 4) return Status::kTruncated;
+    ByteReader crc(bytes.subspan(pos));
+    crc.u32(out.manifest_crc);
+    out.size = pos + 4;
+    out.manifest_size = static_cast<std::uint32_t>(size);
+    return Status::kOk;
+  }
+  if (bytes.size() < kPackHeaderSize) return Status::kTruncated;
+  std::uint16_t flags = 0;
+  r.u16(flags), r.u32(out.manifest_size), r.u32(out.manifest_crc);
+  if (flags != 0 || out.manifest_size > kMaxManifestSize) return Status::kCorrupt;
+  out.size = kPackHeaderSize;
+  return Status::kOk;
+}
+
+}  // namespace
+
+Status read_pack_header(std::span<const std::uint8_t> bytes, std::size_t& manifest_end) {
+  FixedHeader h;
+  if (Status s = read_fixed_header(bytes, h); s != Status::kOk) return s;
+  manifest_end = h.size + h.manifest_size;
   return Status::kOk;
 }
 
 Status read_pack_info(std::span<const std::uint8_t> bytes, PackInfo& out) {
   out = {};
-  std::size_t manifest_end = 0;
-  if (Status s = read_pack_header(bytes, manifest_end); s != Status::kOk) return s;
+  FixedHeader h;
+  if (Status s = read_fixed_header(bytes, h); s != Status::kOk) return s;
+  const std::size_t manifest_end = h.size + h.manifest_size;
   if (bytes.size() < manifest_end) return Status::kTruncated;
-  ByteReader r(bytes.subspan(16));
-  std::uint32_t manifest_crc = 0;
-  r.u32(manifest_crc);
-  const auto manifest = bytes.subspan(kPackHeaderSize, manifest_end - kPackHeaderSize);
-  if (kCheckCrc && crc32(manifest) != manifest_crc) return Status::kCorrupt;
+  const auto manifest = bytes.subspan(h.size, h.manifest_size);
+  if (kCheckCrc && crc32(manifest) != h.manifest_crc) return Status::kCorrupt;
   out.manifest_end = manifest_end;
-  out.version = static_cast<std::uint16_t>(bytes[8] | bytes[9] << 8);
+  out.version = h.version;
   const Status s = parse_manifest(manifest, manifest_end, out);
   if (s != Status::kOk) out = {};
   return s;
@@ -380,6 +543,8 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
   if (models.size() > kMaxModels) throw std::invalid_argument("write_pack: more than 64 models");
   if (options.normals_delay < 0 || options.normals_delay > static_cast<int>(kMaxPasses))
     throw std::invalid_argument("write_pack: normals_delay outside [0, 64]");
+  if (options.crc_group_bytes < 1 || options.crc_group_bytes > kMaxChunkSize)
+    throw std::invalid_argument("write_pack: crc_group_bytes outside [1, 2^31)");
   std::vector<EncodedGeometry> geometry(models.size()), normals(models.size());
   std::vector<int> geometry_passes, normal_passes, mask_level;
   for (std::size_t m = 0; m < models.size(); ++m) {
@@ -446,10 +611,10 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
   manifest.varint(static_cast<std::uint64_t>(mask_stage));
   for (std::size_t m = 0; m < models.size(); ++m) {
     manifest.string(models[m].name);
-    write_normalization(manifest, models[m].normalization);
-    manifest.bytes(geometry[m].header.serialize());
+    write_normalization(manifest, models[m].normalization, kPackVersion);
+    write_codec_header(manifest, geometry[m].header, kPackVersion);
     manifest.u8(normal_passes[m] > 0 ? 1 : 0);
-    if (normal_passes[m] > 0) manifest.bytes(normals[m].header.serialize());
+    if (normal_passes[m] > 0) write_codec_header(manifest, normals[m].header, kPackVersion);
     manifest.varint(models[m].hole_mask.size());
     if (!models[m].hole_mask.empty()) {
       manifest.u8(static_cast<std::uint8_t>(mask_level[m]));
@@ -459,27 +624,39 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
   }
   const std::vector<ChunkKey> order =
       chunk_order(geometry_passes, normal_passes, fine_mask, options.normals_delay, mask_stage);
-  manifest.varint(order.size());
   auto segment = [&](const ChunkKey& key) -> const std::vector<std::uint8_t>& {
     if (key.kind == 2) return fine_mask_bytes[static_cast<std::size_t>(key.model)];
     const auto& encoded = key.kind == 0 ? geometry[static_cast<std::size_t>(key.model)]
                                         : normals[static_cast<std::size_t>(key.model)];
     return encoded.segments[static_cast<std::size_t>(key.pass)];
   };
+  std::vector<std::uint64_t> sizes;
   for (const ChunkKey& key : order) {
-    manifest.varint(segment(key).size());
-    manifest.u32(crc32(segment(key)));
+    sizes.push_back(segment(key).size());
+    if (sizes.back() > kMaxChunkSize - kCrcBytes)
+      throw std::invalid_argument("write_pack: a chunk over 2 GiB");
   }
+  manifest.varint(options.crc_group_bytes);
+  manifest.varint(order.size());
+  for (std::uint64_t size : sizes) manifest.varint(size);
+  const std::vector<bool> closes = crc_group_ends(sizes, options.crc_group_bytes);
 
   ByteWriter file;
   for (std::uint8_t b : kMagic) file.u8(b);
   file.u16(kPackVersion);
-  file.u16(0);
-  file.u32(static_cast<std::uint32_t>(manifest.data().size()));
+  file.varint(manifest.data().size());
   file.u32(crc32(manifest.data()));
   std::vector<std::uint8_t>& out = file.data();
   out.insert(out.end(), manifest.data().begin(), manifest.data().end());
-  for (const ChunkKey& key : order) out.insert(out.end(), segment(key).begin(), segment(key).end());
+  std::size_t group_begin = out.size();
+  for (std::size_t c = 0; c < order.size(); ++c) {
+    out.insert(out.end(), segment(order[c]).begin(), segment(order[c]).end());
+    if (!closes[c]) continue;
+    const std::uint32_t crc =
+        crc32(std::span<const std::uint8_t>(out).subspan(group_begin, out.size() - group_begin));
+    for (int k = 0; k < 4; ++k) out.push_back(static_cast<std::uint8_t>(crc >> (8 * k)));
+    group_begin = out.size();
+  }
   return std::move(out);
 }
 
@@ -499,19 +676,23 @@ struct PackDecoder::State {
     bool has_fine_mask = false;
     std::vector<std::vector<std::uint8_t>> fine_mask;
     Status geometry_status = Status::kOk, normals_status = Status::kOk;
+    // The last update fed the stream bytes not yet verified (the open CRC group, see update()).
+    bool tentative_geometry = false, tentative_normals = false;
   };
   std::vector<Model> models;
-  std::ptrdiff_t tail_chunk = -1;  // the chunk whose prefix was decoded last (−1: none)
 
   std::span<const std::uint8_t> payload(std::span<const std::uint8_t> data, std::size_t c) const {
-    return data.subspan(static_cast<std::size_t>(info.chunks[c].offset), info.chunks[c].size);
+    return data.subspan(static_cast<std::size_t>(info.chunks[c].offset), info.chunks[c].payload_size());
   }
-  /// Feeds one model's stream (geometry or normals) its verified chunks and `tail`.
-  void feed(std::span<const std::uint8_t> data, Model& m, bool geometry, std::span<const std::uint8_t> tail) {
+  /// Feeds one model's stream (geometry or normals) its verified chunks, then the complete chunks `extra`
+  /// and `tail` (a byte prefix of the chunk after them).
+  void feed(std::span<const std::uint8_t> data, Model& m, bool geometry, std::span<const std::size_t> extra,
+            std::span<const std::uint8_t> tail) {
     const auto& list = geometry ? m.geometry_chunks : m.normal_chunks;
     std::vector<std::span<const std::uint8_t>> segments;
-    segments.reserve(list.size());
+    segments.reserve(list.size() + extra.size());
     for (std::size_t c : list) segments.push_back(payload(data, c));
+    for (std::size_t c : extra) segments.push_back(payload(data, c));
     (geometry ? m.geometry_status : m.normals_status) =
         (geometry ? m.geometry : m.normals).update(segments, tail);
   }
@@ -550,61 +731,88 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
       }
     }
     const PackInfo& info = st.info;
-    // Complete chunks, CRC-checked, in order; decoding stops for good at the first that fails.
-    for (; !st.crc_failed && st.next_chunk < info.chunks.size(); ++st.next_chunk) {
-      const std::size_t c = st.next_chunk;
-      const ChunkInfo& chunk = info.chunks[c];
-      if (chunk.offset + chunk.size > data.size()) break;
-      const auto payload = st.payload(data, c);
-      State::Model& m = st.models[static_cast<std::size_t>(chunk.model)];
-      if (kCheckCrc && crc32(payload) != chunk.crc32) {
-        st.crc_failed = true;
-        // A prefix of this chunk was decoded as a partial tail: decode its stream again without it.
-        if (st.tail_chunk == static_cast<std::ptrdiff_t>(c) && chunk.kind != ChunkKind::kHoleMask) {
-          const bool geometry = chunk.kind == ChunkKind::kGeometry;
-          st.reset_stream(m, static_cast<std::size_t>(chunk.model), geometry);
-          st.feed(data, m, geometry, {});
-        }
-        st.tail_chunk = -1;
+    // Complete CRC groups (versions 1–3: single chunks), CRC-checked, in order; decoding stops for good at
+    // the first that fails.
+    while (!st.crc_failed && st.next_chunk < info.chunks.size()) {
+      const std::size_t first = st.next_chunk;
+      std::size_t last = first;
+      if (info.version >= 4)
+        while (last + 1 < info.chunks.size() && info.chunks[last].crc_bytes == 0) ++last;
+      const ChunkInfo& end = info.chunks[last];
+      if (end.offset + end.size > data.size()) break;
+      bool crc_ok = true;
+      if (info.version >= 4) {
+        const auto group = data.subspan(
+            static_cast<std::size_t>(info.chunks[first].offset),
+            static_cast<std::size_t>(end.offset + end.payload_size() - info.chunks[first].offset));
+        ByteReader trailer(data.subspan(static_cast<std::size_t>(end.offset + end.payload_size()), 4));
+        std::uint32_t crc = 0;
+        crc_ok = end.crc_bytes == kCrcBytes && trailer.u32(crc) && (!kCheckCrc || crc32(group) == crc);
+      } else {
+        crc_ok = !kCheckCrc || crc32(st.payload(data, first)) == end.crc32;
+      }
+      if (!crc_ok) {
+        st.crc_failed = true;  // streams fed bytes of this group tentatively start over below
         break;
       }
-      if (chunk.kind == ChunkKind::kHoleMask) {
-        const PackModelInfo& mi = info.models[static_cast<std::size_t>(chunk.model)];
-        const int shift = mi.fine_hole_mask_level - mi.hole_mask_level;
-        (info.version == 1 ? decode_fine_masks_v1 : decode_fine_masks)(
-            payload, mi.hole_mask, 1 << mi.fine_hole_mask_level, shift, m.fine_mask);
-        m.has_fine_mask = true;
-      } else {
-        (chunk.kind == ChunkKind::kGeometry ? m.geometry_chunks : m.normal_chunks).push_back(c);
+      for (std::size_t c = first; c <= last; ++c) {
+        const ChunkInfo& chunk = info.chunks[c];
+        State::Model& m = st.models[static_cast<std::size_t>(chunk.model)];
+        if (chunk.kind == ChunkKind::kHoleMask) {
+          const PackModelInfo& mi = info.models[static_cast<std::size_t>(chunk.model)];
+          const int shift = mi.fine_hole_mask_level - mi.hole_mask_level;
+          (info.version == 1 ? decode_fine_masks_v1 : decode_fine_masks)(
+              st.payload(data, c), mi.hole_mask, 1 << mi.fine_hole_mask_level, shift, m.fine_mask);
+          m.has_fine_mask = true;
+        } else {
+          (chunk.kind == ChunkKind::kGeometry ? m.geometry_chunks : m.normal_chunks).push_back(c);
+        }
+        ++st.chunks_decoded;
       }
-      ++st.chunks_decoded;
+      st.next_chunk = last + 1;
     }
-    // The first incomplete chunk: a byte prefix of an embedded stream.
+    // The open group (the first one not verified: incomplete, or its trailer missing), with
+    // options.partial_chunks: its complete chunks and a byte prefix of the first incomplete one, unverified,
+    // as embedded streams (versions 1–3: the first incomplete chunk only). Hole masks wait for their CRC.
+    // Should the group's CRC fail once complete, the streams fed from it decode again without it.
     st.bytes_used = st.next_chunk == 0 ? info.manifest_end
                                        : static_cast<std::size_t>(info.chunks[st.next_chunk - 1].offset +
                                                                   info.chunks[st.next_chunk - 1].size);
     st.status = st.crc_failed ? Status::kCorrupt : Status::kOk;
-    std::ptrdiff_t tail = -1;
+    struct Open {
+      std::vector<std::size_t> complete;
+      std::span<const std::uint8_t> tail;
+    };
+    std::vector<Open> open_geometry(st.models.size()), open_normals(st.models.size());
     if (!st.crc_failed && st.next_chunk < info.chunks.size()) {
       st.status = Status::kTruncated;
-      const ChunkInfo& chunk = info.chunks[st.next_chunk];
-      if (options.partial_chunks && chunk.offset < data.size() && chunk.kind != ChunkKind::kHoleMask &&
-          (chunk.kind == ChunkKind::kGeometry || options.normals)) {
-        tail = static_cast<std::ptrdiff_t>(st.next_chunk);
-        st.bytes_used = data.size();
+      for (std::size_t c = st.next_chunk; options.partial_chunks && c < info.chunks.size(); ++c) {
+        const ChunkInfo& chunk = info.chunks[c];
+        if (chunk.offset >= data.size()) break;
+        const bool complete = chunk.offset + chunk.payload_size() <= data.size();
+        if (chunk.kind != ChunkKind::kHoleMask && (chunk.kind == ChunkKind::kGeometry || options.normals)) {
+          Open& open =
+              (chunk.kind == ChunkKind::kGeometry ? open_geometry
+                                                  : open_normals)[static_cast<std::size_t>(chunk.model)];
+          if (complete)
+            open.complete.push_back(c);
+          else
+            open.tail = data.subspan(static_cast<std::size_t>(chunk.offset));
+          st.bytes_used = static_cast<std::size_t>(
+              std::min<std::uint64_t>(data.size(), chunk.offset + chunk.payload_size()));
+        }
+        if (!complete || chunk.crc_bytes > 0 || info.version < 4) break;  // the group (v1–3: chunk) ends
       }
     }
-    st.tail_chunk = tail;
     for (std::size_t m = 0; m < st.models.size(); ++m) {
       State::Model& model = st.models[m];
-      const auto tail_of = [&](ChunkKind kind) {
-        if (tail < 0) return std::span<const std::uint8_t>{};
-        const ChunkInfo& chunk = info.chunks[static_cast<std::size_t>(tail)];
-        if (chunk.model != static_cast<int>(m) || chunk.kind != kind) return std::span<const std::uint8_t>{};
-        return data.subspan(static_cast<std::size_t>(chunk.offset));
+      const auto stream = [&](bool geometry, const Open& open, bool& tentative) {
+        if (st.crc_failed && tentative) st.reset_stream(model, m, geometry);
+        st.feed(data, model, geometry, open.complete, open.tail);
+        tentative = !open.complete.empty() || !open.tail.empty();
       };
-      st.feed(data, model, true, tail_of(ChunkKind::kGeometry));
-      if (model.with_normals) st.feed(data, model, false, tail_of(ChunkKind::kNormals));
+      stream(true, open_geometry[m], model.tentative_geometry);
+      if (model.with_normals) stream(false, open_normals[m], model.tentative_normals);
     }
   } catch (const std::exception&) {
     // The decoders do not throw on bytes; a failed allocation on a hostile manifest lands here.
@@ -643,11 +851,7 @@ PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
       if (sm.geometry_status != Status::kOk) result.status = Status::kCorrupt;
       model.geometry = std::move(decoded.patches);
       model.detail_level = decoded.detail_level;
-      const bool any_normals =
-          !sm.normal_chunks.empty() ||
-          (st.tail_chunk >= 0 &&
-           st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].model == static_cast<int>(m) &&
-           st.info.chunks[static_cast<std::size_t>(st.tail_chunk)].kind == ChunkKind::kNormals);
+      const bool any_normals = !sm.normal_chunks.empty() || sm.tentative_normals;
       if (sm.with_normals && any_normals) {
         if (sm.normals_status != Status::kOk) result.status = Status::kCorrupt;
         if (normals) {

@@ -2,16 +2,28 @@
 // maps) of one or more consistent models.
 //
 // Layout (all integers little-endian; varint = unsigned LEB128):
-//   [fixed header, kPackHeaderSize bytes]
-//     magic "GEOMIPK\x1a" (8) | format version u16 | flags u16 | manifest size u32 | manifest CRC32 u32
+//   [fixed header]
+//     version 4: magic "GEOMIPK\x1a" (8) | format version u16 | manifest size varint (1–4 bytes) |
+//                manifest CRC32 u32   (15–18 bytes)
+//     versions 1–3: magic (8) | format version u16 | flags u16 (0) | manifest size u32 | manifest CRC32 u32
+//                (kPackHeaderSize = 20 bytes)
 //   [manifest, manifest-size bytes]
 //     models (name, normalization transform, geometry / normal codec headers, hole masks), seams, and the
-//     chunk table: for each chunk its model, kind (geometry / normals), bit-plane pass, size and CRC32.
-//     Chunk offsets follow from the sizes: chunk 0 starts right after the manifest.
+//     chunk table: for each chunk (a model, kind and bit-plane pass, implied by the canonical order) its
+//     size. Chunk offsets follow from the sizes: chunk 0 starts right after the manifest. Version 4 (the
+//     header diet, docs/codec-v3.md): the table holds payload sizes only; the CRC32s trail the chunks
+//     (below). Doubles (normalization, codec origin and step) are stored as float32 where that is exact,
+//     behind one bit each; the codec header is stored without its 32 bytes of float64 origin/step, which
+//     follow compactly. Versions 1–3: each table entry is size + CRC32 of the chunk; doubles as float64; the
+//     codec header as GeometryCodecHeader::serialize() gives it.
 //   [chunks, in table order]
 //     ordered coarse → fine across all models (pass 0 of every model, then pass 1, ...; normal-map passes
 //     trail the geometry passes), so any byte prefix of the file is a coarser level of detail of every model.
-//
+//     Version 4: consecutive chunks form CRC groups — a chunk whose payload has at least crc_group_bytes
+//     (a manifest field; the writer's default 256) is a group of its own, smaller neighbours are gathered
+//     until their payloads reach it (so the tiny top-plane chunks share one CRC) — and the last chunk of a
+//     group ends with a u32 CRC32 of the group's payloads (the file bytes from the group's first payload up
+//     to that trailer). ChunkInfo::size counts that trailer, so chunks still tile the file.
 // Designed for HTTP range requests: read kPackHeaderSize bytes, then the manifest, then chunks in order.
 // Decoders never throw or assert on bytes; they return a Status.
 #pragma once
@@ -30,11 +42,17 @@
 
 namespace geomip::codec {
 
+/// The most bytes a fixed header takes (versions 1–3: exactly this; version 4: 15–18). A reader that holds
+/// this many bytes of a pack (or all of a shorter source) can always read the fixed header, and the
+/// manifest always ends at or after it.
 inline constexpr std::size_t kPackHeaderSize = 20;
-/// Format version written. Version 3 (this one): codec header version 3 (local frames, orientation weights;
-/// docs/codec-v3.md). Version 2: bit-plane segments hold one stream per patch (codec header version 2),
-/// decoded in parallel. Version 1: one joint stream per segment. Versions 1 and 2 are still read.
-inline constexpr std::uint16_t kPackVersion = 3;
+/// Format version written. Version 4 (this one): the header diet — CRC32 trailers per chunk group instead
+/// of a CRC per chunk in the up-front table, a varint manifest size, compact doubles and codec headers
+/// (above); codec headers of version 3 or later. Version 3: codec header version 3 (local frames,
+/// orientation weights; docs/codec-v3.md). Version 2: bit-plane segments hold one stream per patch (codec
+/// header version 2), decoded in parallel. Version 1: one joint stream per segment. Versions 1–3 are still
+/// read.
+inline constexpr std::uint16_t kPackVersion = 4;
 inline constexpr std::uint16_t kOldestPackVersion = 1;
 
 enum class ChunkKind : std::uint8_t {
@@ -48,8 +66,15 @@ struct ChunkInfo {
   ChunkKind kind = ChunkKind::kGeometry;
   int pass = 0;              ///< bit-plane pass of that model's stream (0 = most significant)
   std::uint64_t offset = 0;  ///< from the start of the file (derived from the sizes)
-  std::uint32_t size = 0;
+  std::uint32_t size = 0;    ///< bytes in the file, the CRC trailer included (offset + size = next offset)
+  /// Versions 1–3: the chunk's CRC32 from the table. Version 4: 0 (the CRC is in the file, see crc_bytes).
   std::uint32_t crc32 = 0;
+  /// Version 4: 4 when the chunk closes its CRC group (its last 4 bytes are the group's CRC32), else 0.
+  std::uint32_t crc_bytes = 0;
+  /// Index of the first chunk of this chunk's CRC group (versions 1–3: the chunk itself). The chunks of a
+  /// group are verified together, when the last one's trailer has arrived.
+  std::size_t group_first = 0;
+  std::uint32_t payload_size() const { return size - crc_bytes; }  ///< the codec segment's bytes
 };
 
 struct PackModelInfo {
@@ -79,8 +104,9 @@ struct PackInfo {
   }
 };
 
-/// Reads the fixed header only: the number of bytes the manifest ends at. kTruncated if fewer than
-/// kPackHeaderSize bytes, kCorrupt on a bad magic, kUnsupportedVersion on another format version.
+/// Reads the fixed header only: the number of bytes the manifest ends at. kTruncated if `bytes` ends inside
+/// the fixed header (never with kPackHeaderSize bytes or more), kCorrupt on a bad magic (or a bad field),
+/// kUnsupportedVersion on another format version.
 Status read_pack_header(std::span<const std::uint8_t> bytes, std::size_t& manifest_end);
 
 /// Reads header + manifest (verifying its CRC). kTruncated if `bytes` ends before the manifest does.
@@ -108,6 +134,10 @@ struct PackWriteOptions {
                                     .tangential_shift = 0,
                                     .orientation_weights = false};
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
+  /// CRC groups (format version 4, see the layout above): chunks with smaller payloads share one CRC32
+  /// trailer until their payloads reach this many bytes; ≥ 1. Larger values save 4 bytes per merged chunk;
+  /// a viewer that decodes verified chunks only (partial_chunks = false) waits for a whole group.
+  std::size_t crc_group_bytes = 256;
   /// Normal-map pass p is placed after geometry pass p + normals_delay of every model.
   int normals_delay = 4;
   /// Hole masks: the manifest carries them this many levels coarser (fewer bytes before the first model);
@@ -127,10 +157,12 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
 struct PackDecodeOptions {
   /// Use only the first max_bytes bytes of the buffer (as if only they had arrived).
   std::size_t max_bytes = std::numeric_limits<std::size_t>::max();
-  bool normals = true;         ///< decode normal maps when the pack has them
-  bool partial_chunks = true;  ///< also use a byte prefix of the first incomplete chunk (embedded streams)
-  int drop_finest_steps = 0;   ///< see GeometryDecodeOptions
-  int max_threads = 0;         ///< per-patch decoding threads, see GeometryDecodeOptions
+  bool normals = true;  ///< decode normal maps when the pack has them
+  /// Also use the bytes not yet verified: a byte prefix of the first incomplete chunk (embedded streams)
+  /// and, in version 4, the complete chunks of its CRC group before it.
+  bool partial_chunks = true;
+  int drop_finest_steps = 0;  ///< see GeometryDecodeOptions
+  int max_threads = 0;        ///< per-patch decoding threads, see GeometryDecodeOptions
 };
 
 struct DecodedModel {
@@ -147,12 +179,16 @@ struct DecodedModel {
 
 struct PackDecodeResult {
   /// kOk: every chunk decoded. kTruncated: the bytes end early; `models` hold what the prefix gives (empty if
-  /// it ends inside the manifest). kCorrupt: a chunk failed its CRC (decoding stopped at the last good pass
-  /// of every model) or the manifest is damaged. kUnsupportedVersion: another format version.
+  /// it ends inside the manifest). kCorrupt: a chunk (version 4: a CRC group) failed its CRC (decoding
+  /// stopped at the last good pass of every model) or the manifest is damaged. kUnsupportedVersion: another
+  /// format version. With options.partial_chunks, the chunks of the first group not verified (version 4:
+  /// its trailer has not arrived; versions 1–3: the first incomplete chunk) are used as far as they have
+  /// arrived, unverified, as a partial chunk always was; if that group's CRC fails once it is complete, its
+  /// streams decode again without it.
   Status status = Status::kOk;
   PackInfo info;
   std::vector<DecodedModel> models;
-  std::size_t chunks_decoded = 0;  ///< complete, CRC-checked chunks used
+  std::size_t chunks_decoded = 0;  ///< complete, CRC-checked chunks used (in file order: the first ones)
   std::size_t bytes_used = 0;      ///< bytes of the buffer that contributed
 };
 
@@ -163,8 +199,8 @@ PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDeco
 /// the longer prefix received so far and decodes only what is new in it (GeometryDecoder per model and
 /// stream: each byte is decoded once), result() gives the models. After any sequence of updates, result()
 /// equals decode_pack() of the last update's bytes with the same options bit for bit (for packs of the
-/// encoder; a chunk whose CRC fails after a prefix of it was decoded makes its model decode again from its
-/// verified chunks, as decode_pack() would).
+/// encoder; a chunk or CRC group that fails its CRC after unverified bytes of it were decoded makes the
+/// streams fed from it decode again from their verified chunks, as decode_pack() would).
 class PackDecoder {
  public:
   explicit PackDecoder(const PackDecodeOptions& options = {});

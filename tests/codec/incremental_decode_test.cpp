@@ -1,7 +1,7 @@
 // Incremental decoding (PackDecoder, GeometryDecoder, BitplaneDecoder): after ANY split of a pack's bytes
 // into increments, the decoder's result equals a one-shot decode_pack() of the same prefix bit for bit —
 // geometry and normal maps, every drop of finest steps, with and without partial chunks, joint and per-patch
-// (post-joint) streams, 2 and 4 patches, and the committed golden packs of format versions 1 to 3.
+// (post-joint) streams, 2 and 4 patches, and the committed golden packs of format versions 1 to 4.
 #include "codec/pack.h"
 
 #include "tests/codec/pillow.h"
@@ -118,7 +118,8 @@ TEST(IncrementalDecode, FixtureHasPerPatchStreams) {
     // Counts of segments (not times): the shared ones must leave room for per-patch ones.
     const int geometry_plane_count = m.geometry.top_bitplane + 1;
     const int normal_plane_count = m.normals.top_bitplane + 1;
-    const int geometry_shared_count = m.geometry.joint_segments, normal_shared_count = m.normals.joint_segments;
+    const int geometry_shared_count = m.geometry.joint_segments,
+              normal_shared_count = m.normals.joint_segments;
     EXPECT_LT(geometry_shared_count, geometry_plane_count - 4) << m.name;
     EXPECT_LT(normal_shared_count, normal_plane_count) << m.name;
   }
@@ -183,7 +184,8 @@ TEST(IncrementalDecode, BandsFromOneDecodeEqualSeparateDecodes) {
 }
 
 TEST(IncrementalDecode, GoldenPacksOfEveryVersion) {
-  for (const char* file : {"golden-pillow.gip", "golden-pillow-v2.gip", "golden-pillow-v3.gip"}) {
+  for (const char* file :
+       {"golden-pillow.gip", "golden-pillow-v2.gip", "golden-pillow-v3.gip", "golden-pillow-v4.gip"}) {
     std::ifstream in(std::string(GEOMIP_SOURCE_DIR) + "/tests/data/" + file, std::ios::binary);
     ASSERT_TRUE(in) << file;
     const std::vector<std::uint8_t> pack((std::istreambuf_iterator<char>(in)),

@@ -104,6 +104,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   std::optional<Eigen::Matrix3d> view_rotation;
   if (options.up && !models.inputs.empty())
     view_rotation = upright_rotation(models.inputs[0].mesh, *options.up);
+  if (view_rotation && view_rotation->isIdentity()) view_rotation.reset();  // the viewer's default: no bytes
   const int mask_level = options.hole_mask_level < 0 ? options.level : std::min(options.hole_mask_level, options.level);
   for (std::size_t m = 0; m < params.size(); ++m) {
     progress("resample", 0.8 + 0.1 * static_cast<double>(m) / static_cast<double>(params.size()));

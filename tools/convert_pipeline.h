@@ -39,8 +39,9 @@ struct ConvertOptions {
   /// The viewer's frame stored as each model's normalization (codec::PackModelInfo::normalization): the up
   /// axis (kAuto: from the first model's shape) and front of the first model (upright_rotation()), one
   /// rotation for every model of the pack alike (a consistent set keeps one pose), then each model's rotated
-  /// box to the centred unit box (view_normalization()). nullopt: identity (no frame; the viewer fits the
-  /// decoded box, y up) — 129 manifest bytes per model fewer, as `geomip rd` measures.
+  /// box to the centred unit box (view_normalization()); a rotation that is the identity is not stored (the
+  /// viewer's default frame). nullopt: identity (no frame; the viewer fits the decoded box, y up) — 129
+  /// manifest bytes per model fewer, as `geomip rd` measures.
   std::optional<UpAxis> up;
   ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode"
 };

@@ -55,38 +55,12 @@ struct Affine {
   }
 };
 
-/// The pack's normalization, or — when it is the identity (packs from `geomip convert` store positions in the
-/// mesh's units and spend no manifest bytes on a frame) — the transform of this decode's bounding box to the
-/// centred unit box. (Recomputed per prefix: the box of a coarse level is within about 1 % of the full one.)
-std::array<double, 16> view_transform(const codec::DecodedModel& m) {
-  const auto& n = m.normalization;
-  const std::array<double, 16> identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  if (n != identity && n != std::array<double, 16>{}) return n;
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (const auto& g : m.geometry) {
-    for (std::size_t k = 0; k + 2 < g.values.size(); k += 3) {
-      for (int c = 0; c < 3; ++c) {
-        const double v = g.values[k + static_cast<std::size_t>(c)];
-        if (std::isfinite(v)) lo[c] = std::min(lo[c], v), hi[c] = std::max(hi[c], v);
-      }
-    }
-  }
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  if (!(extent > 0) || !std::isfinite(extent)) return identity;
-  std::array<double, 16> fit = identity;
-  for (int c = 0; c < 3; ++c) {
-    fit[static_cast<std::size_t>(5 * c)] = 1.0 / extent;
-    fit[static_cast<std::size_t>(4 * c + 3)] = -0.5 * (lo[c] + hi[c]) / extent;
-  }
-  return fit;
-}
-
-void fill_common(const codec::DecodedModel& m, SceneModel& s) {
+void fill_common(const codec::DecodedModel& m, char up, SceneModel& s) {
   s.name = m.name;
   s.level = m.geometry[0].level;
   s.num_patches = static_cast<int>(m.geometry.size());
   s.detail_level = m.detail_level;
-  const Affine xf(view_transform(m));
+  const Affine xf(view_transform(m, up));
   s.normal_level = -1;
   s.normals.clear();
   if (m.normals.size() == m.geometry.size()) {
@@ -115,12 +89,47 @@ void fill_common(const codec::DecodedModel& m, SceneModel& s) {
 
 }  // namespace
 
-SceneModel make_scene_model(const codec::DecodedModel& model) {
+// The pack's normalization, or — when it is the identity (packs from `geomip convert` store positions in the
+// mesh's units and spend no manifest bytes on a frame) — the transform of this decode's bounding box to the
+// centred unit box. (Recomputed per prefix: the box of a coarse level is within about 1 % of the full one.)
+std::array<double, 16> view_transform(const codec::DecodedModel& m, char up) {
+  const auto& n = m.normalization;
+  const std::array<double, 16> identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  if (up == 0 && n != identity && n != std::array<double, 16>{}) return n;
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (const auto& g : m.geometry) {
+    for (std::size_t k = 0; k + 2 < g.values.size(); k += 3) {
+      for (int c = 0; c < 3; ++c) {
+        const double v = g.values[k + static_cast<std::size_t>(c)];
+        if (std::isfinite(v)) lo[c] = std::min(lo[c], v), hi[c] = std::max(hi[c], v);
+      }
+    }
+  }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  if (!(extent > 0) || !std::isfinite(extent)) return identity;
+  std::array<double, 16> fit = identity;
+  for (int c = 0; c < 3; ++c) {
+    fit[static_cast<std::size_t>(5 * c)] = 1.0 / extent;
+    fit[static_cast<std::size_t>(4 * c + 3)] = -0.5 * (lo[c] + hi[c]) / extent;
+  }
+  if (up == 0 || up == 'y') return fit;
+  const auto& r = up_rotation(up).rotation;  // the fitted box is centred: turning it keeps it so
+  std::array<double, 16> turned = identity;
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t c = 0; c < 4; ++c) {
+      double v = 0;
+      for (std::size_t k = 0; k < 3; ++k) v += r[3 * i + k] * fit[4 * k + c];
+      turned[4 * i + c] = v;
+    }
+  return turned;
+}
+
+SceneModel make_scene_model(const codec::DecodedModel& model, char up) {
   check_model(model, "make_scene_model");
   SceneModel s;
-  fill_common(model, s);
+  fill_common(model, up, s);
   s.bands = 1;
-  const Affine xf(view_transform(model));
+  const Affine xf(view_transform(model, up));
   for (const auto& g : model.geometry) {
     const std::size_t base = s.positions.size();
     s.positions.resize(base + g.values.size());
@@ -129,7 +138,7 @@ SceneModel make_scene_model(const codec::DecodedModel& model) {
   return s;
 }
 
-SceneModel make_banded_scene_model(const std::vector<codec::DecodedModel>& by_drop) {
+SceneModel make_banded_scene_model(const std::vector<codec::DecodedModel>& by_drop, char up) {
   if (by_drop.empty()) throw std::invalid_argument("make_banded_scene_model: no decodes");
   for (const auto& m : by_drop) check_model(m, "make_banded_scene_model");
   const auto& full = by_drop[0];
@@ -137,10 +146,10 @@ SceneModel make_banded_scene_model(const std::vector<codec::DecodedModel>& by_dr
     if (m.geometry.size() != full.geometry.size() || m.geometry[0].level != full.geometry[0].level)
       throw std::invalid_argument("make_banded_scene_model: decodes of different layouts");
   SceneModel s;
-  fill_common(full, s);
+  fill_common(full, up, s);
   const int bands = static_cast<int>(by_drop.size());
   s.bands = bands;
-  const Affine xf(view_transform(full));
+  const Affine xf(view_transform(full, up));
   const std::size_t per = 3u * s.size() * s.size();
   s.positions.resize(per * s.num_patches * bands);
   for (int p = 0; p < s.num_patches; ++p)
@@ -288,7 +297,7 @@ std::vector<SceneModel> SceneDecoder::update(std::span<const std::uint8_t> bytes
       if (same_layout(out[m], out[0])) apply_similarity(best_alignment(out[m], out[0]), out[m]);
   };
   if (bands == 1) {
-    for (const auto& m : full.models) out.push_back(make_scene_model(m));
+    for (const auto& m : full.models) out.push_back(make_scene_model(m, settings_.up));
     align();
     return out;
   }
@@ -299,7 +308,7 @@ std::vector<SceneModel> SceneDecoder::update(std::span<const std::uint8_t> bytes
     for (std::size_t m = 0; m < by_model.size() && m < r.models.size(); ++m)
       by_model[m].push_back(std::move(r.models[m]));
   }
-  for (const auto& decodes : by_model) out.push_back(make_banded_scene_model(decodes));
+  for (const auto& decodes : by_model) out.push_back(make_banded_scene_model(decodes, settings_.up));
   align();
   return out;
 }

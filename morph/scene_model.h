@@ -14,8 +14,9 @@
 namespace geomip::morph {
 
 /// One model, ready for upload. Positions are stored as `bands` layers per patch, each a (2^level+1)² grid of
-/// xyz floats in the normalized frame (the pack's normalization applied; for an identity normalization, as
-/// `geomip convert` writes, the decode's bounding box fitted to the centred unit box): with one band the
+/// xyz floats in the normalized frame (view_transform(): the pack's normalization — `geomip convert --up`
+/// stores the viewer's frame there — or, for an identity one, the decode's bounding box fitted to the centred
+/// unit box): with one band the
 /// layer is the geometry image itself; with B > 1 bands, layer 0 is the coarse base (the wavelet
 /// reconstruction with the finest B−1 steps dropped) and layer m ≥ 1 is the detail D added by step B−1−m+1
 /// (so the layers sum to the full geometry, and layer B−1 is the finest band).
@@ -34,13 +35,18 @@ struct SceneModel {
   int size() const { return (1 << level) + 1; }
 };
 
-/// One band: the model as it is. Throws std::invalid_argument if the model has no patches or grids of
-/// different levels.
-SceneModel make_scene_model(const codec::DecodedModel& model);
+/// One band: the model as it is, in the frame of view_transform(model, up). Throws std::invalid_argument if
+/// the model has no patches or grids of different levels.
+SceneModel make_scene_model(const codec::DecodedModel& model, char up = 0);
 
 /// Band-split model for the wavelet-domain morph. `by_drop[d]` is the same bytes decoded with
 /// drop_finest_steps = d, d = 0 … B−1 (B = by_drop.size() ≥ 1).
-SceneModel make_banded_scene_model(const std::vector<codec::DecodedModel>& by_drop);
+SceneModel make_banded_scene_model(const std::vector<codec::DecodedModel>& by_drop, char up = 0);
+
+/// Row-major 4×4 from the model's units to the normalized frame that make_scene_model() applies: the
+/// model's normalization when it is not the identity (and `up` is 0), else the decode's bounding box fitted
+/// to the centred unit box, turned by up_rotation(up) when `up` is 'x', 'y' or 'z'.
+std::array<double, 16> view_transform(const codec::DecodedModel& model, char up = 0);
 
 enum class MorphSchedule { kLinear, kWavelet };
 
@@ -94,6 +100,10 @@ struct DecodeSettings {
   /// SceneDecoder: false decodes every prefix from scratch (the cost before incremental decoding; for
   /// measurements only).
   bool incremental = true;
+  /// 0: the pack's normalization (`geomip convert --up` stores the viewer's frame there; an identity one gets
+  /// the decode's box fitted to the centred unit box, y up). 'x', 'y' or 'z': that axis of the model's units
+  /// is up whatever the pack says (the decode's box fitted, then up_rotation()).
+  char up = 0;
 };
 
 /// Decodes a byte prefix of a pack into scene models. Returns an empty vector (status in `status`) when the

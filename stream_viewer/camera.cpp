@@ -59,12 +59,13 @@ std::array<float, 16> view_projection(const Camera& camera, int width, int heigh
   return multiply(proj, view);
 }
 
-float framing_distance(const Camera& camera, std::span<const float> xyz, int width, int height, float fill) {
+float framing_distance(const Camera& camera, std::span<const float> xyz, int width, int height, float fill,
+                       float max_width_fill) {
   const std::size_t points = xyz.size() / 3;
   if (points == 0) return camera.distance;
   const std::size_t stride = std::max<std::size_t>(1, points / 20000);
-  // Fraction of the viewport the points span at distance d: max(height fraction, width fraction), or
-  // infinity when a point is behind the near plane (too close).
+  // How full the viewport is at distance d: max(height fraction / fill, width fraction / max_width_fill)
+  // (1 = framed), or infinity when a point is behind the near plane (too close).
   const auto span_at = [&](float d) {
     Camera c = camera;
     c.distance = d;
@@ -80,12 +81,12 @@ float framing_distance(const Camera& camera, std::span<const float> xyz, int wid
         hi[r] = std::max(hi[r], v);
       }
     }
-    return std::max(hi[0] - lo[0], hi[1] - lo[1]) / 2;  // NDC spans 2
+    return std::max((hi[1] - lo[1]) / (2 * fill), (hi[0] - lo[0]) / (2 * max_width_fill));  // NDC spans 2
   };
   float near_d = 0.3f, far_d = 20.0f;  // span decreases with the distance
   for (int it = 0; it < 40; ++it) {
     const float mid = 0.5f * (near_d + far_d);
-    (span_at(mid) > fill ? near_d : far_d) = mid;
+    (span_at(mid) > 1 ? near_d : far_d) = mid;
   }
   return far_d;
 }

@@ -22,10 +22,11 @@ std::array<float, 16> view_projection(const Camera& camera, int width, int heigh
 std::array<float, 3> eye_position(const Camera& camera);
 
 /// The camera distance at which `xyz` (points as x, y, z triples, normalized frame), seen from `camera`'s yaw
-/// and pitch, spans `fill` of a width×height viewport's height — or `fill` of its width, whichever is
-/// reached first (so a wide model is not cut off). Bisection over distances in [0.3, 20] (the range the
-/// scroll wheel allows) on at most ~20,000 of the points; returns camera.distance when `xyz` is empty.
+/// and pitch, spans `fill` of a width×height viewport's height — or `max_width_fill` of its width, whichever
+/// is reached first (so a model wider than the viewport's aspect still fills most of it and is not cut off).
+/// Bisection over distances in [0.3, 20] (the range the scroll wheel allows) on at most ~20,000 of the
+/// points; returns camera.distance when `xyz` is empty.
 float framing_distance(const Camera& camera, std::span<const float> xyz, int width, int height,
-                       float fill = 0.7f);
+                       float fill = 0.7f, float max_width_fill = 0.9f);
 
 }  // namespace geomip::viewer

@@ -46,7 +46,7 @@ struct Options {
   double timeout = 120;
   float yaw = 0.6f, pitch = 0.35f, distance = 3.2f;
   bool distance_given = false;  // --distance: no automatic framing
-  std::string up = "y";         // the models' up axis
+  std::string up;               // the models' up axis in their units; empty: the pack's frame
 };
 
 struct Ui {
@@ -184,7 +184,8 @@ int run(const Options& opt) {
     PackSource source(opt.source, FetchOptions{.limit_rate = opt.limit_rate},
                       morph::DecodeSettings{.bands = wavelet ? opt.bands : 1,
                                             .align = !opt.no_align,
-                                            .incremental = !opt.decode_each_prefix});
+                                            .incremental = !opt.decode_each_prefix,
+                                            .up = opt.up.empty() ? '\0' : opt.up[0]});
     Ui ui;
     ui.settings.width = opt.width;
     ui.settings.height = opt.height;
@@ -228,8 +229,6 @@ int run(const Options& opt) {
         }
       }
       if (auto u = source.take_update()) {
-        if (opt.up != "y")
-          for (morph::SceneModel& m : u->models) morph::apply_similarity(morph::up_rotation(opt.up[0]), m);
         renderer.set_models(u->models);
         have_models = true;
         shown_bytes = u->bytes_used;
@@ -421,7 +420,10 @@ int main(int argc, char** argv) {
   app.add_flag("--wireframe", opt.wireframe, "wireframe");
   app.add_option("--limit-rate", opt.limit_rate, "download (or read) at most this many bytes per second");
   app.add_option("--timeout", opt.timeout, "headless: seconds to wait for the pack")->check(non_negative("seconds"));
-  app.add_option("--up", opt.up, "the models' up axis, shown upright (z for z-up data such as the horse)")
+  app.add_option(
+         "--up", opt.up,
+         "the models' up axis in their own units, shown upright whatever the pack's frame says (z for "
+         "z-up data such as the horse); default: the frame `geomip convert --up` stored in the pack")
       ->check(CLI::IsMember({"x", "y", "z"}));
   app.add_option("--yaw", opt.yaw, "camera yaw (radians)");
   app.add_option("--pitch", opt.pitch, "camera pitch (radians)");

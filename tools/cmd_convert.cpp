@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <string>
 
 namespace geomip::tools {
 namespace {
@@ -28,7 +30,18 @@ struct ConvertArgs {
   bool no_normals = false;
   int normal_mesh_steps = ConvertOptions{}.normal_mesh_steps;
   double normal_mesh_reach = ConvertOptions{}.normal_mesh_max_shift;
+  std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
 };
+
+/// --up as ConvertOptions::up (nullopt = no frame stored).
+std::optional<UpAxis> up_axis(const ConvertArgs& args) {
+  const std::string up = args.up.empty() ? (args.no_normals ? "none" : "auto") : args.up;
+  if (up == "x") return UpAxis::kX;
+  if (up == "y") return UpAxis::kY;
+  if (up == "z") return UpAxis::kZ;
+  if (up == "auto") return UpAxis::kAuto;
+  return std::nullopt;
+}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -63,6 +76,7 @@ int run_convert(const ConvertArgs& args) {
   options.sampling_exponent = args.common.sampling_exponent;
   options.normal_mesh_steps = args.normal_mesh_steps;
   options.normal_mesh_max_shift = args.normal_mesh_reach;
+  options.up = up_axis(args);
   options.progress = bar.callback();
   const ConvertResult converted = convert_models(models, options);
   const std::vector<std::uint8_t>& pack = converted.pack;
@@ -131,6 +145,13 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_option("--normal-mesh-reach", args->normal_mesh_reach,
                   "Largest move of a normal-mesh sample, in sample spacings of its level")
       ->check(CLI::Range(0.0, 4.0));
+  cmd->add_option(
+         "--up", args->up,
+         "The models' up axis, stored with the front in each model's normalization (the viewer's frame; "
+         "decoded meshes keep their units): x, y, z, auto (from the first model's shape: the side it "
+         "rests on) or none (no frame: the viewer shows y up). One rotation for all models. Default: "
+         "auto; none with --no-normals (R-D packs stay byte-identical)")
+      ->check(CLI::IsMember({"x", "y", "z", "auto", "none"}));
   return [args] { return run_convert(*args); };
 }
 

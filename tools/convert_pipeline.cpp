@@ -101,6 +101,10 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
 
   t0 = std::chrono::steady_clock::now();
   std::vector<codec::PackModelInput> inputs;
+  std::optional<Eigen::Matrix3d> view_rotation;
+  if (options.up && !models.inputs.empty())
+    view_rotation = upright_rotation(models.inputs[0].mesh, *options.up);
+  if (view_rotation && view_rotation->isIdentity()) view_rotation.reset();  // the viewer's default: no bytes
   const int mask_level = options.hole_mask_level < 0 ? options.level : std::min(options.hole_mask_level, options.level);
   for (std::size_t m = 0; m < params.size(); ++m) {
     progress("resample", 0.8 + 0.1 * static_cast<double>(m) / static_cast<double>(params.size()));
@@ -115,6 +119,8 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
     result.masked_quads.push_back(mask.masked_quads);
     inputs.push_back(pack_model_input(models.inputs[m].name, images, &mask, options.normals));
     inputs.back().hole_mask_level = mask_level;
+    if (view_rotation)
+      inputs.back().normalization = view_normalization(models.inputs[m].mesh, *view_rotation);
   }
   result.resample_seconds = seconds_since(t0);
 

@@ -38,8 +38,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitBadInput;
+    if (e.get_exit_code() == 0) return app.exit(e) == 0 ? kExitOk : kExitBadInput;  // --help, --version
+    std::cerr << "geomip: " << e.what() << " (see --help)\n";  // one line, as every error
+    return kExitBadInput;
   }
 
   for (const auto& c : commands) {

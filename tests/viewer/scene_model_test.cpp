@@ -203,6 +203,33 @@ TEST(UpRotation, TurnsTheUpAxisIntoPlusY) {
   }
 }
 
+// The pack's frame (`geomip convert --up` stores a rotation in the normalization) is what the scene shows;
+// DecodeSettings::up ('x', 'y', 'z': the viewer's --up) overrides it: the decode's box fitted, that axis of
+// the model's units turned to +y.
+TEST(ViewTransform, PackFrameByDefaultAndUpOverridesIt) {
+  codec::DecodedModel m = testing::decoded_model(4, 0, false);
+  // A frame that turns the model's +z into +y (−90° about x) and halves it.
+  m.normalization = {0.5, 0, 0, 0.1, 0, 0, 0.5, 0.2, 0, -0.5, 0, 0.3, 0, 0, 0, 1};
+  EXPECT_EQ(morph::view_transform(m), m.normalization);
+  const morph::SceneModel framed = morph::make_scene_model(m);
+  const auto& g = m.geometry[0].values;
+  EXPECT_FLOAT_EQ(framed.positions[1], static_cast<float>(0.5 * g[2] + 0.2)) << "model z → scene y";
+  for (char up : {'x', 'y', 'z'}) {
+    const auto t = morph::view_transform(m, up);
+    // the override ignores the pack's frame: box fitted (largest extent 1, centred), `up` → +y
+    const int a = up - 'x';
+    EXPECT_EQ(t[static_cast<std::size_t>(a)], 0.0) << up;
+    EXPECT_GT(t[static_cast<std::size_t>(4 + a)], 0.0) << up;
+    EXPECT_EQ(t[static_cast<std::size_t>(8 + a)], 0.0) << up;
+    const morph::SceneModel s = morph::make_scene_model(m, up);
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    for (std::size_t k = 0; k < s.positions.size(); ++k)
+      lo[k % 3] = std::min(lo[k % 3], s.positions[k]), hi[k % 3] = std::max(hi[k % 3], s.positions[k]);
+    EXPECT_NEAR(std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}), 1.0f, 1e-5f) << up;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(lo[c] + hi[c], 0.0f, 1e-5f) << up;
+  }
+}
+
 // The streaming viewer's decoder (morph::SceneDecoder, each byte decoded once, the bands of the wavelet morph
 // from one decode) gives, after every update, exactly what a one-shot decode_scene of that prefix gives.
 TEST(SceneDecoder, StreamEqualsOneShotDecodeOfEveryPrefix) {

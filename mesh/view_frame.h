@@ -1,0 +1,38 @@
+// The frame a viewer shows a mesh in: which way is up and which way the model faces, as an axis-aligned
+// rotation, and the transform of model units into the viewer's normalized frame (codec::PackModelInfo::
+// normalization: y up, centred, largest extent 1). Used by `geomip convert --up`.
+#pragma once
+
+#include "mesh/mesh.h"
+
+#include <array>
+
+namespace geomip {
+
+/// The model's up axis: kAuto guesses it from the shape (ground_direction()); kX/kY/kZ take +x/+y/+z.
+enum class UpAxis { kAuto, kX, kY, kZ };
+
+/// The direction the model rests on, among ±x, ±y, ±z: the face of the bounding box whose contact set — the
+/// referenced vertices within `band` × the box's extent of that face — has the largest 2D convex hull (the
+/// support polygon), relative to the box face's area. A standing quadruped rests on its four feet (a hull
+/// over most of the footprint), while its back, head or flank touch their box faces in a line or a patch.
+/// Ties go to the first of −y, +y, −x, +x, −z, +z. The animals of ../shared/meshes and what it picks for them
+/// are in docs/streaming.md ("Upright and front"). Returns a unit axis vector (−y for an empty mesh).
+/// Cost: O(#V log #V).
+Eigen::Vector3d ground_direction(const TriMesh& mesh, double band = 0.05);
+
+/// The rotation (a signed permutation matrix, det +1) from model units to the viewer's axes: rows are the
+/// model directions that become +x, +y, +z. +y = up (the opposite of ground_direction() for kAuto, else the
+/// named axis). +x = the front: of the two remaining axes, the one along which the box is longer (the length
+/// of an animal; ties: the first in x, y, z order), pointing to the end that reaches higher (the largest up
+/// coordinate of the vertices in the quarter of the length at that end: the head of an animal, which stands
+/// above its tail; ties: the positive end). +z = x × y. A camera at positive yaw (in the xz plane from +z
+/// towards +x) then sees the model from the side, its head turned towards the camera.
+Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up);
+
+/// Row-major 4×4 of x ↦ (R·x − c) / e: R = `rotation`, c and e the centre and the largest extent of the
+/// rotated bounding box of the referenced vertices (the normalized frame: centred, largest extent 1; e = 1
+/// for an empty or degenerate mesh).
+std::array<double, 16> view_normalization(const TriMesh& mesh, const Eigen::Matrix3d& rotation);
+
+}  // namespace geomip

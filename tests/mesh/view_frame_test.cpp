@@ -1,0 +1,136 @@
+// The viewer's frame of a mesh (mesh/view_frame.h): a four-legged "table" in any of the 24 axis-aligned
+// orientations rests on its legs and is turned upright with its higher end in front; the rotation is proper
+// (a signed permutation, det +1); the normalization maps the rotated box onto the centred unit box. On the
+// animals of ../shared/meshes the guessed up axis is the one their data has (seen in the meshes: the horse
+// stands on −z, the pig lies on its back with its legs towards +y, cow and bunny stand on −y).
+#include "mesh/view_frame.h"
+#include "mesh/mesh_io.h"
+#include "tests/param/test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+namespace geomip {
+namespace {
+
+/// Adds an axis-aligned box [lo, hi] as 12 triangles.
+void add_box(TriMesh& m, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const int base = static_cast<int>(m.positions.size());
+  for (int i = 0; i < 8; ++i)
+    m.positions.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    m.triangles.push_back({base + q[0], base + q[1], base + q[2]});
+    m.triangles.push_back({base + q[0], base + q[2], base + q[3]});
+  }
+}
+
+/// A quadruped in its own frame: y up, standing on four legs, 2 long along x, a "head" block at +x that
+/// reaches higher than the body's back.
+TriMesh animal() {
+  TriMesh m;
+  add_box(m, {-1, 0.5, -0.3}, {0.8, 1.0, 0.3});     // body
+  add_box(m, {0.8, 0.6, -0.15}, {1.0, 1.4, 0.15});  // head, above the back
+  for (double x : {-0.8, 0.5})
+    for (double z : {-0.25, 0.2}) add_box(m, {x, 0, z}, {x + 0.1, 0.5, z + 0.05});  // legs
+  return m;
+}
+
+/// The 24 proper axis-aligned rotations.
+std::vector<Eigen::Matrix3d> axis_rotations() {
+  std::vector<Eigen::Matrix3d> out;
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (const auto& p : perms)
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d r = Eigen::Matrix3d::Zero();
+      for (int i = 0; i < 3; ++i) r(i, p[i]) = signs & (1 << i) ? -1 : 1;
+      if (r.determinant() > 0) out.push_back(r);
+    }
+  return out;
+}
+
+TEST(ViewFrame, AnAnimalInAnyAxisOrientationIsTurnedUprightHeadInFront) {
+  const TriMesh base = animal();
+  const auto rotations = axis_rotations();
+  ASSERT_EQ(rotations.size(), 24u);
+  for (const Eigen::Matrix3d& q : rotations) {
+    TriMesh m = base;
+    for (auto& p : m.positions) p = q * p;  // the data's frame: up = q·y, head = q·x
+    EXPECT_TRUE(ground_direction(m).isApprox(-(q * Eigen::Vector3d::UnitY()))) << q;
+    const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+    EXPECT_TRUE((r * r.transpose()).isApprox(Eigen::Matrix3d::Identity()));
+    EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n"
+                                                               << r * q;
+  }
+}
+
+TEST(ViewFrame, ANamedUpAxisIsTakenAsItIs) {
+  TriMesh m = animal();  // y up; say z is up instead
+  const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kZ);
+  EXPECT_TRUE((r * Eigen::Vector3d::UnitZ()).isApprox(Eigen::Vector3d::UnitY()));
+  EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+  // Of x and y, x is the longer axis: it becomes the front, its higher (in z: equal) end first.
+  EXPECT_NEAR(std::abs((r * Eigen::Vector3d::UnitX()).x()), 1.0, 1e-12);
+}
+
+TEST(ViewFrame, NormalizationMapsTheRotatedBoxToTheCentredUnitBox) {
+  TriMesh m = animal();
+  for (auto& p : m.positions) p = 3.0 * Eigen::Vector3d(p.z(), p.x(), p.y()) + Eigen::Vector3d(5, -2, 7);
+  m.positions.emplace_back(1e6, 1e6, 1e6);  // unreferenced: ignored
+  const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
+  const auto n = view_normalization(m, r);
+  EXPECT_EQ(n[12], 0);
+  EXPECT_EQ(n[13], 0);
+  EXPECT_EQ(n[14], 0);
+  EXPECT_EQ(n[15], 1);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
+  for (std::size_t v = 0; v + 1 < m.positions.size(); ++v) {
+    const Eigen::Vector3d& p = m.positions[v];
+    Eigen::Vector3d q;
+    for (int i = 0; i < 3; ++i)
+      q[i] = n[static_cast<std::size_t>(4 * i)] * p.x() + n[static_cast<std::size_t>(4 * i + 1)] * p.y() +
+             n[static_cast<std::size_t>(4 * i + 2)] * p.z() + n[static_cast<std::size_t>(4 * i + 3)];
+    lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  }
+  EXPECT_NEAR((hi - lo).maxCoeff(), 1.0, 1e-12);
+  EXPECT_TRUE((lo + hi).isZero(1e-12)) << (lo + hi).transpose();
+  EXPECT_NEAR(hi.y() - lo.y(), 1.4 / 2.0, 1e-12) << "y is the animal's height (1.4 of its length 2)";
+}
+
+TEST(ViewFrame, DegenerateMeshesGiveAFrameWithoutNaN) {
+  TriMesh empty;
+  EXPECT_TRUE(ground_direction(empty).isApprox(-Eigen::Vector3d::UnitY()));
+  const auto n = view_normalization(empty, upright_rotation(empty, UpAxis::kAuto));
+  for (double v : n) EXPECT_TRUE(std::isfinite(v));
+  TriMesh flat;  // one triangle in the plane z = 0
+  flat.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  flat.triangles = {{0, 1, 2}};
+  const Eigen::Matrix3d r = upright_rotation(flat, UpAxis::kAuto);
+  EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+  for (double v : view_normalization(flat, r)) EXPECT_TRUE(std::isfinite(v));
+}
+
+struct Animal {
+  const char* file;
+  Eigen::Vector3d up;  // in the data's units, seen in the meshes
+};
+
+TEST(ViewFrame, TheAnimalsOfTheSharedMeshesGetTheirDataUpAxis) {
+  const Animal animals[] = {
+      {"horse.obj", Eigen::Vector3d::UnitZ()}, {"pig.obj", -Eigen::Vector3d::UnitY()},
+      {"cow.obj", Eigen::Vector3d::UnitY()},   {"spot.obj", Eigen::Vector3d::UnitY()},
+      {"bunny.obj", Eigen::Vector3d::UnitY()}, {"armadillo.obj", Eigen::Vector3d::UnitY()}};
+  for (const Animal& a : animals) {
+    GEOMIP_REQUIRE_SHARED_MESH(path, a.file);
+    const TriMesh m = read_mesh(path);
+    EXPECT_TRUE((-ground_direction(m)).isApprox(a.up)) << a.file << ": " << -ground_direction(m).transpose();
+    const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
+    EXPECT_TRUE((r * a.up).isApprox(Eigen::Vector3d::UnitY())) << a.file;
+  }
+}
+
+}  // namespace
+}  // namespace geomip

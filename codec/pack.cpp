@@ -678,7 +678,7 @@ struct PackDecoder::State {
     Status geometry_status = Status::kOk, normals_status = Status::kOk;
     // The last update fed the stream bytes not yet verified (the open CRC group, see update()).
     bool tentative_geometry = false, tentative_normals = false;
-    std::size_t open_geometry_chunks = 0;  // complete geometry chunks of the open (unverified) group, decoded
+    std::size_t tentative_geometry_passes = 0;  // complete geometry chunks among them
   };
   std::vector<Model> models;
 
@@ -813,7 +813,7 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
         tentative = !open.complete.empty() || !open.tail.empty();
       };
       stream(true, open_geometry[m], model.tentative_geometry);
-      model.open_geometry_chunks = open_geometry[m].complete.size();
+      model.tentative_geometry_passes = open_geometry[m].complete.size();
       if (model.with_normals) stream(false, open_normals[m], model.tentative_normals);
     }
   } catch (const std::exception&) {
@@ -847,8 +847,7 @@ PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
         model.hole_mask = sm.fine_mask;
         model.hole_mask_level = model_info.fine_hole_mask_level;
       }
-      // Complete passes decoded, verified or (open group) not yet: what a prefix shows.
-      model.geometry_passes = sm.geometry_chunks.size() + sm.open_geometry_chunks;
+      model.geometry_passes = sm.geometry_chunks.size() + sm.tentative_geometry_passes;
       DecodedGeometry decoded;
       sm.geometry.result(decoded, drop_finest_steps);
       if (sm.geometry_status != Status::kOk) result.status = Status::kCorrupt;

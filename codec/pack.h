@@ -174,7 +174,8 @@ struct DecodedModel {
   std::vector<std::vector<std::uint8_t>> hole_mask;  ///< as PackModelInfo::hole_mask
   int hole_mask_level = 0;
   int detail_level = 0;             ///< finest level that received detail
-  std::size_t geometry_passes = 0;  ///< complete geometry passes decoded
+  /// Complete geometry passes decoded (with partial_chunks, version 4: those of the open CRC group too).
+  std::size_t geometry_passes = 0;
 };
 
 struct PackDecodeResult {

@@ -11,15 +11,32 @@
 
 namespace geomip {
 
+/// What the choice of a layout minimizes (both computed from partition_stats()).
+enum class LayoutObjective {
+  kAreaSpread,    ///< Σ (A_q / Ā)² / K: equal patch areas
+  kSamplingCost,  ///< K · Σ A_q² / (flatness_q · A²): equal areas and patches close to height fields
+};
+
 struct QuadLayoutOptions {
   /// K, the number of quads (patches), ≥ 2. The coarse mesh has 2K triangles and K + 2 − 2·genus vertices.
   int patches = 8;
+  /// At most this many steps that move the corners to even out the patch areas (0: none); each step costs
+  /// one partition_mesh_layout().
+  int balance_steps = 40;
+  LayoutObjective objective = LayoutObjective::kSamplingCost;
 };
 
 /// What choose_quad_layout() measured on the layout it returns.
 struct QuadLayoutChoice {
   QuadLayout layout;
   double area_balance = 0.0;   ///< smallest / largest patch area of its partition (PartitionStats)
+  /// Σ (A_q / Ā)² / K over its patch areas A_q (Ā their mean): 1 when all are equal. With the same grid on
+  /// every patch a patch's squared resampling error grows like A_q², so this is what the choice lowers.
+  double area_spread = 0.0;
+  /// K · Σ A_q² / (flatness_q · A²) (A the total area; PatchStats::flatness): relative to K equal flat
+  /// squares (1), an estimate of the layout's squared resampling error at a fixed sample count.
+  double sampling_cost = 0.0;
+  int balance_steps = 0;       ///< corner moves kept by the balancing
   std::size_t candidates = 0;  ///< pairings tried that partition the mesh
 };
 

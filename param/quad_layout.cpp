@@ -52,7 +52,11 @@ class Simplifier {
  public:
   // `centroid_rule`: of two merged vertices the one nearer their area's centroid stays; else the one that
   // stands for more area.
-  Simplifier(const TriMesh& mesh, bool centroid_rule) : m_(mesh), centroid_rule_(centroid_rule) {
+  // `pinned` vertices are never collapsed away (they stay coarse vertices); may be empty.
+  Simplifier(const TriMesh& mesh, bool centroid_rule, const std::vector<int>& pinned)
+      : m_(mesh), centroid_rule_(centroid_rule) {
+    pinned_.assign(m_.positions.size(), 0);
+    for (int v : pinned) pinned_[v] = 1;
     vf_.resize(m_.positions.size());
     for (int f = 0; f < static_cast<int>(m_.triangles.size()); ++f) {
       for (int v : m_.triangles[f]) vf_[v].push_back(f);
@@ -189,10 +193,13 @@ class Simplifier {
       const Eigen::Vector3d centre = (moment_[u] + moment_[v]) / merged;
       const double du = (m_.positions[u] - centre).squaredNorm(),
                    dv = (m_.positions[v] - centre).squaredNorm();
-      if (centroid_rule_) {
-        if (dv > du || (dv == du && v > u)) continue;  // the vertex nearer the merged area's centroid stays
-      } else if (carried_[u] > carried_[v] || (carried_[u] == carried_[v] && v > u)) {
-        continue;  // the vertex that stands for more area stays
+      if (pinned_[u]) continue;  // a pinned vertex stays
+      if (!pinned_[v]) {
+        if (centroid_rule_) {
+          if (dv > du || (dv == du && v > u)) continue;  // the vertex nearer the merged area's centroid stays
+        } else if (carried_[u] > carried_[v] || (carried_[u] == carried_[v] && v > u)) {
+          continue;  // the vertex that stands for more area stays
+        }
       }
       heap_.push({merged, u, v, stamp_[u], stamp_[v]});
     }
@@ -200,6 +207,7 @@ class Simplifier {
 
   TriMesh m_;
   std::vector<std::vector<int>> vf_;
+  std::vector<char> pinned_;
   std::vector<char> face_alive_;
   std::vector<std::uint32_t> stamp_;
   std::vector<double> carried_;          // surface area each vertex stands for
@@ -462,6 +470,81 @@ void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int
 }
 
 
+// The tips of the shape's protrusions (legs, ears, head, tail): the maxima of the geodesic distance (Dijkstra
+// on the edge graph) from the vertex nearest the area centroid whose persistence (how far the distance
+// falls from the maximum before its region of the superlevel set joins one with a higher maximum) is at
+// least `min_persistence` times the largest distance, most persistent first, at most `max_tips`.
+std::vector<int> protrusion_tips(const TriMesh& mesh, double min_persistence, std::size_t max_tips) {
+  const int nv = static_cast<int>(mesh.positions.size());
+  std::vector<std::vector<int>> adj(nv);
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  for (const auto& t : mesh.triangles) {
+    for (int j = 0; j < 3; ++j) adj[t[j]].push_back(t[(j + 1) % 3]);
+    const double a = (mesh.positions[t[1]] - mesh.positions[t[0]])
+                         .cross(mesh.positions[t[2]] - mesh.positions[t[0]])
+                         .norm();
+    moment += a * (mesh.positions[t[0]] + mesh.positions[t[1]] + mesh.positions[t[2]]) / 3.0;
+    area += a;
+  }
+  const Eigen::Vector3d centre = moment / area;
+  int source = -1;
+  for (int v = 0; v < nv; ++v) {
+    if (adj[v].empty()) continue;
+    if (source < 0 || (mesh.positions[v] - centre).squaredNorm() <
+                          (mesh.positions[source] - centre).squaredNorm())
+      source = v;
+  }
+  std::vector<double> dist(nv, std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  dist[source] = 0.0;
+  queue.push({0.0, source});
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > dist[v]) continue;
+    for (int w : adj[v]) {
+      const double dw = d + (mesh.positions[w] - mesh.positions[v]).norm();
+      if (dw < dist[w]) {
+        dist[w] = dw;
+        queue.push({dw, w});
+      }
+    }
+  }
+  // Superlevel-set persistence by union-find, vertices in decreasing distance.
+  std::vector<int> order;
+  for (int v = 0; v < nv; ++v) {
+    if (!adj[v].empty()) order.push_back(v);
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return dist[a] != dist[b] ? dist[a] > dist[b] : a < b; });
+  std::vector<int> parent(nv, -1), peak(nv, -1);
+  std::function<int(int)> find = [&](int v) { return parent[v] == v ? v : parent[v] = find(parent[v]); };
+  std::vector<std::pair<double, int>> maxima;  // (persistence, vertex)
+  const double top = dist[order.front()];
+  for (int v : order) {
+    parent[v] = v;
+    peak[v] = v;
+    for (int w : adj[v]) {
+      if (parent[w] < 0) continue;
+      const int a = find(v), b = find(w);
+      if (a == b) continue;
+      // the region with the lower peak dies here
+      const int keep = dist[peak[a]] >= dist[peak[b]] ? a : b, die = keep == a ? b : a;
+      if (peak[die] != v) maxima.push_back({dist[peak[die]] - dist[v], peak[die]});
+      parent[die] = keep;
+    }
+  }
+  maxima.push_back({top, order.front()});  // the global maximum never dies
+  std::sort(maxima.begin(), maxima.end(), std::greater<>());
+  std::vector<int> tips;
+  for (const auto& [persistence, v] : maxima) {
+    if (persistence < min_persistence * top || tips.size() >= max_tips) break;
+    tips.push_back(v);
+  }
+  return tips;
+}
+
 // Moves the corners of `layout` over the mesh so that its patches get more equal areas. A move takes a set
 // of corners; each moves towards the area centroids of its larger neighbouring patches and away from its
 // smaller ones (a corner moved into a patch takes area from it and gives it to the patches on its other
@@ -471,7 +554,8 @@ void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int
 // the patch farthest from the mean area first (up to 3 patches); when nothing is kept the step is halved.
 // At most `evaluations` partitions are tried. Returns the number of moves kept.
 int relax_corners(const TriMesh& mesh, const std::function<double(const PartitionStats&)>& objective,
-                  QuadLayout& layout, PartitionResult& partition, PartitionStats& stats, int evaluations) {
+                  const std::vector<int>& locked, QuadLayout& layout, PartitionResult& partition,
+                  PartitionStats& stats, int evaluations) {
   const int nc = static_cast<int>(layout.corners.size());
   const int nq = static_cast<int>(layout.quads.size());
   std::vector<std::vector<int>> quads_at(nc);
@@ -527,6 +611,7 @@ int relax_corners(const TriMesh& mesh, const std::function<double(const Partitio
       std::vector<char> taken(mesh.positions.size(), 0);
       for (int v : layout.corners) taken[v] = 1;
       for (int c : move) {
+        if (std::find(locked.begin(), locked.end(), layout.corners[c]) != locked.end()) continue;
         const Eigen::Vector3d& pc = mesh.positions[layout.corners[c]];
         double local = 0.0;
         for (int q : quads_at[c]) local += area[q];
@@ -601,29 +686,52 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
   }
   const std::function<double(const PartitionStats&)> objective =
       options.objective == LayoutObjective::kSamplingCost ? sampling_cost : area_spread;
+  std::string last_error;
+  // Two groups of candidates: coarse meshes without and with the protrusion tips pinned (at most half the
+  // corners), by either collapse rule, each paired three ways. The best pairing of each group is balanced
+  // (corners moved, tips stay), and the better of the two balanced layouts is returned.
+  const std::vector<int> tips =
+      options.tip_persistence > 0.0
+          ? protrusion_tips(mesh, options.tip_persistence, static_cast<std::size_t>(target / 2))
+          : std::vector<int>{};
   QuadLayoutChoice best;
   double best_cost = 0.0;
-  std::string last_error;
-  for (const bool centroid_rule : {true, false}) {
-    Simplifier simplifier(mesh, centroid_rule);
-    if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
-      last_error = "cannot simplify the mesh to " + std::to_string(target) + " vertices without folding it";
-      continue;
+  std::size_t candidates = 0;
+  for (const bool pin_tips : {false, true}) {
+    if ((pin_tips && tips.empty()) || (!pin_tips && options.only_pinned_tips && !tips.empty())) continue;
+    QuadLayoutChoice group;
+    double group_cost = 0.0;
+    for (const bool centroid_rule : {true, false}) {
+      Simplifier simplifier(mesh, centroid_rule, pin_tips ? tips : std::vector<int>{});
+      if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
+        last_error = "cannot simplify the mesh to " + std::to_string(target) + " vertices without folding it";
+        continue;
+      }
+      std::vector<std::array<int, 3>> coarse = simplifier.triangles();
+      delaunay_flips(mesh.positions, coarse);
+      pair_coarse_triangles(mesh, coarse, k, objective, group, group_cost, last_error);
     }
-    std::vector<std::array<int, 3>> coarse = simplifier.triangles();
-    delaunay_flips(mesh.positions, coarse);
-    pair_coarse_triangles(mesh, coarse, k, objective, best, best_cost, last_error);
+    if (group.candidates == 0) continue;
+    candidates += group.candidates;
+    if (options.balance_steps > 0) {
+      PartitionResult partition = partition_mesh_layout(mesh, group.layout);
+      PartitionStats stats = partition_stats(partition);
+      group.balance_steps =
+          relax_corners(mesh, objective, tips, group.layout, partition, stats, options.balance_steps);
+      group_cost = objective(stats);
+    }
+    if (best.candidates == 0 || group_cost < best_cost) {
+      best = std::move(group);
+      best_cost = group_cost;
+      best.tips_pinned = pin_tips;
+    }
   }
   if (best.candidates == 0) {
     throw InvalidInput(std::string(kFn) + "no layout of " + std::to_string(k) +
                        " patches partitions the mesh (" + last_error + "); try another number of patches");
   }
-  if (options.balance_steps > 0) {
-    PartitionResult partition = partition_mesh_layout(mesh, best.layout);
-    PartitionStats stats = partition_stats(partition);
-    best.balance_steps = relax_corners(mesh, objective, best.layout, partition, stats, options.balance_steps);
-    best.area_balance = stats.area_balance;
-  }
+  best.candidates = candidates;
+  best.tips = tips;
   {
     const PartitionStats stats = partition_stats(partition_mesh_layout(mesh, best.layout));
     best.area_balance = stats.area_balance;

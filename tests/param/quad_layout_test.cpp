@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <string>
 
@@ -72,6 +73,41 @@ TEST(QuadLayout, BalancingEvensOutPatchAreas) {
     const QuadLayoutChoice balanced = expect_valid_layout(m, k, 0.45);
     EXPECT_LE(balanced.sampling_cost, raw.sampling_cost + 1e-12);
     EXPECT_LE(balanced.area_spread, 1.05);
+  }
+}
+
+// Protrusion tips: a sphere with four spikes (along ±x and ±y, 1.5 long) — each spike's cap holds a maximum
+// of the geodesic distance from the middle of the surface with a persistence of about a tenth of the largest
+// distance or more; with tips pinned, there is one tip on every spike, every tip is a corner of the layout,
+// and the layout is valid.
+TEST(QuadLayout, PinnedTipsAreCorners) {
+  TriMesh m = test::sphere(3);
+  const std::array<Eigen::Vector3d, 4> axes = {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0),
+                                               Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0)};
+  for (auto& p : m.positions) {
+    double r = 1.0;
+    for (const auto& a : axes) r += 1.5 * std::max(0.0, (p.normalized().dot(a) - 0.85) / 0.15);
+    p = r * p.normalized();
+  }
+  QuadLayoutOptions options;
+  options.patches = 8;
+  options.tip_persistence = 0.1;
+  options.only_pinned_tips = true;
+  const QuadLayoutChoice choice = choose_quad_layout(m, options);
+  EXPECT_TRUE(choice.tips_pinned);
+  ASSERT_EQ(choice.tips.size(), 4u);
+  const PartitionResult r = partition_mesh_layout(m, choice.layout);
+  EXPECT_EQ(test::check_partition(m, choice.layout.corners, r, &choice.layout), "");
+  for (int p = 0; p < options.patches; ++p) EXPECT_EQ(test::tutte_square_embedding(r, p).flipped, 0u);
+  for (int tip : choice.tips) {
+    EXPECT_NE(std::find(choice.layout.corners.begin(), choice.layout.corners.end(), tip),
+              choice.layout.corners.end())
+        << "tip " << tip << " is not a corner";
+  }
+  for (const auto& a : axes) {  // a tip on every spike's cap
+    int on_cap = 0;
+    for (int tip : choice.tips) on_cap += m.positions[tip].normalized().dot(a) > 0.85;
+    EXPECT_EQ(on_cap, 1) << "tips on the spike along " << a.transpose();
   }
 }
 

@@ -20,12 +20,43 @@ namespace {
 
 const char* const kFn = "choose_quad_layout: ";
 
+// Σ (A_q / Ā)² / K over the patches of `stats` (Ā the mean area): 1 when every patch has the same area,
+// larger the more the areas spread. With the same grid on every patch, a patch's squared resampling
+// error grows like its area squared, so this is the quantity that balancing lowers.
+double area_spread(const PartitionStats& stats) {
+  double total = 0.0, squares = 0.0;
+  for (const auto& p : stats.patches) {
+    total += p.area;
+    squares += p.area * p.area;
+  }
+  const double k = static_cast<double>(stats.patches.size());
+  return squares * k / (total * total);
+}
+
+// K · Σ A_q² / (flatness_q · A²) (A the total area): an estimate of the squared resampling error of a
+// layout whose patches all get the same grid, relative to K equal flat squares (1). A patch's squared error
+// grows like A_q² · σ_q² (σ_q its L2 stretch), and σ_q² grows like 1 / flatness_q (a patch that wraps around
+// a leg or an ear folds more of its area onto the same square): on the horse's 8-patch layout σ_q² and
+// 1 / flatness_q agree within a factor of 2 for 6 of its 8 patches (docs/measurements.md).
+double sampling_cost(const PartitionStats& stats) {
+  double total = 0.0, cost = 0.0;
+  for (const auto& p : stats.patches) {
+    total += p.area;
+    cost += p.area * p.area / std::max(p.flatness, 0.05);
+  }
+  return cost * static_cast<double>(stats.patches.size()) / (total * total);
+}
+
 // Half-edge collapses on a closed manifold triangle mesh, shortest edge first, vertices never moved.
 class Simplifier {
  public:
   // `centroid_rule`: of two merged vertices the one nearer their area's centroid stays; else the one that
   // stands for more area.
-  Simplifier(const TriMesh& mesh, bool centroid_rule) : m_(mesh), centroid_rule_(centroid_rule) {
+  // `pinned` vertices are never collapsed away (they stay coarse vertices); may be empty.
+  Simplifier(const TriMesh& mesh, bool centroid_rule, const std::vector<int>& pinned)
+      : m_(mesh), centroid_rule_(centroid_rule) {
+    pinned_.assign(m_.positions.size(), 0);
+    for (int v : pinned) pinned_[v] = 1;
     vf_.resize(m_.positions.size());
     for (int f = 0; f < static_cast<int>(m_.triangles.size()); ++f) {
       for (int v : m_.triangles[f]) vf_[v].push_back(f);
@@ -162,10 +193,13 @@ class Simplifier {
       const Eigen::Vector3d centre = (moment_[u] + moment_[v]) / merged;
       const double du = (m_.positions[u] - centre).squaredNorm(),
                    dv = (m_.positions[v] - centre).squaredNorm();
-      if (centroid_rule_) {
-        if (dv > du || (dv == du && v > u)) continue;  // the vertex nearer the merged area's centroid stays
-      } else if (carried_[u] > carried_[v] || (carried_[u] == carried_[v] && v > u)) {
-        continue;  // the vertex that stands for more area stays
+      if (pinned_[u]) continue;  // a pinned vertex stays
+      if (!pinned_[v]) {
+        if (centroid_rule_) {
+          if (dv > du || (dv == du && v > u)) continue;  // the vertex nearer the merged area's centroid stays
+        } else if (carried_[u] > carried_[v] || (carried_[u] == carried_[v] && v > u)) {
+          continue;  // the vertex that stands for more area stays
+        }
       }
       heap_.push({merged, u, v, stamp_[u], stamp_[v]});
     }
@@ -173,6 +207,7 @@ class Simplifier {
 
   TriMesh m_;
   std::vector<std::vector<int>> vf_;
+  std::vector<char> pinned_;
   std::vector<char> face_alive_;
   std::vector<std::uint32_t> stamp_;
   std::vector<double> carried_;          // surface area each vertex stands for
@@ -356,7 +391,8 @@ void even_quads_at_two_quad_corners(QuadLayout& layout) {
 // Pairs `coarse` (closed, 2k triangles over mesh vertices) into k quads by each greedy score completed to a
 // perfect matching; every pairing that partitions `mesh` is measured and kept in `best` if more balanced.
 void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int, 3>>& coarse, long long k,
-                           QuadLayoutChoice& best, std::string& last_error) {
+                           const std::function<double(const PartitionStats&)>& objective,
+                           QuadLayoutChoice& best, double& best_cost, std::string& last_error) {
   const int nf = static_cast<int>(coarse.size());
   // Dual graph: triangles sharing an edge.
   std::unordered_map<std::uint64_t, int> by_edge;
@@ -421,16 +457,206 @@ void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int
     }
     even_quads_at_two_quad_corners(layout);
     try {
-      const double balance = partition_stats(partition_mesh_layout(mesh, layout)).area_balance;
+      const PartitionStats stats = partition_stats(partition_mesh_layout(mesh, layout));
       ++best.candidates;
-      if (balance > best.area_balance) {
+      if (best.candidates == 1 || objective(stats) < best_cost) {
+        best_cost = objective(stats);
         best.layout = std::move(layout);
-        best.area_balance = balance;
       }
     } catch (const InvalidInput& e) {
       last_error = e.what();
     }
   }
+}
+
+
+// The tips of the shape's protrusions (legs, ears, head, tail): the maxima of the geodesic distance (Dijkstra
+// on the edge graph) from the vertex nearest the area centroid whose persistence (how far the distance
+// falls from the maximum before its region of the superlevel set joins one with a higher maximum) is at
+// least `min_persistence` times the largest distance, most persistent first, at most `max_tips`.
+std::vector<int> protrusion_tips(const TriMesh& mesh, double min_persistence, std::size_t max_tips) {
+  const int nv = static_cast<int>(mesh.positions.size());
+  std::vector<std::vector<int>> adj(nv);
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  for (const auto& t : mesh.triangles) {
+    for (int j = 0; j < 3; ++j) adj[t[j]].push_back(t[(j + 1) % 3]);
+    const double a = (mesh.positions[t[1]] - mesh.positions[t[0]])
+                         .cross(mesh.positions[t[2]] - mesh.positions[t[0]])
+                         .norm();
+    moment += a * (mesh.positions[t[0]] + mesh.positions[t[1]] + mesh.positions[t[2]]) / 3.0;
+    area += a;
+  }
+  const Eigen::Vector3d centre = moment / area;
+  int source = -1;
+  for (int v = 0; v < nv; ++v) {
+    if (adj[v].empty()) continue;
+    if (source < 0 || (mesh.positions[v] - centre).squaredNorm() <
+                          (mesh.positions[source] - centre).squaredNorm())
+      source = v;
+  }
+  std::vector<double> dist(nv, std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  dist[source] = 0.0;
+  queue.push({0.0, source});
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > dist[v]) continue;
+    for (int w : adj[v]) {
+      const double dw = d + (mesh.positions[w] - mesh.positions[v]).norm();
+      if (dw < dist[w]) {
+        dist[w] = dw;
+        queue.push({dw, w});
+      }
+    }
+  }
+  // Superlevel-set persistence by union-find, vertices in decreasing distance.
+  std::vector<int> order;
+  for (int v = 0; v < nv; ++v) {
+    if (!adj[v].empty()) order.push_back(v);
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return dist[a] != dist[b] ? dist[a] > dist[b] : a < b; });
+  std::vector<int> parent(nv, -1), peak(nv, -1);
+  std::function<int(int)> find = [&](int v) { return parent[v] == v ? v : parent[v] = find(parent[v]); };
+  std::vector<std::pair<double, int>> maxima;  // (persistence, vertex)
+  const double top = dist[order.front()];
+  for (int v : order) {
+    parent[v] = v;
+    peak[v] = v;
+    for (int w : adj[v]) {
+      if (parent[w] < 0) continue;
+      const int a = find(v), b = find(w);
+      if (a == b) continue;
+      // the region with the lower peak dies here
+      const int keep = dist[peak[a]] >= dist[peak[b]] ? a : b, die = keep == a ? b : a;
+      if (peak[die] != v) maxima.push_back({dist[peak[die]] - dist[v], peak[die]});
+      parent[die] = keep;
+    }
+  }
+  maxima.push_back({top, order.front()});  // the global maximum never dies
+  std::sort(maxima.begin(), maxima.end(), std::greater<>());
+  std::vector<int> tips;
+  for (const auto& [persistence, v] : maxima) {
+    if (persistence < min_persistence * top || tips.size() >= max_tips) break;
+    tips.push_back(v);
+  }
+  return tips;
+}
+
+// Moves the corners of `layout` over the mesh so that its patches get more equal areas. A move takes a set
+// of corners; each moves towards the area centroids of its larger neighbouring patches and away from its
+// smaller ones (a corner moved into a patch takes area from it and gives it to the patches on its other
+// sides), by `step` times the area-weighted sum of the directions, and lands on the nearest vertex of its
+// neighbouring patches that is not another corner. A move is kept when the new layout partitions the mesh
+// with a lower area_spread(). Each round tries all corners at once, then the corners of one patch at a time,
+// the patch farthest from the mean area first (up to 3 patches); when nothing is kept the step is halved.
+// At most `evaluations` partitions are tried. Returns the number of moves kept.
+int relax_corners(const TriMesh& mesh, const std::function<double(const PartitionStats&)>& objective,
+                  const std::vector<int>& locked, QuadLayout& layout, PartitionResult& partition,
+                  PartitionStats& stats, int evaluations) {
+  const int nc = static_cast<int>(layout.corners.size());
+  const int nq = static_cast<int>(layout.quads.size());
+  std::vector<std::vector<int>> quads_at(nc);
+  for (int q = 0; q < nq; ++q) {
+    for (int c : layout.quads[q]) quads_at[c].push_back(q);
+  }
+  double spread = objective(stats);
+  double step = 0.5;
+  int kept = 0, tried = 0;
+  while (tried < evaluations && step > 0.03) {
+    const auto& pm = partition.mesh;
+    // Area centroid of every patch and the vertices of each patch (original mesh vertices only).
+    std::vector<Eigen::Vector3d> centroid(nq, Eigen::Vector3d::Zero());
+    std::vector<double> area(nq, 0.0);
+    std::vector<std::vector<int>> verts(nq);
+    for (std::size_t f = 0; f < pm.triangles.size(); ++f) {
+      const auto& t = pm.triangles[f];
+      const int q = partition.face_patch[f];
+      const double a = 0.5 * (pm.positions[t[1]] - pm.positions[t[0]])
+                                 .cross(pm.positions[t[2]] - pm.positions[t[0]])
+                                 .norm();
+      centroid[q] += a * (pm.positions[t[0]] + pm.positions[t[1]] + pm.positions[t[2]]) / 3.0;
+      area[q] += a;
+      for (int v : t) {
+        if (v < static_cast<int>(mesh.positions.size())) verts[q].push_back(v);
+      }
+    }
+    double total = 0.0;
+    for (int q = 0; q < nq; ++q) {
+      centroid[q] /= area[q];
+      total += area[q];
+      std::sort(verts[q].begin(), verts[q].end());
+      verts[q].erase(std::unique(verts[q].begin(), verts[q].end()), verts[q].end());
+    }
+    const double mean = total / nq;
+    // The moves of this round: all corners, then each of the 3 patches farthest from the mean area.
+    std::vector<int> order(nq);
+    for (int q = 0; q < nq; ++q) order[q] = q;
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      const double da = std::abs(area[a] - mean), db = std::abs(area[b] - mean);
+      return da != db ? da > db : a < b;
+    });
+    std::vector<std::vector<int>> moves(1);
+    for (int c = 0; c < nc; ++c) moves[0].push_back(c);
+    for (int i = 0; i < std::min(nq, 3); ++i) {
+      const auto& q = layout.quads[order[i]];
+      moves.emplace_back(q.begin(), q.end());
+    }
+    bool improved = false;
+    for (const auto& move : moves) {
+      if (tried >= evaluations) break;
+      QuadLayout moved = layout;
+      std::vector<char> taken(mesh.positions.size(), 0);
+      for (int v : layout.corners) taken[v] = 1;
+      for (int c : move) {
+        if (std::find(locked.begin(), locked.end(), layout.corners[c]) != locked.end()) continue;
+        const Eigen::Vector3d& pc = mesh.positions[layout.corners[c]];
+        double local = 0.0;
+        for (int q : quads_at[c]) local += area[q];
+        local /= static_cast<double>(quads_at[c].size());
+        Eigen::Vector3d target = pc;
+        for (int q : quads_at[c]) target += step * (area[q] - local) / mean * (centroid[q] - pc);
+        int best_v = -1;
+        double best_d = std::numeric_limits<double>::infinity();
+        for (int q : quads_at[c]) {
+          for (int v : verts[q]) {
+            if (taken[v] && v != moved.corners[c]) continue;
+            const double d = (mesh.positions[v] - target).squaredNorm();
+            if (d < best_d) {
+              best_d = d;
+              best_v = v;
+            }
+          }
+        }
+        if (best_v < 0) continue;
+        taken[moved.corners[c]] = 0;
+        moved.corners[c] = best_v;
+        taken[best_v] = 1;
+      }
+      if (moved.corners == layout.corners) continue;
+      ++tried;
+      try {
+        PartitionResult candidate = partition_mesh_layout(mesh, moved);
+        PartitionStats candidate_stats = partition_stats(candidate);
+        const double candidate_spread = objective(candidate_stats);
+        if (candidate_spread < spread) {
+          layout = std::move(moved);
+          partition = std::move(candidate);
+          stats = std::move(candidate_stats);
+          spread = candidate_spread;
+          ++kept;
+          improved = true;
+          break;
+        }
+      } catch (const InvalidInput&) {
+        // this move cuts the mesh into other regions than the layout's quads: not kept
+      }
+    }
+    step = improved ? std::min(1.0, step * 1.25) : step * 0.5;
+  }
+  return kept;
 }
 
 }  // namespace
@@ -458,22 +684,59 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
     throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches need " + std::to_string(target) +
                        " corners but the mesh has " + std::to_string(vertices) + " vertices");
   }
-  QuadLayoutChoice best;
-  best.area_balance = -1.0;
+  const std::function<double(const PartitionStats&)> objective =
+      options.objective == LayoutObjective::kSamplingCost ? sampling_cost : area_spread;
   std::string last_error;
-  for (const bool centroid_rule : {true, false}) {
-    Simplifier simplifier(mesh, centroid_rule);
-    if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
-      last_error = "cannot simplify the mesh to " + std::to_string(target) + " vertices without folding it";
-      continue;
+  // Two groups of candidates: coarse meshes without and with the protrusion tips pinned (at most half the
+  // corners), by either collapse rule, each paired three ways. The best pairing of each group is balanced
+  // (corners moved, tips stay), and the better of the two balanced layouts is returned.
+  const std::vector<int> tips =
+      options.tip_persistence > 0.0
+          ? protrusion_tips(mesh, options.tip_persistence, static_cast<std::size_t>(target / 2))
+          : std::vector<int>{};
+  QuadLayoutChoice best;
+  double best_cost = 0.0;
+  std::size_t candidates = 0;
+  for (const bool pin_tips : {false, true}) {
+    if ((pin_tips && tips.empty()) || (!pin_tips && options.only_pinned_tips && !tips.empty())) continue;
+    QuadLayoutChoice group;
+    double group_cost = 0.0;
+    for (const bool centroid_rule : {true, false}) {
+      Simplifier simplifier(mesh, centroid_rule, pin_tips ? tips : std::vector<int>{});
+      if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
+        last_error = "cannot simplify the mesh to " + std::to_string(target) + " vertices without folding it";
+        continue;
+      }
+      std::vector<std::array<int, 3>> coarse = simplifier.triangles();
+      delaunay_flips(mesh.positions, coarse);
+      pair_coarse_triangles(mesh, coarse, k, objective, group, group_cost, last_error);
     }
-    std::vector<std::array<int, 3>> coarse = simplifier.triangles();
-    delaunay_flips(mesh.positions, coarse);
-    pair_coarse_triangles(mesh, coarse, k, best, last_error);
+    if (group.candidates == 0) continue;
+    candidates += group.candidates;
+    if (options.balance_steps > 0) {
+      PartitionResult partition = partition_mesh_layout(mesh, group.layout);
+      PartitionStats stats = partition_stats(partition);
+      group.balance_steps =
+          relax_corners(mesh, objective, tips, group.layout, partition, stats, options.balance_steps);
+      group_cost = objective(stats);
+    }
+    if (best.candidates == 0 || group_cost < best_cost) {
+      best = std::move(group);
+      best_cost = group_cost;
+      best.tips_pinned = pin_tips;
+    }
   }
   if (best.candidates == 0) {
     throw InvalidInput(std::string(kFn) + "no layout of " + std::to_string(k) +
                        " patches partitions the mesh (" + last_error + "); try another number of patches");
+  }
+  best.candidates = candidates;
+  best.tips = tips;
+  {
+    const PartitionStats stats = partition_stats(partition_mesh_layout(mesh, best.layout));
+    best.area_balance = stats.area_balance;
+    best.area_spread = area_spread(stats);
+    best.sampling_cost = sampling_cost(stats);
   }
   return best;
 }

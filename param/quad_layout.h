@@ -8,18 +8,45 @@
 #include "param/mesh_partition.h"
 
 #include <cstddef>
+#include <vector>
 
 namespace geomip {
+
+/// What the choice of a layout minimizes (both computed from partition_stats()).
+enum class LayoutObjective {
+  kAreaSpread,    ///< Σ (A_q / Ā)² / K: equal patch areas
+  kSamplingCost,  ///< K · Σ A_q² / (flatness_q · A²): equal areas and patches close to height fields
+};
 
 struct QuadLayoutOptions {
   /// K, the number of quads (patches), ≥ 2. The coarse mesh has 2K triangles and K + 2 − 2·genus vertices.
   int patches = 8;
+  /// At most this many steps that move the corners to even out the patch areas (0: none); each step costs
+  /// one partition_mesh_layout().
+  int balance_steps = 40;
+  LayoutObjective objective = LayoutObjective::kSamplingCost;
+  /// Protrusion tips: maxima of the geodesic distance from the middle of the surface whose persistence is at
+  /// least this fraction of the largest distance are offered as corners (layouts with them pinned compete
+  /// with layouts without, by the objective); 0 (default): no tips. Off by default because on the horse
+  /// the pinned-tip layout wins on the objective but loses remesh PSNR (docs/measurements.md).
+  double tip_persistence = 0.0;
+  /// For measurements: only the candidates with the tips pinned (when tips are found).
+  bool only_pinned_tips = false;
 };
 
 /// What choose_quad_layout() measured on the layout it returns.
 struct QuadLayoutChoice {
   QuadLayout layout;
   double area_balance = 0.0;   ///< smallest / largest patch area of its partition (PartitionStats)
+  /// Σ (A_q / Ā)² / K over its patch areas A_q (Ā their mean): 1 when all are equal. With the same grid on
+  /// every patch a patch's squared resampling error grows like A_q², so this is what the choice lowers.
+  double area_spread = 0.0;
+  /// K · Σ A_q² / (flatness_q · A²) (A the total area; PatchStats::flatness): relative to K equal flat
+  /// squares (1), an estimate of the layout's squared resampling error at a fixed sample count.
+  double sampling_cost = 0.0;
+  int balance_steps = 0;       ///< corner moves kept by the balancing
+  std::vector<int> tips;       ///< protrusion tips found (vertex ids; pinned in some candidates)
+  bool tips_pinned = false;    ///< the layout returned is one with the tips pinned
   std::size_t candidates = 0;  ///< pairings tried that partition the mesh
 };
 
@@ -35,9 +62,15 @@ struct QuadLayoutChoice {
 ///    bridgeless on a closed triangle mesh, so one exists (Petersen 1891). A greedy matching by one of three
 ///    scores (flattest pairs, pairs closest to the mean quad area, pairs across the longest edge) is
 ///    completed by augmenting paths with blossom contraction (Edmonds 1965);
-/// 3. every pairing that partition_mesh_layout() accepts is measured and the one with the best area balance
-///    (PartitionStats::area_balance) is returned.
-/// Cost: O(F log F) for the simplification plus one partition per pairing.
+/// 3. every pairing that partition_mesh_layout() accepts is measured and the one with the lowest objective
+///    (QuadLayoutOptions::objective; PartitionStats) is kept;
+/// 4. its corners are moved to lower the objective (at most `balance_steps` partitions tried): each corner
+///    steps towards the area centroids of its larger neighbouring patches and away from its smaller ones,
+///    landing on a mesh vertex that is not another corner; a move is kept only when the layout still
+///    partitions the mesh and the objective drops, so it never makes the layout worse.
+/// With `tip_persistence` > 0 the steps run twice, without and with the protrusion tips pinned as coarse
+/// vertices (never collapsed, never moved), and the layout with the lower objective is returned.
+/// Cost: O(F log F) for the simplification plus one partition per pairing and per balancing step.
 ///
 /// \throw InvalidInput with "choose_quad_layout:" when the mesh is not one closed, manifold, oriented
 ///   component, K < 2, K + 2 − 2g < 4 (K too small for the genus), K + 2 − 2g exceeds the mesh's vertices

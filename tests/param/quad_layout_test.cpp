@@ -8,27 +8,45 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <string>
 
 namespace geomip {
 namespace {
 
-void expect_valid_layout(const TriMesh& m, int patches, double min_balance) {
-  SCOPED_TRACE(std::to_string(patches) + " patches");
+QuadLayoutChoice expect_valid_layout(const TriMesh& m, int patches, double min_balance,
+                                     int balance_steps = QuadLayoutOptions{}.balance_steps) {
+  SCOPED_TRACE(std::to_string(patches) + " patches, " + std::to_string(balance_steps) + " balancing steps");
   QuadLayoutOptions options;
   options.patches = patches;
+  options.balance_steps = balance_steps;
   const QuadLayoutChoice choice = choose_quad_layout(m, options);
-  ASSERT_EQ(choice.layout.quads.size(), static_cast<std::size_t>(patches));
+  EXPECT_EQ(choice.layout.quads.size(), static_cast<std::size_t>(patches));
   EXPECT_GE(choice.candidates, 1u);
   const PartitionResult r = partition_mesh_layout(m, choice.layout);
   EXPECT_EQ(test::check_partition(m, choice.layout.corners, r, &choice.layout), "");
   for (int p = 0; p < patches; ++p)
     EXPECT_EQ(test::tutte_square_embedding(r, p).flipped, 0u) << "patch " << p;
-  const double balance = partition_stats(r).area_balance;
+  const PartitionStats stats = partition_stats(r);
+  const double balance = stats.area_balance;
   EXPECT_DOUBLE_EQ(balance, choice.area_balance);
   EXPECT_GE(balance, min_balance);
-  std::printf("%d patches: area balance %.3f, %zu pairings partition\n", patches, balance, choice.candidates);
+  double total = 0.0, squares = 0.0, cost = 0.0;
+  for (const auto& p : stats.patches) {
+    total += p.area;
+    squares += p.area * p.area;
+    cost += p.area * p.area / std::max(p.flatness, 0.05);
+  }
+  EXPECT_NEAR(choice.area_spread, squares * patches / (total * total), 1e-9);
+  EXPECT_NEAR(choice.sampling_cost, cost * patches / (total * total), 1e-9);
+  EXPECT_GE(choice.sampling_cost, choice.area_spread - 1e-12);  // flatness ≤ 1
+  EXPECT_GE(choice.area_spread, 1.0 - 1e-12);  // Cauchy–Schwarz: 1 only for equal areas
+  EXPECT_LE(choice.balance_steps, balance_steps);
+  std::printf("%d patches: area balance %.3f, spread %.3f, %zu pairings partition, %d balancing moves\n",
+              patches, balance, choice.area_spread, choice.candidates, choice.balance_steps);
+  return choice;
 }
 
 TEST(QuadLayout, SphereLayoutsOfSeveralSizes) {
@@ -42,6 +60,55 @@ TEST(QuadLayout, TorusLayout) {
 
 TEST(QuadLayout, DoubleTorusLayout) {
   expect_valid_layout(test::subdivide(test::double_torus(), 1), 24, 0.02);
+}
+
+// An ellipsoid (a sphere scaled 2.5 × 1 × 0.6): the coarse mesh's quads differ in area, the balancing moves
+// the corners until the patches are close to equal; it never makes the sampling cost (what it minimizes)
+// worse than the layout it starts from.
+TEST(QuadLayout, BalancingEvensOutPatchAreas) {
+  TriMesh m = test::sphere(3);
+  for (auto& p : m.positions) p = Eigen::Vector3d(2.5 * p.x(), p.y(), 0.6 * p.z());
+  for (int k : {8, 12}) {
+    const QuadLayoutChoice raw = expect_valid_layout(m, k, 0.0, 0);
+    const QuadLayoutChoice balanced = expect_valid_layout(m, k, 0.45);
+    EXPECT_LE(balanced.sampling_cost, raw.sampling_cost + 1e-12);
+    EXPECT_LE(balanced.area_spread, 1.05);
+  }
+}
+
+// Protrusion tips: a sphere with four spikes (along ±x and ±y, 1.5 long) — each spike's cap holds a maximum
+// of the geodesic distance from the middle of the surface with a persistence of about a tenth of the largest
+// distance or more; with tips pinned, there is one tip on every spike, every tip is a corner of the layout,
+// and the layout is valid.
+TEST(QuadLayout, PinnedTipsAreCorners) {
+  TriMesh m = test::sphere(3);
+  const std::array<Eigen::Vector3d, 4> axes = {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0),
+                                               Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0)};
+  for (auto& p : m.positions) {
+    double r = 1.0;
+    for (const auto& a : axes) r += 1.5 * std::max(0.0, (p.normalized().dot(a) - 0.85) / 0.15);
+    p = r * p.normalized();
+  }
+  QuadLayoutOptions options;
+  options.patches = 8;
+  options.tip_persistence = 0.1;
+  options.only_pinned_tips = true;
+  const QuadLayoutChoice choice = choose_quad_layout(m, options);
+  EXPECT_TRUE(choice.tips_pinned);
+  ASSERT_EQ(choice.tips.size(), 4u);
+  const PartitionResult r = partition_mesh_layout(m, choice.layout);
+  EXPECT_EQ(test::check_partition(m, choice.layout.corners, r, &choice.layout), "");
+  for (int p = 0; p < options.patches; ++p) EXPECT_EQ(test::tutte_square_embedding(r, p).flipped, 0u);
+  for (int tip : choice.tips) {
+    EXPECT_NE(std::find(choice.layout.corners.begin(), choice.layout.corners.end(), tip),
+              choice.layout.corners.end())
+        << "tip " << tip << " is not a corner";
+  }
+  for (const auto& a : axes) {  // a tip on every spike's cap
+    int on_cap = 0;
+    for (int tip : choice.tips) on_cap += m.positions[tip].normalized().dot(a) > 0.85;
+    EXPECT_EQ(on_cap, 1) << "tips on the spike along " << a.transpose();
+  }
 }
 
 void expect_refused(const TriMesh& m, int patches, const std::string& fragment) {

@@ -1,0 +1,69 @@
+// Automatic quad layouts on real meshes: area balance (smallest / largest patch), area spread and the corner
+// moves of the balancing for each K, without the parameterization. Not part of ctest (figures, not tests).
+// Run: build/tests/bench/layout_bench MESH K [K...]   (env GEOMIP_BALANCE_STEPS: balancing steps, default
+// QuadLayoutOptions' own)
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_repair.h"
+#include "mesh/mesh_topology.h"
+#include "param/quad_layout.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <stdexcept>
+#include <string>
+
+int main(int argc, char** argv) {
+  using namespace geomip;
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: layout_bench MESH K [K...]\n");
+    return 2;
+  }
+  try {
+    TriMesh mesh = read_mesh(argv[1]);
+    const TopologyReport r = analyze_topology(mesh);
+    if (r.boundary_loops > 0 || !r.manifold) mesh = repair_mesh(mesh).mesh;
+    for (int i = 2; i < argc; ++i) {
+      QuadLayoutOptions options;
+      options.patches = std::atoi(argv[i]);
+      if (const char* steps = std::getenv("GEOMIP_BALANCE_STEPS")) options.balance_steps = std::atoi(steps);
+      if (const char* t = std::getenv("GEOMIP_TIP_PERSISTENCE")) options.tip_persistence = std::atof(t);
+      options.only_pinned_tips = std::getenv("GEOMIP_ONLY_PINNED_TIPS") != nullptr;
+      if (const char* o = std::getenv("GEOMIP_LAYOUT_OBJECTIVE"); o && std::string(o) == "area")
+        options.objective = LayoutObjective::kAreaSpread;
+      const auto start = std::chrono::steady_clock::now();
+      const QuadLayoutChoice c = choose_quad_layout(mesh, options);
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::printf("%s K=%d balance %.3f spread %.3f cost %.3f moves %d candidates %zu tips %zu%s (%.1f s)\n", argv[1],
+                  options.patches, c.area_balance, c.area_spread, c.sampling_cost, c.balance_steps,
+                  c.candidates, c.tips.size(), c.tips_pinned ? " pinned" : "", seconds);
+      if (const char* json = std::getenv("GEOMIP_LAYOUT_JSON")) {  // a CORR.json of this layout, corners as xyz
+        std::FILE* f = std::fopen(json, "w");
+        if (!f) throw std::runtime_error(std::string("cannot write ") + json);
+        std::fprintf(f, "{\"layout\": {\"quads\": [");
+        for (std::size_t q = 0; q < c.layout.quads.size(); ++q) {
+          const auto& quad = c.layout.quads[q];
+          std::fprintf(f, "%s[%d, %d, %d, %d]", q ? ", " : "", quad[0], quad[1], quad[2], quad[3]);
+        }
+        std::fprintf(f, "]}, \"models\": [{\"mesh\": \"%s\", \"partition_points\": [", argv[1]);
+        for (std::size_t j = 0; j < c.layout.corners.size(); ++j) {
+          const auto& p = mesh.positions[c.layout.corners[j]];
+          std::fprintf(f, "%s[%.17g, %.17g, %.17g]", j ? ", " : "", p.x(), p.y(), p.z());
+        }
+        std::fprintf(f, "]}]}\n");
+        std::fclose(f);
+      }
+      const PartitionStats stats = partition_stats(partition_mesh_layout(mesh, c.layout));
+      for (std::size_t q = 0; q < stats.patches.size(); ++q) {
+        std::printf("  patch %zu: area %.6g, boundary %.4g, flatness %.3f\n", q, stats.patches[q].area,
+                    stats.patches[q].boundary_length, stats.patches[q].flatness);
+      }
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "layout_bench: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

@@ -12,6 +12,13 @@ std::string check_pack_header(std::span<const std::uint8_t> head, std::uint64_t 
     manifest_end = 0;
     return "not a .gip pack (" + std::string(codec::status_message(st)) + ")";
   }
+  // Format 4's header is shorter than the first read (codec::kPackHeaderSize bytes); every real manifest
+  // reaches past it, and the fetcher's reads assume so.
+  if (manifest_end < codec::kPackHeaderSize) {
+    const std::size_t claimed = manifest_end;
+    manifest_end = 0;
+    return "not a usable .gip pack (its manifest ends at byte " + std::to_string(claimed) + ", too short to hold a model)";
+  }
   if (available != kUnknownSize && manifest_end > available)
     return "truncated .gip pack (its manifest ends at byte " + std::to_string(manifest_end) +
            ", the source has " + std::to_string(available) + " bytes)";

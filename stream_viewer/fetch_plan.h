@@ -27,7 +27,8 @@ struct FetchPlan {
 };
 
 /// Checks the fixed header (`head` holds at least its first codec::kPackHeaderSize bytes, or the whole source
-/// when it is shorter) and that the manifest fits in `available` bytes. Returns "" and sets `manifest_end`,
+/// when it is shorter), that the manifest ends at or past byte codec::kPackHeaderSize (a format-4 header is
+/// shorter, but no manifest that holds a model is) and that it fits in `available` bytes. Returns "" and sets `manifest_end`,
 /// or one line saying why the source is not a usable pack. Never throws.
 std::string check_pack_header(std::span<const std::uint8_t> head, std::uint64_t available,
                               std::size_t& manifest_end);

@@ -114,6 +114,12 @@ TEST(FetchPlan, ManifestPastTheSourceOrBadHeaderIsOneLine) {
   EXPECT_NE(e.find("truncated"), std::string::npos) << e;
   e = check_pack_header(std::span(bytes).first(5), 5, manifest_end);
   EXPECT_NE(e.find("not a .gip pack"), std::string::npos) << e;
+  // A format-4 header (magic, version 4, varint manifest size 2, CRC: 15 bytes) announcing a 2-byte manifest:
+  // it would end inside the first read.
+  const std::vector<std::uint8_t> tiny = {'G', 'E', 'O', 'M', 'I', 'P', 'K', 0x1a, 4, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  e = check_pack_header(tiny, tiny.size(), manifest_end);
+  EXPECT_NE(e.find("manifest ends at byte"), std::string::npos) << e;
+  EXPECT_EQ(manifest_end, 0u);
   std::vector<std::uint8_t> text(64, 'x');
   e = plan(text, text.size(), p);
   EXPECT_NE(e.find("not a .gip pack"), std::string::npos) << e;

@@ -30,6 +30,9 @@ struct ConvertArgs {
   bool no_normals = false;
   int normal_mesh_steps = ConvertOptions{}.normal_mesh_steps;
   double normal_mesh_reach = ConvertOptions{}.normal_mesh_max_shift;
+  int frame_steps = ConvertOptions{}.frame_steps;
+  int tangential_shift = ConvertOptions{}.tangential_shift;
+  bool no_orientation_weights = false;
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
 };
 
@@ -58,6 +61,11 @@ int run_convert(const ConvertArgs& args) {
   if (args.normal_mesh_steps < -1 || args.normal_mesh_steps > args.level)
     throw InvalidInput("--normal-mesh " + std::to_string(args.normal_mesh_steps) + " is outside [0, " +
                        std::to_string(args.level) + "] (the level)");
+  if (args.frame_steps < 0 || args.frame_steps > args.level)
+    throw InvalidInput("--frame-steps " + std::to_string(args.frame_steps) + " is outside [0, " +
+                       std::to_string(args.level) + "] (the level)");
+  if (args.tangential_shift < 0 || args.tangential_shift > 8)
+    throw InvalidInput("--tangential-shift " + std::to_string(args.tangential_shift) + " is outside [0, 8]");
   if (args.normal_mesh_steps > 0 && (args.common.meshes.size() > 1 || !args.common.points.empty()))
     throw InvalidInput("--normal-mesh moves samples off the parameterization, which the morphs of a consistent "
                        "set rely on: use it with one mesh");
@@ -76,6 +84,9 @@ int run_convert(const ConvertArgs& args) {
   options.sampling_exponent = args.common.sampling_exponent;
   options.normal_mesh_steps = args.normal_mesh_steps;
   options.normal_mesh_max_shift = args.normal_mesh_reach;
+  options.frame_steps = args.frame_steps;
+  options.tangential_shift = args.tangential_shift;
+  options.orientation_weights = !args.no_orientation_weights;
   options.up = up_axis(args);
   options.progress = bar.callback();
   const ConvertResult converted = convert_models(models, options);
@@ -145,6 +156,15 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_option("--normal-mesh-reach", args->normal_mesh_reach,
                   "Largest move of a normal-mesh sample, in sample spacings of its level")
       ->check(CLI::Range(0.0, 4.0));
+  // Codec tools, for ablations (docs/codec-v3.md); the defaults are the codec's best measured.
+  cmd->add_option("--frame-steps", args->frame_steps,
+                  "Code the details of the finest STEPS wavelet steps in local (normal, tangent) frames "
+                  "(default " + std::to_string(ConvertOptions{}.frame_steps) + ", 0 = off)");
+  cmd->add_option("--tangential-shift", args->tangential_shift,
+                  "Quantize framed tangential components 2^S times coarser than normal ones (default " +
+                      std::to_string(ConvertOptions{}.tangential_shift) + ")");
+  cmd->add_flag("--no-orientation-weights", args->no_orientation_weights,
+                "Weigh row/column and diagonal detail bands alike (ablations)");
   cmd->add_option(
          "--up", args->up,
          "The models' up axis, stored with the front in each model's normalization (the viewer's frame; "

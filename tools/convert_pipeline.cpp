@@ -129,6 +129,9 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   codec::PackWriteOptions write;
   write.normals = options.normals;
   write.geometry.quantization_bits = options.quantization_bits;
+  write.geometry.frame_steps = options.frame_steps;
+  write.geometry.tangential_shift = options.tangential_shift;
+  write.geometry.orientation_weights = options.orientation_weights;
   result.pack = codec::write_pack(inputs, write);
   result.encode_seconds = seconds_since(t0);
   progress("encode", 1.0);

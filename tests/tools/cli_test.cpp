@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace geomip {
@@ -724,6 +725,43 @@ TEST_F(CliPack, NormalMeshRefusedForSeveralMeshes) {
   EXPECT_NE(r.err.find("one mesh"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(pack));
   expect_bad_input("convert -q '" + spot_ + "' --normal-mesh 9 --level 8 -o '" + pack + "'", "--normal-mesh");
+}
+
+// The codec's tools can be switched off for ablations: without local frames (and without normal-mesh
+// resampling) the whole pack decodes losslessly up to the quantization, i.e. every decoded vertex lies within
+// half a quantization step per coordinate of the level-N remesh's (same parameterization, same samples);
+// with the default frames the rotation rounds (about a step per coordinate), which this bound does not allow.
+// Out-of-range switches: exit 2, one line, no pack.
+TEST_F(CliPack, CodecSwitchesForAblations) {
+  Outcome r = geomip("remesh --quiet '" + spot_ + "' --level 4 --sampling-exponent 0 -o '" + dir_ + "/m'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const TriMesh remesh = read_mesh(dir_ + "/m/spot.M4.obj");
+  const BoundingBox box = referenced_bounding_box(remesh);
+  const double step = (box.max - box.min).maxCoeff() / 16384.0;  // 14 bits over the largest extent
+  const auto largest_offset_in_steps = [&](const std::string& switches) {
+    const std::string pack = dir_ + "/ablation.gip";
+    const Outcome c = geomip("convert -q '" + spot_ + "' --level 4 --no-normals --normal-mesh 0 " + switches +
+                             " -o '" + pack + "'");
+    EXPECT_EQ(c.exit_code, 0) << c.err;
+    const Outcome d = geomip("decode -q '" + pack + "' -o '" + dir_ + "/ablation.obj'");
+    EXPECT_EQ(d.exit_code, 0) << d.err;
+    const TriMesh decoded = read_mesh(dir_ + "/ablation.obj");
+    EXPECT_EQ(decoded.num_vertices(), remesh.num_vertices());
+    double largest = 0;  // over decoded vertices: distance (L∞) to the nearest remesh vertex
+    for (const Eigen::Vector3d& p : decoded.positions) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Eigen::Vector3d& q : remesh.positions) nearest = std::min(nearest, (p - q).lpNorm<Eigen::Infinity>());
+      largest = std::max(largest, nearest);
+    }
+    return largest / step;
+  };
+  EXPECT_LE(largest_offset_in_steps("--frame-steps 0 --no-orientation-weights"), 0.5 + 1e-6);
+  EXPECT_LE(largest_offset_in_steps("--frame-steps 0"), 0.5 + 1e-6);
+  EXPECT_GT(largest_offset_in_steps("--frame-steps 3 --tangential-shift 2"), 0.5);
+  const std::string pack = dir_ + "/bad.gip";
+  expect_bad_input("convert -q '" + spot_ + "' --level 4 --frame-steps 5 -o '" + pack + "'", "--frame-steps");
+  expect_bad_input("convert -q '" + spot_ + "' --level 4 --tangential-shift 9 -o '" + pack + "'",
+                   "--tangential-shift");
 }
 
 // --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch

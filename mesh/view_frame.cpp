@@ -65,8 +65,7 @@ int front_votes(const TriMesh& mesh, const std::vector<Eigen::Vector3d>& points,
   const int reach = sign(top[1] - top[0]);
   const int width = sign((side_hi[1] - side_lo[1]) - (side_hi[0] - side_lo[0]));
   // 3. Mass: the centroid of the enclosed volume (signed tetrahedra from the box centre) lies behind the
-  //    middle of the length, towards the body; no opinion for an open or flat mesh (|volume| ≤ 1e-9 of the
-  //    box's).
+  //    middle of the length, towards the body; no opinion for a flat mesh (|volume| ≤ 1e-9 of the box's).
   const Eigen::Vector3d centre = 0.5 * (lo + hi);
   double volume = 0, moment = 0;
   for (const auto& t : mesh.triangles) {

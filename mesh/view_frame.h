@@ -31,7 +31,8 @@ Eigen::Vector3d ground_direction(const TriMesh& mesh, double band = 0.05);
 ///   width — the side extent (the third axis) of the tenth of the length at that end (ears, horns, a turned
 ///           head; a tail is thin);
 ///   mass  — the distance of that end from the centroid of the enclosed volume (the body is behind the head;
-///           no vote when the signed volume is below 1e-9 of the box's: an open or flat mesh).
+///           signed tetrahedra from the box's centre, so an open mesh counts as closed by cones to it; no
+///           vote when |volume| ≤ 1e-9 of the box's: a flat mesh).
 /// A head resting on the ground (the pig of ../shared/meshes) loses the reach but wins the other two. +z =
 /// x × y. A camera at positive yaw (in the xz plane from +z towards +x) then sees the model from the side,
 /// its head turned towards the camera. The animals of ../shared/meshes, each cue and the result are in

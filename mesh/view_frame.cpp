@@ -43,6 +43,50 @@ double hull_area(std::vector<Eigen::Vector2d> p) {
   return std::abs(area) / 2;
 }
 
+/// The three cues of upright_rotation()'s front, each +1 (the positive end of axis `length`), −1 or 0 (no
+/// opinion), summed.
+int front_votes(const TriMesh& mesh, const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up,
+                int up_index, int length, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const auto sign = [](double v) { return v > 0 ? 1 : v < 0 ? -1 : 0; };
+  const int side = 3 - length - up_index;
+  const double extent = hi[length] - lo[length];
+  // 1. Reach: the largest up coordinate in the quarter of the length at each end.
+  // 2. Width: the side extent of the tenth of the length at each end (ears, horns, a turned head).
+  double top[2] = {-HUGE_VAL, -HUGE_VAL}, side_lo[2] = {HUGE_VAL, HUGE_VAL},
+         side_hi[2] = {-HUGE_VAL, -HUGE_VAL};
+  for (const auto& p : points) {
+    const double height = up.dot(p);
+    if (p[length] <= lo[length] + 0.25 * extent) top[0] = std::max(top[0], height);
+    if (p[length] >= hi[length] - 0.25 * extent) top[1] = std::max(top[1], height);
+    for (int end = 0; end < 2; ++end)
+      if (end == 0 ? p[length] <= lo[length] + 0.1 * extent : p[length] >= hi[length] - 0.1 * extent)
+        side_lo[end] = std::min(side_lo[end], p[side]), side_hi[end] = std::max(side_hi[end], p[side]);
+  }
+  const int reach = sign(top[1] - top[0]);
+  const int width = sign((side_hi[1] - side_lo[1]) - (side_hi[0] - side_lo[0]));
+  // 3. Mass: the centroid of the enclosed volume (signed tetrahedra from the box centre) lies behind the
+  //    middle of the length, towards the body; no opinion for a flat mesh (|volume| ≤ 1e-9 of the box's).
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  double volume = 0, moment = 0;
+  for (const auto& t : mesh.triangles) {
+    bool valid = true;
+    for (int v : t) valid = valid && v >= 0 && static_cast<std::size_t>(v) < mesh.positions.size();
+    if (!valid) continue;
+    const Eigen::Vector3d a = mesh.positions[static_cast<std::size_t>(t[0])] - centre,
+                          b = mesh.positions[static_cast<std::size_t>(t[1])] - centre,
+                          c = mesh.positions[static_cast<std::size_t>(t[2])] - centre;
+    if (!a.allFinite() || !b.allFinite() || !c.allFinite()) continue;
+    const double v6 = a.dot(b.cross(c));
+    volume += v6;
+    moment += v6 * (a[length] + b[length] + c[length]) / 4;
+  }
+  const Eigen::Vector3d box = hi - lo;
+  const bool closed = std::abs(volume) / 6 > 1e-9 * box.x() * box.y() * box.z();
+  const int mass = closed ? -sign(moment / volume) : 0;
+  const int votes = reach + width + mass;
+  return votes != 0 ? votes : reach;
+}
+
 }  // namespace
 
 Eigen::Vector3d ground_direction(const TriMesh& mesh, double band) {
@@ -71,7 +115,7 @@ Eigen::Vector3d ground_direction(const TriMesh& mesh, double band) {
   return best;
 }
 
-Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up_axis) {
+Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up_axis, const Eigen::Vector3d& front_axis) {
   const Eigen::Vector3d up = up_axis == UpAxis::kX   ? Eigen::Vector3d::UnitX()
                              : up_axis == UpAxis::kY ? Eigen::Vector3d::UnitY()
                              : up_axis == UpAxis::kZ ? Eigen::Vector3d::UnitZ()
@@ -88,15 +132,15 @@ Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up_axis) {
   int length = -1;
   for (int c = 0; c < 3; ++c)
     if (c != up_index && (length < 0 || hi[c] - lo[c] > hi[length] - lo[length])) length = c;
-  // Its end that reaches higher: the largest up coordinate in the quarter of the length at each end.
-  const double quarter = 0.25 * (hi[length] - lo[length]);
-  double top_low = -HUGE_VAL, top_high = -HUGE_VAL;
-  for (const auto& p : points) {
-    const double height = up.dot(p);
-    if (p[length] <= lo[length] + quarter) top_low = std::max(top_low, height);
-    if (p[length] >= hi[length] - quarter) top_high = std::max(top_high, height);
-  }
-  const Eigen::Vector3d front = Eigen::Vector3d::Unit(length) * (top_low > top_high ? -1.0 : 1.0);
+  // A given front: a signed unit axis across up.
+  int front_index = 0;
+  front_axis.cwiseAbs().maxCoeff(&front_index);
+  const bool given =
+      front_index != up_index && std::abs(front_axis[front_index]) == 1 && front_axis.cwiseAbs().sum() == 1;
+  const Eigen::Vector3d front =
+      given ? front_axis
+            : Eigen::Vector3d(Eigen::Vector3d::Unit(length) *
+                              (front_votes(mesh, points, up, up_index, length, lo, hi) < 0 ? -1.0 : 1.0));
   Eigen::Matrix3d r;
   r.row(0) = front.transpose();
   r.row(1) = up.transpose();

@@ -1,6 +1,6 @@
 // The frame a viewer shows a mesh in: which way is up and which way the model faces, as an axis-aligned
 // rotation, and the transform of model units into the viewer's normalized frame (codec::PackModelInfo::
-// normalization: y up, centred, largest extent 1). Used by `geomip convert --up`.
+// normalization: y up, centred, largest extent 1). Used by `geomip convert --up, --front`.
 #pragma once
 
 #include "mesh/mesh.h"
@@ -23,12 +23,22 @@ Eigen::Vector3d ground_direction(const TriMesh& mesh, double band = 0.05);
 
 /// The rotation (a signed permutation matrix, det +1) from model units to the viewer's axes: rows are the
 /// model directions that become +x, +y, +z. +y = up (the opposite of ground_direction() for kAuto, else the
-/// named axis). +x = the front: of the two remaining axes, the one along which the box is longer (the length
-/// of an animal; ties: the first in x, y, z order), pointing to the end that reaches higher (the largest up
-/// coordinate of the vertices in the quarter of the length at that end: the head of an animal, which stands
-/// above its tail; ties: the positive end). +z = x × y. A camera at positive yaw (in the xz plane from +z
-/// towards +x) then sees the model from the side, its head turned towards the camera.
-Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up);
+/// named axis). +x = the front: `front` when it is a signed unit axis perpendicular to up; otherwise (zero,
+/// the default, or along up) of the two remaining axes the one along which the box is longer (the length of
+/// an animal; ties: the first in x, y, z order), pointing to the end that wins two of three cues, each a
+/// vote for the end where it is larger (ties: no vote; all three even: the positive end):
+///   reach — the largest up coordinate in the quarter of the length at that end (a head held above the tail);
+///   width — the side extent (the third axis) of the tenth of the length at that end (ears, horns, a turned
+///           head; a tail is thin);
+///   mass  — the distance of that end from the centroid of the enclosed volume (the body is behind the head;
+///           signed tetrahedra from the box's centre, so an open mesh counts as closed by cones to it; no
+///           vote when |volume| ≤ 1e-9 of the box's: a flat mesh).
+/// A head resting on the ground (the pig of ../shared/meshes) loses the reach but wins the other two. +z =
+/// x × y. A camera at positive yaw (in the xz plane from +z towards +x) then sees the model from the side,
+/// its head turned towards the camera. The animals of ../shared/meshes, each cue and the result are in
+/// docs/streaming.md ("Upright and front"). Cost: O(#V + #F) after ground_direction().
+Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up,
+                                 const Eigen::Vector3d& front = Eigen::Vector3d::Zero());
 
 /// Row-major 4×4 of x ↦ (R·x − c) / e: R = `rotation`, c and e the centre and the largest extent of the
 /// rotated bounding box of the referenced vertices (the normalized frame: centred, largest extent 1; e = 1

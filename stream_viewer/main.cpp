@@ -122,16 +122,20 @@ void scroll(GLFWwindow* w, double, double dy) {
                                             0.3f, 20.0f);
 }
 
-/// The xyz samples of the scene models' first layers (the geometry itself, or the coarse base of a banded
-/// model).
+/// The xyz samples of the scene models themselves: per patch the sum of its bands (one band: the geometry; a
+/// banded model's bands add up to it), so that both morph schedules frame a model alike.
 std::vector<float> base_layers(const std::vector<morph::SceneModel>& models) {
   std::vector<float> xyz;
   for (const morph::SceneModel& m : models) {
     const std::size_t per = 3u * static_cast<std::size_t>(m.size()) * static_cast<std::size_t>(m.size());
     for (int p = 0; p < m.num_patches; ++p) {
-      const auto first =
-          m.positions.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(p) * m.bands * per);
-      xyz.insert(xyz.end(), first, first + static_cast<std::ptrdiff_t>(per));
+      const std::size_t first = static_cast<std::size_t>(p) * static_cast<std::size_t>(m.bands) * per;
+      const std::size_t at = xyz.size();
+      xyz.insert(xyz.end(), m.positions.begin() + static_cast<std::ptrdiff_t>(first),
+                 m.positions.begin() + static_cast<std::ptrdiff_t>(first + per));
+      for (int b = 1; b < m.bands; ++b)
+        for (std::size_t k = 0; k < per; ++k)
+          xyz[at + k] += m.positions[first + static_cast<std::size_t>(b) * per + k];
     }
   }
   return xyz;

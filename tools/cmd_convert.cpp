@@ -34,6 +34,7 @@ struct ConvertArgs {
   int tangential_shift = ConvertOptions{}.tangential_shift;
   bool no_orientation_weights = false;
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
+  std::string front;  ///< +x, -x, +y, -y, +z, -z; empty: from the shape
 };
 
 /// --up as ConvertOptions::up (nullopt = no frame stored).
@@ -44,6 +45,12 @@ std::optional<UpAxis> up_axis(const ConvertArgs& args) {
   if (up == "z") return UpAxis::kZ;
   if (up == "auto") return UpAxis::kAuto;
   return std::nullopt;
+}
+
+/// --front as a signed unit axis of the model's units (zero = from the shape, upright_rotation()).
+Eigen::Vector3d front_axis(const ConvertArgs& args) {
+  if (args.front.size() != 2) return Eigen::Vector3d::Zero();
+  return Eigen::Vector3d::Unit(args.front[1] - 'x') * (args.front[0] == '-' ? -1.0 : 1.0);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -74,6 +81,14 @@ int run_convert(const ConvertArgs& args) {
   const PreparedModels models =
       prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches);
 
+  const std::optional<UpAxis> up = up_axis(args);
+  const Eigen::Vector3d front = front_axis(args);
+  if (!front.isZero() && !models.inputs.empty()) {
+    if (!up) throw InvalidInput("--front " + args.front + " needs a stored frame: --up x, y, z or auto");
+    if (!upright_rotation(models.inputs[0].mesh, *up, front).row(0).transpose().isApprox(front))
+      throw InvalidInput("--front " + args.front + " is along the up axis; name one of the other two axes");
+  }
+
   ProgressBar bar("convert", report);
   ConvertOptions options;
   options.level = args.level;
@@ -87,7 +102,8 @@ int run_convert(const ConvertArgs& args) {
   options.frame_steps = args.frame_steps;
   options.tangential_shift = args.tangential_shift;
   options.orientation_weights = !args.no_orientation_weights;
-  options.up = up_axis(args);
+  options.up = up;
+  options.front = front;
   options.progress = bar.callback();
   const ConvertResult converted = convert_models(models, options);
   const std::vector<std::uint8_t>& pack = converted.pack;
@@ -172,6 +188,11 @@ CommandRunner add_convert_command(CLI::App& app) {
          "rests on) or none (no frame: the viewer shows y up). One rotation for all models. Default: "
          "auto; none with --no-normals (R-D packs stay byte-identical)")
       ->check(CLI::IsMember({"x", "y", "z", "auto", "none"}));
+  cmd->add_option("--front", args->front,
+                  "The model axis the viewer shows as its front (the head of an animal, towards the default "
+                  "camera): +x, -x, +y, -y, +z or -z, across the up axis. Default: from the first model's "
+                  "shape (docs/streaming.md, \"Upright and front\")")
+      ->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
   return [args] { return run_convert(*args); };
 }
 

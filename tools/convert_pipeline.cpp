@@ -103,7 +103,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   std::vector<codec::PackModelInput> inputs;
   std::optional<Eigen::Matrix3d> view_rotation;
   if (options.up && !models.inputs.empty())
-    view_rotation = upright_rotation(models.inputs[0].mesh, *options.up);
+    view_rotation = upright_rotation(models.inputs[0].mesh, *options.up, options.front);
   if (view_rotation && view_rotation->isIdentity()) view_rotation.reset();  // the viewer's default: no bytes
   const int mask_level = options.hole_mask_level < 0 ? options.level : std::min(options.hole_mask_level, options.level);
   for (std::size_t m = 0; m < params.size(); ++m) {

@@ -49,6 +49,9 @@ struct ConvertOptions {
   /// viewer's default frame). nullopt: identity (no frame; the viewer fits the decoded box, y up) — 129
   /// manifest bytes per model fewer, as `geomip rd` measures.
   std::optional<UpAxis> up;
+  /// The front with `up` (upright_rotation()'s `front`): a signed unit axis of the first model's units, or
+  /// zero (default) for the shape's rule.
+  Eigen::Vector3d front = Eigen::Vector3d::Zero();
   ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode"
 };
 

@@ -13,7 +13,7 @@
 // fileSize, level, levels (each refinement: bytes, level), models, message, draws, decodes, decodeMs (time
 // spent decoding), requests, camera }.
 import { createDecoder, GeomipError } from './geomip.js';
-import { Renderer } from './renderer.js';
+import { Renderer, framingDistance } from './renderer.js';
 
 const params = new URLSearchParams(location.search);
 const canvas = document.getElementById('view');
@@ -27,6 +27,8 @@ const state = window.geomipViewer = {
 };
 if (params.get('hud') === '0') document.getElementById('hud').hidden = true;
 const camera = state.camera = { yaw: 0.6, pitch: 0.35, distance: 3.2, fovYDeg: 35 };
+// Until the user turns or zooms, each refinement frames the models (~70 % of the height, as geomip-view).
+let cameraMoved = false;
 const view = {
   source: Number(params.get('from') ?? 0), target: Number(params.get('to') ?? 1),
   t: Number(params.get('morph') ?? 0), schedule: params.get('schedule') === 'wavelet' ? 'wavelet' : 'linear',
@@ -75,6 +77,7 @@ canvas.addEventListener('pointercancel', (e) => pointers.delete(e.pointerId));
 canvas.addEventListener('pointermove', (e) => {
   const last = pointers.get(e.pointerId);
   if (!last) return;
+  cameraMoved = true;
   if (pointers.size === 1) {
     camera.yaw -= (e.clientX - last.clientX) * 0.01;
     camera.pitch = Math.min(1.5, Math.max(-1.5, camera.pitch + (e.clientY - last.clientY) * 0.01));
@@ -89,6 +92,7 @@ canvas.addEventListener('pointermove', (e) => {
 });
 canvas.addEventListener('wheel', (e) => {
   e.preventDefault();
+  cameraMoved = true;
   camera.distance = Math.min(20, Math.max(0.5, camera.distance * Math.exp(e.deltaY * 0.001)));
   redraw();
 }, { passive: false });
@@ -186,6 +190,8 @@ function refine(source, layout) {
     ++state.decodes;
     if (scene.models.length === 0) return;
     renderer?.setModels(scene.models);
+    if (!cameraMoved)
+      camera.distance = framingDistance(camera, scene.models, canvas.clientWidth || 1, canvas.clientHeight || 1);
     state.models = scene.models.length;
     state.level = scene.models[0].detailLevel;
     state.levels.push({ bytes: size, level: state.level });

@@ -2,7 +2,8 @@
 // orientations rests on its legs and is turned upright with its higher end in front; the rotation is proper
 // (a signed permutation, det +1); the normalization maps the rotated box onto the centred unit box. On the
 // animals of ../shared/meshes the guessed up axis is the one their data has (seen in the meshes: the horse
-// stands on −z, the pig lies on its back with its legs towards +y, cow and bunny stand on −y).
+// stands on −z, the pig lies on its back with its legs towards +y, cow and bunny stand on −y) and the front
+// is the head's end (the pig's head rests lower than its rump: a lying animal with ears covers that case).
 #include "mesh/view_frame.h"
 #include "mesh/mesh_io.h"
 #include "tests/param/test_meshes.h"
@@ -67,6 +68,39 @@ TEST(ViewFrame, AnAnimalInAnyAxisOrientationIsTurnedUprightHeadInFront) {
   }
 }
 
+/// A quadruped lying down, y up, 2 long along x: its head (at +x) rests on the ground, lower than its rump,
+/// with ears out to the sides; the body's bulk is behind the middle of its length.
+TEST(ViewFrame, ALyingAnimalWhoseHeadIsLowerThanItsRumpFacesWithItsHead) {
+  TriMesh m;
+  add_box(m, {-0.8, 0, -0.3}, {0.4, 0.8, 0.3});       // body, its back the highest point
+  add_box(m, {-1, 0.2, -0.2}, {-0.8, 0.6, 0.2});      // rump
+  add_box(m, {0.4, 0, -0.15}, {1.0, 0.5, 0.15});      // head and neck, on the ground
+  add_box(m, {0.85, 0.3, -0.45}, {0.95, 0.4, 0.45});  // ears, wider than the body
+  for (const Eigen::Matrix3d& q : axis_rotations()) {
+    TriMesh t = m;
+    for (auto& p : t.positions) p = q * p;
+    const Eigen::Matrix3d r = upright_rotation(t, UpAxis::kAuto);
+    EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n"
+                                                               << r * q;
+  }
+}
+
+TEST(ViewFrame, AGivenFrontAcrossUpIsTakenAsItIs) {
+  const TriMesh m = animal();  // y up, head at +x
+  for (const Eigen::Vector3d& front :
+       {Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, -1)}) {
+    const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto, front);
+    EXPECT_TRUE(r.row(0).transpose().isApprox(front)) << front.transpose();
+    EXPECT_TRUE(r.row(1).transpose().isApprox(Eigen::Vector3d::UnitY()));
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+  }
+  // Along up, or not a unit axis: the shape's rule.
+  for (const Eigen::Vector3d& front :
+       {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0.6, 0, 0.8)})
+    EXPECT_TRUE(upright_rotation(m, UpAxis::kAuto, front).isApprox(upright_rotation(m, UpAxis::kAuto)))
+        << front.transpose();
+}
+
 TEST(ViewFrame, ANamedUpAxisIsTakenAsItIs) {
   TriMesh m = animal();  // y up; say z is up instead
   const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kZ);
@@ -115,20 +149,26 @@ TEST(ViewFrame, DegenerateMeshesGiveAFrameWithoutNaN) {
 
 struct Animal {
   const char* file;
-  Eigen::Vector3d up;  // in the data's units, seen in the meshes
+  Eigen::Vector3d up;    // in the data's units, seen in the meshes
+  Eigen::Vector3d head;  // where the head points (data units; tests/data/make_animals_corr.py)
 };
 
-TEST(ViewFrame, TheAnimalsOfTheSharedMeshesGetTheirDataUpAxis) {
-  const Animal animals[] = {
-      {"horse.obj", Eigen::Vector3d::UnitZ()}, {"pig.obj", -Eigen::Vector3d::UnitY()},
-      {"cow.obj", Eigen::Vector3d::UnitY()},   {"spot.obj", Eigen::Vector3d::UnitY()},
-      {"bunny.obj", Eigen::Vector3d::UnitY()}, {"armadillo.obj", Eigen::Vector3d::UnitY()}};
+TEST(ViewFrame, TheAnimalsOfTheSharedMeshesGetTheirDataUpAxisAndFaceWithTheirHeads) {
+  const Animal animals[] = {{"horse.obj", Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY()},
+                            {"pig.obj", -Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ()},
+                            {"cow.obj", Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitX()},
+                            {"spot.obj", Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ()},
+                            {"bunny.obj", Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitX()},
+                            {"armadillo.obj", Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero()}};
   for (const Animal& a : animals) {
     GEOMIP_REQUIRE_SHARED_MESH(path, a.file);
     const TriMesh m = read_mesh(path);
     EXPECT_TRUE((-ground_direction(m)).isApprox(a.up)) << a.file << ": " << -ground_direction(m).transpose();
     const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
     EXPECT_TRUE((r * a.up).isApprox(Eigen::Vector3d::UnitY())) << a.file;
+    if (!a.head.isZero()) {
+      EXPECT_TRUE((r * a.head).isApprox(Eigen::Vector3d::UnitX())) << a.file << ": front " << r.row(0);
+    }
   }
 }
 

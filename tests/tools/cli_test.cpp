@@ -959,6 +959,31 @@ TEST_F(CliPack, ConvertUpStoresAFrameAndLeavesDecodedMeshesAlone) {
   EXPECT_FALSE(fs::exists(bad));
 }
 
+// convert --front: the named model axis becomes the viewer's +x (row 0 of the normalization); an axis along
+// up, or a front without a frame (--up none), exits 2 with one line and writes nothing.
+TEST_F(CliPack, ConvertFrontNamesTheViewersFront) {
+  const std::string faced = dir_ + "/faced.gip";
+  ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 3 --up y --front -x -o '" + faced + "'").exit_code, 0);
+  const std::string bytes = slurp(faced);
+  codec::PackInfo info;
+  ASSERT_EQ(codec::read_pack_info({reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()}, info),
+            codec::Status::kOk);
+  ASSERT_EQ(info.models.size(), 1u);
+  const auto& n = info.models[0].normalization;
+  EXPECT_LT(n[0], 0) << "row 0 (the viewer's +x) is the model's -x";
+  EXPECT_EQ(n[1], 0);
+  EXPECT_EQ(n[2], 0);
+  EXPECT_GT(n[5], 0) << "row 1 (the viewer's +y) is the model's +y";
+  for (const char* args : {"--up y --front +y", "--up none --front +x", "--front +q"}) {
+    const std::string bad = dir_ + "/bad_front.gip";
+    const Outcome r = geomip("convert -q '" + spot_ + "' --level 3 " + args + " -o '" + bad + "'");
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find("--front"), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(bad)) << args;
+  }
+}
+
 TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {
   const std::string pack = dir_ + "/spot.gip";
   ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 --no-normals -o '" + pack + "'").exit_code, 0);

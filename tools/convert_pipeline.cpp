@@ -131,6 +131,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   write.geometry.quantization_bits = options.quantization_bits;
   result.pack = codec::write_pack(inputs, write);
   result.encode_seconds = seconds_since(t0);
+  if (options.keep_inputs) result.inputs = std::move(inputs);
   progress("encode", 1.0);
   return result;
 }

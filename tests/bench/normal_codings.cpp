@@ -126,9 +126,10 @@ Vec oct_decode(double u, double w) {
 
 }  // namespace
 
-bool normal_frames_along_grid(const std::vector<Grid3>& normals, const std::vector<Grid3>& geometry) {
-  double sum = 0;
+Orientation normal_frames_along_grid(const std::vector<Grid3>& normals, const std::vector<Grid3>& geometry) {
+  Orientation along;
   for (std::size_t p = 0; p < std::min(normals.size(), geometry.size()); ++p) {
+    double sum = 0;
     const PatchFrames frames(geometry[p], normals[p].level, true);
     const int n = normals[p].size();
     for (int j = 0; j < n; ++j)
@@ -136,17 +137,18 @@ bool normal_frames_along_grid(const std::vector<Grid3>& normals, const std::vect
         const float* v = normals[p].values.data() + 3 * (static_cast<std::size_t>(j) * n + i);
         sum += dot(frames.at(i, j).g, Vec{v[0], v[1], v[2]});
       }
+    along.push_back(sum >= 0);
   }
-  return sum >= 0;
+  return along;
 }
 
 std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std::vector<Grid3>& geometry,
-                                   bool along_grid) {
+                                   const Orientation& along_grid) {
   if (normals.size() != geometry.size())
     throw std::invalid_argument("normal_residual: normal maps and geometry have different patch counts");
   std::vector<Grid3> out(normals.size());
   for (std::size_t p = 0; p < normals.size(); ++p) {
-    const PatchFrames frames(geometry[p], normals[p].level, along_grid);
+    const PatchFrames frames(geometry[p], normals[p].level, p >= along_grid.size() || along_grid[p]);
     const int n = normals[p].size();
     out[p].level = normals[p].level;
     out[p].values.assign(3u * static_cast<std::size_t>(n) * n, 0.f);
@@ -166,13 +168,15 @@ std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std:
   return out;
 }
 
-void apply_normal_residual(std::vector<Grid3>& maps, const std::vector<Grid3>& geometry, bool along_grid,
+void apply_normal_residual(std::vector<Grid3>& maps, const std::vector<Grid3>& geometry,
+                           const Orientation& along_grid,
                            int max_threads) {
   const Grid3 none;
   std::vector<PatchFrames> frames;
   frames.reserve(maps.size());
   for (std::size_t p = 0; p < maps.size(); ++p)
-    frames.emplace_back(p < geometry.size() ? geometry[p] : none, maps[p].level, along_grid);
+    frames.emplace_back(p < geometry.size() ? geometry[p] : none, maps[p].level,
+                        p >= along_grid.size() || along_grid[p]);
   // Independent texels: tasks of kRows rows of one patch.
   constexpr int kRows = 64;
   std::vector<std::pair<std::size_t, int>> tasks;

@@ -6,8 +6,8 @@
 // |n·b| + |n·g|) in g's hemisphere, folded outside it; the third channel of the grids is 0.
 //   - Residual against the decoded geometry: at every normal-map texel the frame comes from a geometry grid
 //     (the decoder's): its parametric derivatives (central differences, one-sided at the grid border)
-//     interpolated bilinearly to the texel, g = ∂u × ∂v normalized (negated for grids that run the other
-//     way), t = ∂u made orthogonal to g, b = g × t.
+//     interpolated bilinearly to the texel, g = ∂u × ∂v normalized (negated for a patch whose grid runs the
+//     other way), t = ∂u made orthogonal to g, b = g × t.
 //   - Global octahedral coding: the same with a flat grid P(i, j) = (i, j, 0), whose frames are the xyz axes.
 // The frames of two patches differ along their common side: residual grids are coded without seams.
 // A decoder would have to build the same frames bit for bit: the frame math uses only double-precision
@@ -22,17 +22,20 @@ namespace geomip::bench {
 
 using codec::Grid3;
 
-/// Whether ∂u × ∂v of `geometry`'s grids points along `normals` (the sum of n·g over all texels is ≥ 0);
-/// false when the grids run the other way (then the frames use −∂u × ∂v). Grids as for
-/// normal_residual().
-bool normal_frames_along_grid(const std::vector<Grid3>& normals, const std::vector<Grid3>& geometry);
+/// Per patch: whether the frames use ∂u × ∂v (true) or −∂u × ∂v (false; a patch whose grid runs the other
+/// way). A patch beyond the vector's size: true.
+using Orientation = std::vector<bool>;
+
+/// Per patch, whether ∂u × ∂v of `geometry`'s grid points along `normals` (the sum of n·g over the patch's
+/// texels is ≥ 0). Grids as for normal_residual().
+Orientation normal_frames_along_grid(const std::vector<Grid3>& normals, const std::vector<Grid3>& geometry);
 
 /// The residual grids of `normals` (unit vectors, one grid per patch, all of one level) against the frames of
 /// `geometry` (the decoder's geometry: same patch count, any level; a normal level finer than the geometry's
 /// interpolates its frames, a coarser one samples them): per texel (u, v, 0), u, v ∈ [−1, 1].
 /// \throw std::invalid_argument when the patch counts differ (encoder input, not bytes).
 std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std::vector<Grid3>& geometry,
-                                   bool along_grid);
+                                   const Orientation& along_grid);
 
 /// Inverse of normal_residual(): turns the decoded residual grids `maps` (channels 0 and 1 used; any values,
 /// clamped to [−1, 1]) in place into unit normals in the frames of `geometry` (a decoder's geometry: any
@@ -40,7 +43,7 @@ std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std:
 /// the xyz axes (so do grids beyond geometry's patch count). Every output texel is a unit
 /// vector (to float rounding). `max_threads` as GeometryDecodeOptions::max_threads (the texels are
 /// independent: the result does not depend on it). Cost: a few dozen double operations per texel.
-void apply_normal_residual(std::vector<Grid3>& maps, const std::vector<Grid3>& geometry, bool along_grid,
-                           int max_threads = 0);
+void apply_normal_residual(std::vector<Grid3>& maps, const std::vector<Grid3>& geometry,
+                           const Orientation& along_grid, int max_threads = 0);
 
 }  // namespace geomip::bench

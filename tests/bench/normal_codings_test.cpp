@@ -39,7 +39,7 @@ Fixture fixture(int level) {
 
 TEST(NormalCodings, ResidualRoundTripsWithoutQuantization) {
   const Fixture f = fixture(4);
-  for (const bool along : {true, false}) {
+  for (const Orientation& along : {Orientation{true, true}, Orientation{false, true}, Orientation{}}) {
     std::vector<Grid3> maps = normal_residual(f.normals, f.geometry, along);
     for (const Grid3& g : maps)
       for (std::size_t k = 0; k < g.values.size(); k += 3) {
@@ -58,14 +58,14 @@ TEST(NormalCodings, ResidualRoundTripsWithoutQuantization) {
 TEST(NormalCodings, ChannelErrorsTurnTheNormalByABoundedAngle) {
   const Fixture f = fixture(4);
   const double d = 1.0 / 1024;
-  std::vector<Grid3> maps = normal_residual(f.normals, f.geometry, true);
+  std::vector<Grid3> maps = normal_residual(f.normals, f.geometry, {});
   int sign = 1;
   for (Grid3& g : maps)
     for (std::size_t k = 0; k < g.values.size(); k += 3, sign = -sign) {
       g.values[k] += static_cast<float>(sign * d);
       g.values[k + 1] -= static_cast<float>(d);
     }
-  apply_normal_residual(maps, f.geometry, true);
+  apply_normal_residual(maps, f.geometry, {});
   EXPECT_LE(max_angle(maps, f.normals), 3 * std::sqrt(2.0) * d + 1e-5);
 }
 
@@ -81,7 +81,7 @@ TEST(NormalCodings, AnyDecodedValuesGiveUnitNormals) {
     for (float& v : g.values) v = 0.f;
   for (const std::vector<Grid3>* geometry : {&f.geometry, static_cast<const std::vector<Grid3>*>(&zeros)}) {
     std::vector<Grid3> out = maps;
-    apply_normal_residual(out, *geometry, true);
+    apply_normal_residual(out, *geometry, {});
     for (const Grid3& g : out)
       for (std::size_t k = 0; k < g.values.size(); k += 3) {
         const double len = std::hypot(double(g.values[k]), double(g.values[k + 1]), double(g.values[k + 2]));
@@ -92,11 +92,13 @@ TEST(NormalCodings, AnyDecodedValuesGiveUnitNormals) {
 
 TEST(NormalCodings, OrientationFollowsTheNormals) {
   const Fixture f = fixture(3);
-  const bool along = normal_frames_along_grid(f.normals, f.geometry);
-  std::vector<Grid3> flipped = f.normals;
-  for (Grid3& g : flipped)
-    for (float& v : g.values) v = -v;
-  EXPECT_NE(normal_frames_along_grid(flipped, f.geometry), along);
+  const Orientation along = normal_frames_along_grid(f.normals, f.geometry);
+  ASSERT_EQ(along.size(), 2u);
+  std::vector<Grid3> flipped = f.normals;  // patch 1's normals reversed
+  for (float& v : flipped[1].values) v = -v;
+  const Orientation other = normal_frames_along_grid(flipped, f.geometry);
+  EXPECT_EQ(other[0], along[0]);
+  EXPECT_NE(other[1], along[1]);
 }
 
 }  // namespace

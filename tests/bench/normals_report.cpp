@@ -146,16 +146,16 @@ void stream_report(const PackModelInput& in, int bits) {
         float* v = g.values.data() + 3 * (static_cast<std::size_t>(j) * g.size() + i);
         v[0] = static_cast<float>(i), v[1] = static_cast<float>(j), v[2] = 0;
       }
-  const bool along = normal_frames_along_grid(in.normals, decoded_geometry);
+  const geomip::bench::Orientation along = normal_frames_along_grid(in.normals, decoded_geometry);
   struct Variant {
     const char* name;
     EncodedGeometry encoded;
     const std::vector<Grid3>* frames;  // null: xyz
-    bool along;
+    geomip::bench::Orientation along;
   };
   const Variant variants[] = {
-      {"xyz", encode_geometry(in.normals, in.seams, options), nullptr, true},
-      {"octahedral", encode_geometry(normal_residual(in.normals, flat, true), {}, options), &flat, true},
+      {"xyz", encode_geometry(in.normals, in.seams, options), nullptr, {}},
+      {"octahedral", encode_geometry(normal_residual(in.normals, flat, {}), {}, options), &flat, {}},
       {"residual", encode_geometry(normal_residual(in.normals, decoded_geometry, along), {}, options),
        &decoded_geometry, along},
   };

@@ -14,7 +14,7 @@
 //
 // Angular error of decoded normal maps: the packs' xyz coding against two-channel codings (normal-byte
 // budgets), and today's pack at file prefixes (normals_report.cpp):
-//   codec_bench --normals MESH.obj [--bits B,...] [--normal-mesh K]
+//   codec_bench --normals MESH.obj [--bits B,...] [--normal-mesh K] [--base BYTES]
 //
 // For instruction counts (valgrind --tool=callgrind, repeatable on a shared machine), one decode on one
 // thread:

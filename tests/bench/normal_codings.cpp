@@ -68,7 +68,8 @@ class PatchFrames {
     shift_ = level_ - geometry.level;
   }
 
-  Frame at(int ti, int tj) const {
+  /// The frame at texel (ti, tj); `axis` (or null): its normal instead of the grid's (t from ∂u as ever).
+  Frame at(int ti, int tj, const float* axis = nullptr) const {
     Frame f;
     if (n_ == 0) return f;
     Vec du, dv;
@@ -87,12 +88,12 @@ class PatchFrames {
       };
       du = bilinear(du_), dv = bilinear(dv_);
     }
-    Vec g = along_ ? cross(du, dv) : cross(dv, du);
+    Vec g = axis ? Vec{axis[0], axis[1], axis[2]} : along_ ? cross(du, dv) : cross(dv, du);
     if (!normalize(g)) return f;
     Vec t = du - dot(du, g) * g;
     if (!normalize(t)) {
-      const Vec axis = std::abs(g.x) < 0.5 ? Vec{1, 0, 0} : Vec{0, 1, 0};
-      t = axis - dot(axis, g) * g;
+      const Vec fallback = std::abs(g.x) < 0.5 ? Vec{1, 0, 0} : Vec{0, 1, 0};
+      t = fallback - dot(fallback, g) * g;
       if (!normalize(t)) return f;
     }
     f.g = g, f.t = t, f.b = cross(g, t);
@@ -143,7 +144,7 @@ Orientation normal_frames_along_grid(const std::vector<Grid3>& normals, const st
 }
 
 std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std::vector<Grid3>& geometry,
-                                   const Orientation& along_grid) {
+                                   const Orientation& along_grid, const std::vector<Grid3>* axes) {
   if (normals.size() != geometry.size())
     throw std::invalid_argument("normal_residual: normal maps and geometry have different patch counts");
   std::vector<Grid3> out(normals.size());
@@ -158,7 +159,7 @@ std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std:
         const float* v = normals[p].values.data() + k;
         Vec nv{v[0], v[1], v[2]};
         if (!normalize(nv)) nv = {0, 0, 1};
-        const Frame f = frames.at(i, j);
+        const Frame f = frames.at(i, j, axes ? (*axes)[p].values.data() + k : nullptr);
         double u, w;
         oct_encode({dot(nv, f.t), dot(nv, f.b), dot(nv, f.g)}, u, w);
         out[p].values[k] = static_cast<float>(u);
@@ -169,8 +170,7 @@ std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std:
 }
 
 void apply_normal_residual(std::vector<Grid3>& maps, const std::vector<Grid3>& geometry,
-                           const Orientation& along_grid,
-                           int max_threads) {
+                           const Orientation& along_grid, const std::vector<Grid3>* axes, int max_threads) {
   const Grid3 none;
   std::vector<PatchFrames> frames;
   frames.reserve(maps.size());
@@ -189,10 +189,13 @@ void apply_normal_residual(std::vector<Grid3>& maps, const std::vector<Grid3>& g
     const int n = map.size();
     for (int j = j0; j < std::min(n, j0 + kRows); ++j)
       for (int i = 0; i < n; ++i) {
-        float* v = map.values.data() + 3 * (static_cast<std::size_t>(j) * n + i);
+        const std::size_t k = 3 * (static_cast<std::size_t>(j) * n + i);
+        float* v = map.values.data() + k;
         const double u = std::isnan(v[0]) ? 0.0 : v[0], w = std::isnan(v[1]) ? 0.0 : v[1];
         const Vec local = oct_decode(u, w);
-        const Frame f = frames[p].at(i, j);
+        const Frame f = frames[p].at(i, j, axes && p < axes->size() && (*axes)[p].values.size() == map.values.size()
+                                               ? (*axes)[p].values.data() + k
+                                               : nullptr);
         const Vec a = local.x * f.t, b = local.y * f.b, c = local.z * f.g;
         Vec out{a.x + b.x + c.x, a.y + b.y + c.y, a.z + b.z + c.z};
         if (!normalize(out)) out = f.g;

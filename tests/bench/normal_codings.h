@@ -9,6 +9,7 @@
 //     interpolated bilinearly to the texel, g = ∂u × ∂v normalized (negated for a patch whose grid runs the
 //     other way), t = ∂u made orthogonal to g, b = g × t.
 //   - Global octahedral coding: the same with a flat grid P(i, j) = (i, j, 0), whose frames are the xyz axes.
+//   - Two layers: g from a given normal field (a coarse decode of the xyz normal map), t from the grid.
 // The frames of two patches differ along their common side: residual grids are coded without seams.
 // A decoder would have to build the same frames bit for bit: the frame math uses only double-precision
 // +, −, ×, ÷ and sqrt on float inputs, each written as its own operation.
@@ -34,8 +35,10 @@ Orientation normal_frames_along_grid(const std::vector<Grid3>& normals, const st
 /// `geometry` (the decoder's geometry: same patch count, any level; a normal level finer than the geometry's
 /// interpolates its frames, a coarser one samples them): per texel (u, v, 0), u, v ∈ [−1, 1].
 /// \throw std::invalid_argument when the patch counts differ (encoder input, not bytes).
+/// `axes` (optional, grids like `normals`): a normal field to use as the frames' g instead of the grid's
+/// (t from ∂u as ever) — e.g. a coarse decode of the normal map itself (a two-layer coding).
 std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std::vector<Grid3>& geometry,
-                                   const Orientation& along_grid);
+                                   const Orientation& along_grid, const std::vector<Grid3>* axes = nullptr);
 
 /// Inverse of normal_residual(): turns the decoded residual grids `maps` (channels 0 and 1 used; any values,
 /// clamped to [−1, 1]) in place into unit normals in the frames of `geometry` (a decoder's geometry: any
@@ -44,6 +47,7 @@ std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std:
 /// vector (to float rounding). `max_threads` as GeometryDecodeOptions::max_threads (the texels are
 /// independent: the result does not depend on it). Cost: a few dozen double operations per texel.
 void apply_normal_residual(std::vector<Grid3>& maps, const std::vector<Grid3>& geometry,
-                           const Orientation& along_grid, int max_threads = 0);
+                           const Orientation& along_grid, const std::vector<Grid3>* axes = nullptr,
+                           int max_threads = 0);
 
 }  // namespace geomip::bench

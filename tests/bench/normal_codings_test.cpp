@@ -52,6 +52,24 @@ TEST(NormalCodings, ResidualRoundTripsWithoutQuantization) {
   }
 }
 
+// Two layers: frames whose normal is a given field (here a rotated copy of the normals: 0.2 rad about x).
+TEST(NormalCodings, TwoLayerResidualRoundTrips) {
+  const Fixture f = fixture(4);
+  std::vector<Grid3> axes = f.normals;
+  const double c = std::cos(0.2), s = std::sin(0.2);
+  for (Grid3& g : axes)
+    for (std::size_t k = 0; k < g.values.size(); k += 3) {
+      const double y = g.values[k + 1], z = g.values[k + 2];
+      g.values[k + 1] = static_cast<float>(c * y - s * z), g.values[k + 2] = static_cast<float>(s * y + c * z);
+    }
+  std::vector<Grid3> maps = normal_residual(f.normals, f.geometry, {}, &axes);
+  for (const Grid3& g : maps)
+    for (std::size_t k = 0; k < g.values.size(); k += 3)
+      ASSERT_LE(std::abs(g.values[k]) + std::abs(g.values[k + 1]), 0.21f);  // |(u, v)|₁ ≤ tan-ish of 0.2 rad
+  apply_normal_residual(maps, f.geometry, {}, &axes);
+  EXPECT_LE(max_angle(maps, f.normals), 1e-5);
+}
+
 // Each octahedral channel off by at most d moves (u, v) by at most d·√2; the octahedral decoding D is
 // piecewise linear with |dD| ≤ √3·|d(u, v)| and |D| ≥ 1/√3 (its L1 norm is 1), so the unit normal turns by at
 // most 3·√2·d.

@@ -1,4 +1,4 @@
-// codec_bench --normals MESH.obj [--bits B,...] [--normal-mesh K]: the angular error of decoded normal maps
+// codec_bench --normals MESH.obj [--bits B,...] [--normal-mesh K] [--base BYTES]: the angular error of decoded normal maps
 // (docs/codec-v3.md, "Normal maps: two-channel codings"). MESH goes through `geomip convert`'s pipeline once
 // (default options: level 8, normal maps at level 9, hole masks; --normal-mesh as convert's); its
 // uncompressed normal maps are the reference. Errors are the mean /
@@ -7,8 +7,9 @@
 // quad before). Printed:
 //   - the error of the fully decoded geometry's own normals (no normal map at all);
 //   - the normal stream alone (model 0), per quantization (--bits, default 10), at normal-byte budgets
-//     (complete segments plus a prefix of the next): xyz (the packs' coding), octahedral in one global frame
-//     and the residual against the fully decoded geometry (normal_codings.h);
+//     (complete segments plus a prefix of the next): xyz (the packs' coding), octahedral in one global frame,
+//     the residual against the fully decoded geometry, and two layers: the first BYTES of the xyz stream
+//     (--base, default 20000) as the frames' normal, then the residual in those frames (normal_codings.h);
 //   - today's pack (write_pack() defaults): the full pack and file prefixes of it, with the normal-chunk
 //     bytes they hold; where no normal chunk has arrived, the decoded geometry's normals (what a viewer
 //     shades with then).
@@ -124,16 +125,25 @@ std::vector<Grid3> decode_budget(const EncodedGeometry& e, std::size_t budget) {
   return d.patches;
 }
 
+void normalize_grid(Grid3& g) {
+  for (std::size_t k = 0; k < g.values.size(); k += 3) {
+    float* n = g.values.data() + k;
+    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (len > 0) n[0] /= len, n[1] /= len, n[2] /= len;
+  }
+}
+
 std::size_t stream_bytes(const EncodedGeometry& e) {
   std::size_t n = 0;
   for (const auto& segment : e.segments) n += segment.size();
   return n;
 }
 
-/// The normal stream alone (model 0), three codings at normal-byte budgets: xyz (the packs' coding: 3
+/// The normal stream alone (model 0), four codings at normal-byte budgets: xyz (the packs' coding: 3
 /// channels, seams shared), octahedral in one global frame (2 channels; a flat grid's frames are the xyz
-/// axes) and the residual against the fully decoded geometry (normal_codings.h).
-void stream_report(const PackModelInput& in, int bits) {
+/// axes), the residual against the fully decoded geometry, and two layers — the first `base_bytes` of the
+/// xyz stream, then the residual against their normals (bytes: both layers; normal_codings.h).
+void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes) {
   const GeometryCodecOptions codec = PackWriteOptions{}.normal_codec;
   GeometryCodecOptions options = codec;
   options.quantization_bits = bits;
@@ -152,30 +162,34 @@ void stream_report(const PackModelInput& in, int bits) {
     EncodedGeometry encoded;
     const std::vector<Grid3>* frames;  // null: xyz
     geomip::bench::Orientation along;
+    const std::vector<Grid3>* axes = nullptr;  // two layers: the base layer's normals
+    std::size_t base_bytes = 0;                // bytes of the base layer (counted in the budgets)
   };
+  // Two layers: the xyz stream's first base_bytes (today's options) as the frames' normal, the residual in
+  // those frames.
+  const EncodedGeometry base = encode_geometry(in.normals, in.seams, codec);
+  std::vector<Grid3> axes = decode_budget(base, base_bytes);
+  for (Grid3& g : axes) normalize_grid(g);
   const Variant variants[] = {
       {"xyz", encode_geometry(in.normals, in.seams, options), nullptr, {}},
       {"octahedral", encode_geometry(normal_residual(in.normals, flat, {}), {}, options), &flat, {}},
       {"residual", encode_geometry(normal_residual(in.normals, decoded_geometry, along), {}, options),
        &decoded_geometry, along},
+      {"two-layer", encode_geometry(normal_residual(in.normals, decoded_geometry, along, &axes), {}, options),
+       &decoded_geometry, along, &axes, base_bytes},
   };
   std::printf("normal stream alone, %d bits (model %s)\n  %-12s %9s   %7s %7s %7s\n", bits, in.name.c_str(),
               "coding", "bytes", "mean°", "p95°", "max°");
   for (const Variant& v : variants) {
-    const std::size_t total = stream_bytes(v.encoded);
+    const std::size_t total = v.base_bytes + stream_bytes(v.encoded);
     for (std::size_t budget : {10000, 20000, 40000, 80000, 160000, 320000, 0}) {
-      if (budget >= total) continue;
+      if (budget >= total || (budget != 0 && budget <= v.base_bytes)) continue;
       const std::size_t b = budget == 0 ? total : budget;
-      std::vector<Grid3> normals = decode_budget(v.encoded, b);
+      std::vector<Grid3> normals = decode_budget(v.encoded, b - v.base_bytes);
       if (v.frames) {
-        apply_normal_residual(normals, *v.frames, v.along);
+        apply_normal_residual(normals, *v.frames, v.along, v.axes);
       } else {
-        for (Grid3& g : normals)
-          for (std::size_t k = 0; k < g.values.size(); k += 3) {
-            float* n = g.values.data() + k;
-            const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            if (len > 0) n[0] /= len, n[1] /= len, n[2] /= len;
-          }
+        for (Grid3& g : normals) normalize_grid(g);
       }
       std::vector<double> all;
       collect_angles(in, normals, all);
@@ -190,8 +204,10 @@ void stream_report(const PackModelInput& in, int bits) {
 int normals_report(int argc, char** argv) {
   std::vector<int> bits_list = {10};
   int normal_mesh_steps = geomip::tools::ConvertOptions{}.normal_mesh_steps;
+  std::size_t base_bytes = 20000;
   for (int i = 3; i + 1 < argc; ++i) {
     if (std::strcmp(argv[i], "--normal-mesh") == 0) normal_mesh_steps = std::atoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--base") == 0) base_bytes = static_cast<std::size_t>(std::atol(argv[i + 1]));
     if (std::strcmp(argv[i], "--bits") == 0) {
       bits_list.clear();
       for (const char* p = argv[i + 1]; *p;) {
@@ -216,7 +232,7 @@ int normals_report(int argc, char** argv) {
     std::printf("the fully decoded geometry's own normals: mean %.3f°, p95 %.3f°, max %.2f°\n", st.mean, st.p95,
                 st.max);
   }
-  for (int bits : bits_list) stream_report(in[0], bits);
+  for (int bits : bits_list) stream_report(in[0], bits, base_bytes);
   std::printf("today's pack (xyz normal maps, %d bits), all models\n  %-14s %9s %9s   %7s %7s %7s\n",
               PackWriteOptions{}.normal_codec.quantization_bits, "decode", "bytes", "normal B", "mean°", "p95°",
               "max°");

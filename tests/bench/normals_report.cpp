@@ -182,7 +182,7 @@ void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes) {
               "coding", "bytes", "mean°", "p95°", "max°");
   for (const Variant& v : variants) {
     const std::size_t total = v.base_bytes + stream_bytes(v.encoded);
-    for (std::size_t budget : {10000, 20000, 40000, 80000, 160000, 320000, 0}) {
+    for (std::size_t budget : {10000, 20000, 40000, 80000, 160000, 320000, 400000, 450000, 500000, 0}) {
       if (budget >= total || (budget != 0 && budget <= v.base_bytes)) continue;
       const std::size_t b = budget == 0 ? total : budget;
       std::vector<Grid3> normals = decode_budget(v.encoded, b - v.base_bytes);

@@ -134,6 +134,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   write.geometry.orientation_weights = options.orientation_weights;
   result.pack = codec::write_pack(inputs, write);
   result.encode_seconds = seconds_since(t0);
+  if (options.keep_inputs) result.inputs = std::move(inputs);
   progress("encode", 1.0);
   return result;
 }

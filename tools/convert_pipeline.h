@@ -53,10 +53,14 @@ struct ConvertOptions {
   /// zero (default) for the shape's rule.
   Eigen::Vector3d front = Eigen::Vector3d::Zero();
   ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode"
+  /// Keep the pack's inputs (geometry images, normal maps, hole masks before coding) in
+  /// ConvertResult::inputs (codec_bench --normals measures the coded normal maps against them).
+  bool keep_inputs = false;
 };
 
 struct ConvertResult {
   std::vector<std::uint8_t> pack;
+  std::vector<codec::PackModelInput> inputs;  ///< with ConvertOptions::keep_inputs, else empty
   std::vector<std::size_t> masked_quads;  ///< per model: grid quads left out as filled holes
   /// Normal-mesh resampling: the steps applied (0 = off) and figures over all patches.
   int normal_mesh_steps = 0;

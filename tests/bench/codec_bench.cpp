@@ -12,6 +12,10 @@
 // Draco's in-process decode of that full mesh (14-bit positions, compression level 10, best of the same
 // repetitions) and geomip's full decode as a ratio to it.
 //
+// Angular error of decoded normal maps: the packs' xyz coding against two-channel codings (normal-byte
+// budgets), and today's pack at file prefixes (normals_report.cpp):
+//   codec_bench --normals MESH.obj [--bits B,...] [--normal-mesh K] [--base BYTES]
+//
 // For instruction counts (valgrind --tool=callgrind, repeatable on a shared machine), one decode on one
 // thread:
 //   codec_bench --decode-once FILE.gip full|increments|shown
@@ -368,7 +372,10 @@ int decode_once(const std::string& path, const std::string& mode) {
 
 }  // namespace
 
+int normals_report(int argc, char** argv);  // normals_report.cpp
+
 int main(int argc, char** argv) {
+  if (argc >= 3 && std::strcmp(argv[1], "--normals") == 0) return normals_report(argc, argv);
   if (argc == 4 && std::strcmp(argv[1], "--decode-once") == 0) return decode_once(argv[2], argv[3]);
   if (argc == 3 && std::strcmp(argv[1], "--pack") == 0) return pack_report(argv[2]);
   if ((argc == 3 || argc == 4) && std::strcmp(argv[1], "--stream") == 0)

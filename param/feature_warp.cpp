@@ -795,7 +795,29 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
   std::vector<int> legs(n, 0);
   int parks = 0, rounds = 0;
   bool force = false;  // after a round without progress: accept paths that only miss the soft clearance
-  auto stalled = [&](int k) { give_up(k, "the warp " + warper.stuck_reason()); };
+  // A feature that stalls steps aside (back and to the left or right of its way, alternately, a little farther
+  // each time) and then heads for its target again from there; after `options.sidesteps` of them it is given up.
+  std::vector<int> sidesteps(n, 0);
+  auto stalled = [&](int k, std::vector<int>& waiting) {
+    const int w = kCorners + k;
+    const Vec2 x = warp.pos[w];
+    const Vec2 dir = (targets[k] - x).normalized(), perp(-dir.y(), dir.x());
+    while (sidesteps[k] < options.sidesteps) {
+      const double side = sidesteps[k] % 2 == 0 ? 1.0 : -1.0;
+      const double length = options.sidestep_length * (1 + sidesteps[k] / 2);
+      const Vec2 via = x + side * length * perp - 0.5 * options.sidestep_length * dir;
+      ++sidesteps[k];
+      if (!strictly_inside(via, options.sidestep_length) || blocker(w, x, via, false) >= 0) continue;
+      ++result.detours;
+      if (warper.move(k, via) == Warper::Outcome::kArrived) {
+        legs[k] = 0;
+        waiting.push_back(k);  // on from there in the next round
+        return;
+      }
+    }
+    give_up(k, "the warp " + warper.stuck_reason() + ", also after " + std::to_string(sidesteps[k]) +
+                   " steps aside");
+  };
   while (!pending.empty()) {
     if (rounds++ > 8 * n + 8) {
       for (int k : pending) give_up(k, "features waiting for each other's places could not be untangled");
@@ -814,7 +836,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         return warper.move(k, to) == Warper::Outcome::kArrived;
       };
       if (soft < 0 || (hard < 0 && (force || legs[k] >= 2))) {
-        if (!go(targets[k])) stalled(k);
+        if (!go(targets[k])) stalled(k, waiting);
         continue;
       }
       // Wait while the target is still taken (or crowded) by a feature that has yet to move.
@@ -829,14 +851,14 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         ++result.detours;
         ++legs[k];
         if (!go(via)) {
-          stalled(k);
+          stalled(k, waiting);
           continue;
         }
         waiting.push_back(k);  // the second leg is checked in the next round
         continue;
       }
       if (hard < 0) {
-        if (!go(targets[k])) stalled(k);
+        if (!go(targets[k])) stalled(k, waiting);
         continue;
       }
       waiting.push_back(k);

@@ -57,6 +57,11 @@ struct FeatureWarpOptions {
   /// Upper bound on steps (moves between events/repairs) of one feature; a feature that needs more is stopped
   /// where it is (still foldover-free) and reported in `FeatureWarpResult::unreached`.
   std::size_t max_steps_per_feature = 20000;
+  /// A feature that stalls (the repair cannot keep the base triangles ahead of it positive) steps aside this
+  /// many times at most before it is reported unreached: back by half a `sidestep_length` and to the left or
+  /// right of its way (alternately, by 1, 1, 2, 2, ... `sidestep_length`), then on toward its target.
+  int sidesteps = 4;
+  double sidestep_length = 0.03;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after
   /// the Delaunay flips that follow a move. May be empty. For tests and visualization.

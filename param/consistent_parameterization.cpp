@@ -322,6 +322,7 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
   // Features of a patch are in the same order in every model (ascending local id in model 0 would not be):
   // order each model's list by feature index.
   std::vector<std::vector<Eigen::Vector2d>> ordered(work.size());
+  std::vector<int> feature_indices;  // the user's feature index of each target
   for (std::size_t i = 0; i < work.size(); ++i) {
     const auto& pw = work[i].patches[p];
     std::vector<std::pair<int, Eigen::Vector2d>> by_index;
@@ -330,8 +331,25 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
     std::sort(by_index.begin(), by_index.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
     for (const auto& e : by_index) ordered[i].push_back(e.second);
+    if (i == 0) {
+      for (const auto& e : by_index) feature_indices.push_back(e.first);
+    }
   }
   const std::vector<Eigen::Vector2d> targets = average_feature_targets(ordered);
+  // Two features with the same common (u,v) cannot both be there (e.g. they lie the other way round on two
+  // models): say which, before warp_features refuses it with patch-local indices.
+  const double apart = FeatureWarpOptions{}.collision_distance;
+  for (std::size_t k = 0; k < targets.size(); ++k) {
+    for (std::size_t l = 0; l < k; ++l) {
+      if ((targets[k] - targets[l]).norm() > apart) continue;
+      char at[96];
+      std::snprintf(at, sizeof at, " (%.3f, %.3f) in patch %zu", targets[k].x(), targets[k].y(), p);
+      throw InvalidInput("parameterize_consistently: features " + std::to_string(feature_indices[l]) + " and " +
+                         std::to_string(feature_indices[k]) + " get the same common (u,v)" + at +
+                         " from the average over the models, so neither can be reached; corresponding features "
+                         "must lie alike on every model: check the correspondence file");
+    }
+  }
   for (std::size_t i = 0; i < work.size(); ++i) {
     auto& pw = work[i].patches[p];
     const auto t0 = Clock::now();
@@ -357,7 +375,7 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
       throw InvalidInput(
           "parameterize_consistently: feature " + std::to_string(feature) + " of model '" + models[i].name +
           "' (vertex " + std::to_string(models[i].features[feature]) + ") cannot move" + where +
-          " without folding the parameterization" +
+          " without folding the parameterization: " + r.unreached_reasons.front() +
           (r.unreached.size() > 1 ? " (" + std::to_string(r.unreached.size() - 1) + " more)" : "") +
           "; corresponding features must lie alike on every model: check the correspondence file");
     }

@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <utility>
@@ -328,6 +329,12 @@ class Warper {
   }
 
   enum class Outcome { kArrived, kStuck };
+  Outcome stuck(const char* why) {
+    stuck_reason_ = why;
+    return Outcome::kStuck;
+  }
+
+  const std::vector<int>& star_of(int v) const { return star_[v]; }
 
   /// The longest base edge at feature k (current uv): the size of the star that travels with it.
   double star_radius(int k) const {
@@ -348,7 +355,7 @@ class Warper {
       if (x0 == q) return Outcome::kArrived;
       if (step % kStallSteps == kStallSteps - 1) {  // a stall: repairs that keep the feature in place
         const double remaining = (x0 - q).norm();
-        if (remaining > checkpoint * (1 - 1e-3)) return Outcome::kStuck;
+        if (remaining > checkpoint * (1 - 1e-3)) return stuck("stalled: the base triangles ahead of it could not be kept positive");
         checkpoint = remaining;
       }
       const Vec2 d = q - x0;
@@ -390,7 +397,7 @@ class Warper {
             flip_t = t;
           }
         }
-        if (flip_t < 0) return Outcome::kStuck;
+        if (flip_t < 0) return stuck("no warp event found before a warp triangle degenerates");
         // The vertex in the middle of the collinear triple at the event; the edge opposite it is flipped.
         const Vec2 xe = point_at(hi);
         const int lw = warp_.local(flip_t, w);
@@ -399,7 +406,7 @@ class Warper {
         const double s = (xe - pa).dot(pb - pa) / (pb - pa).squaredNorm();
         flip_i = s <= 0 ? (lw + 1) % 3 : s >= 1 ? (lw + 2) % 3 : lw;
         int m, p, qq, r;
-        if (!warp_.flip_quad(flip_t, flip_i, m, p, qq, r)) return Outcome::kStuck;
+        if (!warp_.flip_quad(flip_t, flip_i, m, p, qq, r)) return stuck("a warp event on the square's side");
         // Both new triangles have an area linear in t; flip halfway between where they become valid and lo.
         double lower = 0;
         for (const Tri& n : {Tri{m, p, r}, Tri{m, r, qq}}) {
@@ -415,7 +422,7 @@ class Warper {
         int tries = 0;
         while (!flip_valid(point_at(ts)) && tries++ < 64) ts = 0.5 * (ts + lo);
         if (!flip_valid(point_at(ts))) {
-          if (!flip_valid(point_at(lo))) return Outcome::kStuck;
+          if (!flip_valid(point_at(lo))) return stuck("no valid warp edge flip at an event");
           ts = lo;
         }
         if (ts < t_candidate) {
@@ -492,7 +499,7 @@ class Warper {
 
       // 4. The event: flip before the degeneration.
       if (flip_t >= 0 && moved) {
-        if (result_.events >= options_.max_events) return Outcome::kStuck;
+        if (result_.events >= options_.max_events) return stuck("the warp used up max_events");
         for (int t : warp_.flip(flip_t, flip_i)) note_area(t);
         ++result_.events;
         notify();
@@ -506,11 +513,14 @@ class Warper {
       // the max-min-area point; then centroids over a wider region).
       if (offending >= 0 && !repair(offending, false, options_.repair_rings) &&
           !repair(offending, true, options_.repair_rings) && !repair(offending, false, 4 * options_.repair_rings)) {
-        return Outcome::kStuck;
+        return stuck("a base triangle ahead of it could not be repaired");
       }
     }
-    return Outcome::kStuck;
+    return stuck("it used up max_steps_per_feature");
   }
+
+  /// Why the last `move` returned kStuck.
+  const std::string& stuck_reason() const { return stuck_reason_; }
 
   void notify() const {
     if (options_.observer) options_.observer(warp_.pos, warp_.tri);
@@ -609,6 +619,7 @@ class Warper {
   FeatureWarpResult& result_;
   WarpMesh& warp_;
   std::vector<std::vector<int>> star_;  // base triangles around each vertex
+  std::string stuck_reason_;
   std::vector<char> fixed_;             // features and boundary vertices: never repaired
   std::vector<double> mu_;              // scratch: feature weight of each moving point
   std::vector<unsigned> stamp_;         // scratch: base triangles already collected in this step
@@ -744,17 +755,72 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
     return false;
   };
 
+  std::vector<std::string> reason(n);
+  auto give_up = [&](int k, const std::string& why) {
+    if (!reason[k].empty()) return;
+    char at[96];
+    const Vec2& x = warp.pos[kCorners + k];
+    std::snprintf(at, sizeof at, " (stopped at (%.4f, %.4f), %.3g short of the target)", x.x(), x.y(),
+                  (x - targets[k]).norm());
+    reason[k] = why + at;
+  };
+  // Targets that no embedding can reach: a base triangle whose three vertices are all fixed (features at their
+  // targets, boundary vertices where they are) and that would not be positive there. The features of such a
+  // triangle that have to move are reported and do not move.
   std::vector<int> pending;
   for (int k = 0; k < n; ++k) {
-    if (uv[features[k]] != targets[k]) pending.push_back(k);
+    if (uv[features[k]] == targets[k]) continue;  // a feature already there is not to blame
+    for (int t : warper.star_of(features[k])) {
+      Vec2 p[3];
+      bool all_fixed = true;
+      for (int i = 0; i < 3 && all_fixed; ++i) {
+        const int v = triangles[t][i];
+        const auto it = std::find(features.begin(), features.end(), v);
+        if (it != features.end()) {
+          p[i] = targets[it - features.begin()];
+        } else if (on_boundary(uv[v])) {
+          p[i] = uv[v];
+        } else {
+          all_fixed = false;
+        }
+      }
+      if (all_fixed && orient2d(p[0], p[1], p[2]) <= 0) {
+        reason[k] = "a base triangle of it and other features or boundary vertices would be flipped or flat with "
+                    "every feature at its target, so no fold-free embedding reaches it";
+        break;
+      }
+    }
+    if (reason[k].empty() && uv[features[k]] != targets[k]) pending.push_back(k);
   }
   std::vector<int> legs(n, 0);
   int parks = 0, rounds = 0;
   bool force = false;  // after a round without progress: accept paths that only miss the soft clearance
-  auto give_up = [&](int k) { result.unreached.push_back(k); };
+  // A feature that stalls steps aside (back and to the left or right of its way, alternately, a little farther
+  // each time) and then heads for its target again from there; after `options.sidesteps` of them it is given up.
+  std::vector<int> sidesteps(n, 0);
+  auto stalled = [&](int k, std::vector<int>& waiting) {
+    const int w = kCorners + k;
+    const Vec2 x = warp.pos[w];
+    const Vec2 dir = (targets[k] - x).normalized(), perp(-dir.y(), dir.x());
+    while (sidesteps[k] < options.sidesteps) {
+      const double side = sidesteps[k] % 2 == 0 ? 1.0 : -1.0;
+      const double length = options.sidestep_length * (1 + sidesteps[k] / 2);
+      const Vec2 via = x + side * length * perp - 0.5 * options.sidestep_length * dir;
+      ++sidesteps[k];
+      if (!strictly_inside(via, options.sidestep_length) || blocker(w, x, via, false) >= 0) continue;
+      ++result.detours;
+      if (warper.move(k, via) == Warper::Outcome::kArrived) {
+        legs[k] = 0;
+        waiting.push_back(k);  // on from there in the next round
+        return;
+      }
+    }
+    give_up(k, "the warp " + warper.stuck_reason() + ", also after " + std::to_string(sidesteps[k]) +
+                   " steps aside");
+  };
   while (!pending.empty()) {
     if (rounds++ > 8 * n + 8) {
-      for (int k : pending) give_up(k);
+      for (int k : pending) give_up(k, "features waiting for each other's places could not be untangled");
       break;
     }
     std::vector<int> waiting;
@@ -770,7 +836,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         return warper.move(k, to) == Warper::Outcome::kArrived;
       };
       if (soft < 0 || (hard < 0 && (force || legs[k] >= 2))) {
-        if (!go(targets[k])) give_up(k);
+        if (!go(targets[k])) stalled(k, waiting);
         continue;
       }
       // Wait while the target is still taken (or crowded) by a feature that has yet to move.
@@ -785,14 +851,14 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         ++result.detours;
         ++legs[k];
         if (!go(via)) {
-          give_up(k);
+          stalled(k, waiting);
           continue;
         }
         waiting.push_back(k);  // the second leg is checked in the next round
         continue;
       }
       if (hard < 0) {
-        if (!go(targets[k])) give_up(k);
+        if (!go(targets[k])) stalled(k, waiting);
         continue;
       }
       waiting.push_back(k);
@@ -804,18 +870,23 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
       const Vec2 x0 = warp.pos[w];
       Vec2 park;
       if (parks++ > 2 * n || !waypoint(w, x0, targets[k], -1, false, park)) {
-        for (int l : waiting) give_up(l);
+        for (int l : waiting) give_up(l, "features waiting for each other's places found no parking spot");
         break;
       }
       ++result.detours;
       if (warper.move(k, park) != Warper::Outcome::kArrived) {
-        give_up(k);
+        give_up(k, "the warp " + warper.stuck_reason() + " on the way to a parking spot");
         waiting.erase(waiting.begin());
       }
     }
     pending.swap(waiting);
   }
-  std::sort(result.unreached.begin(), result.unreached.end());
+  for (int k = 0; k < n; ++k) {
+    if (reason[k].empty() && uv[features[k]] != targets[k]) give_up(k, "the warp stopped short");
+    if (reason[k].empty()) continue;
+    result.unreached.push_back(k);
+    result.unreached_reasons.push_back(reason[k]);
+  }
 
   for (int k = 0; k < n; ++k) {
     result.max_feature_error = std::max(result.max_feature_error, (uv[features[k]] - targets[k]).norm());

@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace geomip {
@@ -56,6 +57,11 @@ struct FeatureWarpOptions {
   /// Upper bound on steps (moves between events/repairs) of one feature; a feature that needs more is stopped
   /// where it is (still foldover-free) and reported in `FeatureWarpResult::unreached`.
   std::size_t max_steps_per_feature = 20000;
+  /// A feature that stalls (the repair cannot keep the base triangles ahead of it positive) steps aside this
+  /// many times at most before it is reported unreached: back by half a `sidestep_length` and to the left or
+  /// right of its way (alternately, by 1, 1, 2, 2, ... `sidestep_length`), then on toward its target.
+  int sidesteps = 4;
+  double sidestep_length = 0.03;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after
   /// the Delaunay flips that follow a move. May be empty. For tests and visualization.
@@ -78,10 +84,15 @@ struct FeatureWarpResult {
   double max_feature_error = 0;
   /// Smallest signed area of a warp triangle seen after any move or flip (> 0: the warp never folded).
   double min_warp_triangle_area = 0;
-  /// Indices k (into `features`) of features that could not reach their target without folding the base
-  /// mesh (e.g. a target that inverts a base triangle whose vertices are all features or on the boundary, or
-  /// features that would have to pass through each other); they stay at a foldover-free intermediate position.
+  /// Indices k (into `features`), ascending, of features that could not reach their target without folding
+  /// the base mesh (e.g. a target that inverts a base triangle whose vertices are all features or on the
+  /// boundary, or a warp that stalled); they stay at a foldover-free intermediate position.
   std::vector<int> unreached;
+  /// One line per entry of `unreached`, in the same order: why that feature stopped short. Either a proof that
+  /// no fold-free embedding has it at its target (a base triangle whose three vertices are all features or
+  /// boundary vertices would be flipped or flat with every feature at its target; the features of it that have
+  /// to move are reported and not moved), or where and why the warp gave up on it.
+  std::vector<std::string> unreached_reasons;
   /// Base triangles with signed area <= 0 after the warp, checked with exact predicates: always 0 unless
   /// `keep_base_mesh_valid` is false.
   std::size_t flipped_triangles = 0;

@@ -8,6 +8,8 @@
 
 #include <chrono>
 #include <iostream>
+#include <map>
+#include <string>
 #include <random>
 
 namespace geomip {
@@ -191,6 +193,7 @@ RandomCase random_case(int n, std::mt19937& rng, double reach) {
 
 struct TrialFigures {
   std::size_t features = 0, unreached = 0, events = 0, repaired = 0, max_events = 0, max_repaired = 0;
+  std::map<std::string, std::size_t> reasons;  // why features stopped short: the reason up to its position
   double seconds = 0;
 };
 
@@ -209,6 +212,13 @@ TrialFigures run_random_trials(int trials, double reach, unsigned seed) {
     SCOPED_TRACE("trial " + std::to_string(trial));
     expect_warp_properties(e, uv, c.features, c.targets, r);
     for (int k : r.unreached) EXPECT_GT((uv[c.features[k]] - c.targets[k]).norm(), 0.0);
+    EXPECT_TRUE(std::is_sorted(r.unreached.begin(), r.unreached.end()));
+    EXPECT_EQ(r.unreached_reasons.size(), r.unreached.size());
+    for (const std::string& why : r.unreached_reasons) {
+      EXPECT_FALSE(why.empty());
+      EXPECT_EQ(why.find('\n'), std::string::npos) << why;
+      ++fig.reasons[why.substr(0, why.find(" ("))];
+    }
     EXPECT_EQ(r.max_feature_error > 0, !r.unreached.empty());
     fig.features += c.features.size();
     fig.unreached += r.unreached.size();
@@ -221,6 +231,7 @@ TrialFigures run_random_trials(int trials, double reach, unsigned seed) {
             << fig.unreached << "/" << fig.features << ", events " << fig.events << " (max " << fig.max_events
             << "), repaired vertices " << fig.repaired << " (max " << fig.max_repaired << "), "
             << 1e3 * fig.seconds / trials << " ms per warp\n";
+  for (const auto& [why, count] : fig.reasons) std::cout << "[ figures  ]   " << count << " x " << why << "\n";
   return fig;
 }
 
@@ -349,6 +360,11 @@ TEST(WarpFeatures, ImpossibleTargetIsReportedNotFolded) {
   const std::vector<Vec2> targets = {Vec2(0.75, 0.1), uv[features[1]]};
   const FeatureWarpResult r = warp_features(e.triangles, uv, features, targets);
   ASSERT_EQ(r.unreached, std::vector<int>{0});
+  ASSERT_EQ(r.unreached_reasons.size(), 1u);
+  // The reason is a proof (the triangle of both features and the boundary vertex), and the feature is not moved.
+  EXPECT_NE(r.unreached_reasons[0].find("no fold-free embedding reaches it"), std::string::npos)
+      << r.unreached_reasons[0];
+  EXPECT_EQ(uv[features[0]], e.uv[features[0]]);
   EXPECT_GT(r.max_feature_error, 0.0);
   EXPECT_EQ(uv[features[1]], targets[1]);
   expect_warp_properties(e, uv, features, targets, r);

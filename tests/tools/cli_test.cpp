@@ -348,6 +348,26 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
   EXPECT_FALSE(fs::exists(out + "/spot.param.obj"));
 }
 
+// Issue #15 item 5: two features that lie the other way round on two models get the same common (u,v), so
+// neither can be reached. param, remesh and convert say so in one line naming both features, exit 2 and write
+// nothing.
+TEST_F(CliParam, FeaturesWithTheSameCommonTargetExitTwoWithoutOutput) {
+  const std::string c = corr("swap.json", model("[0, 1000, 2000, 2900]", "[100, 1752]") + "," +
+                                              model("[0, 1000, 2000, 2900]", "[1752, 100]"));
+  const std::string out = dir_ + "/swap";
+  for (const std::string& args : {"param -q --points '" + c + "' -o '" + out + "'",
+                                  "remesh -q --points '" + c + "' --level 3 -o '" + out + "'",
+                                  "convert -q --points '" + c + "' --level 3 -o '" + out + ".gip'"}) {
+    const Outcome r = geomip(args);
+    EXPECT_FALSE(r.crashed) << args;
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("features 0 and 1 get the same common (u,v)"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+    EXPECT_FALSE(fs::exists(out + ".gip")) << args;
+  }
+}
+
 }  // namespace
 }  // namespace geomip
 

@@ -590,13 +590,20 @@ class PlaneCoder {
     int lw[kMaxQuadLevels], lh[kMaxQuadLevels];
     std::size_t lbase[kMaxQuadLevels];
     for (int i = 0; i < levels; ++i) lw[i] = band.lw[i], lh[i] = band.lh[i], lbase[i] = band.lbase[i];
+    // Per level nl of this band: the parent band's node covering (x, y) is (x, y) >> pshift[nl] at level
+    // nl − 1 (level 0 for nl = 0), inside pw[nl] × ph[nl] (0 × 0 when the parent has no such level).
     const Band* const pb = band.parent >= 0 ? &bands_[static_cast<std::size_t>(band.parent)] : nullptr;
-    const std::uint8_t* const pst = pb ? pb->state.data() : nullptr;
-    const int plevels = pb ? pb->levels : 0;
-    int plw[kMaxQuadLevels], plh[kMaxQuadLevels];
-    std::size_t plbase[kMaxQuadLevels];
-    for (int i = 0; i < plevels; ++i) plw[i] = pb->lw[i], plh[i] = pb->lh[i], plbase[i] = pb->lbase[i];
-    const int ctx_base = (band.cls * 3 + band.kcls) * 4;
+    const std::uint8_t* pbase[kMaxQuadLevels];
+    int pw[kMaxQuadLevels], ph[kMaxQuadLevels], pshift[kMaxQuadLevels], lctx[kMaxQuadLevels];
+    for (int i = 0; i < levels; ++i) {
+      const int pl = i > 0 ? i - 1 : 0;
+      const bool has = pb && pl < pb->levels;
+      pbase[i] = has ? pb->state.data() + pb->lbase[pl] : nullptr;
+      pw[i] = has ? pb->lw[pl] : 0;
+      ph[i] = has ? pb->lh[pl] : 0;
+      pshift[i] = i > 0 ? 0 : 1;
+      lctx[i] = ((band.cls * 3 + band.kcls) * 4 + std::min(i, 3)) * 6;
+    }
     const auto node = [&](int nl, int nx, int ny) {
       return lbase[nl] + static_cast<std::size_t>(ny) * static_cast<std::size_t>(lw[nl]) +
              static_cast<std::size_t>(nx);
@@ -610,15 +617,13 @@ class PlaneCoder {
       if (ny > 0) nbr += *(at - w) & kSig;
       if (ny + 1 < h) nbr += at[w] & kSig;
       nbr = std::min(nbr, 2);
-      int par = 0;
-      if (pst) {
-        const int pl = nl > 0 ? nl - 1 : 0, px = nl > 0 ? nx : nx >> 1, py = nl > 0 ? ny : ny >> 1;
-        if (pl < plevels && px < plw[pl] && py < plh[pl])
-          par = pst[plbase[pl] + static_cast<std::size_t>(py) * static_cast<std::size_t>(plw[pl]) +
-                    static_cast<std::size_t>(px)] &
-                kSig;
-      }
-      return (((ctx_base + std::min(nl, 3)) * 3 + nbr) * 2) + par;
+      const int px = nx >> pshift[nl], py = ny >> pshift[nl];
+      const int par = px < pw[nl] && py < ph[nl]
+                          ? pbase[nl][static_cast<std::size_t>(py) * static_cast<std::size_t>(pw[nl]) +
+                                      static_cast<std::size_t>(px)] &
+                                kSig
+                          : 0;
+      return lctx[nl] + nbr * 2 + par;
     };
     Frame stack[kMaxQuadLevels];
     for (std::size_t n = 0; n < lis_size; ++n) {

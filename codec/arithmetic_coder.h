@@ -100,7 +100,8 @@ class ArithmeticDecoder {
   explicit ArithmeticDecoder(std::span<const std::uint8_t> bytes) : bytes_(bytes) {
     for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
   }
-  int decode(Context& context) {
+  // Always inlined: the bit-plane decoder's loops keep the decoder's state in registers only when it is.
+  [[gnu::always_inline]] int decode(Context& context) {
     const std::uint32_t bound = (range_ >> 16) * context.p0();
     const int bit = code_ >= bound;
     const std::uint32_t mask = 0u - static_cast<std::uint32_t>(bit);
@@ -110,7 +111,7 @@ class ArithmeticDecoder {
     if (range_ < kTop) normalize();
     return bit;
   }
-  int decode_bypass() {
+  [[gnu::always_inline]] int decode_bypass() {
     range_ >>= 1;
     const int bit = code_ >= range_;
     code_ -= range_ & (0u - static_cast<std::uint32_t>(bit));

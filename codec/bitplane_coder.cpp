@@ -437,6 +437,12 @@ class PlaneCoder {
       const int p = b - band.offset;
       if (k.pc == kBandStart) {
         if (p < 0 || band.lis.empty() || (band.start >= 0 && b > band.start)) continue;
+        if (!kCheck) {  // a whole band with the stream complete: the fast loop takes it
+          dec_ = d;
+          sort_fast(band, p);
+          d = dec_;
+          continue;
+        }
         band.lis_next.clear();
         k.n = 0;
         k.pc = kLisEntry;
@@ -566,6 +572,132 @@ class PlaneCoder {
     }
     dec_ = d;
     return true;
+  }
+
+  /// The decoder's sorting pass over one whole band (stream complete): the same decisions as the kTest /
+  /// kChannel / kSign / kNext steps of sort_pass(), in the same order, with the traversal state and the range
+  /// decoder in locals (byte stores into the quadtree state would otherwise force the cursor back to memory
+  /// per symbol).
+  void sort_fast(Band& band, int p) {
+    ArithmeticDecoder d = dec_;
+    band.lis_next.clear();
+    std::uint8_t* const st = band.state.data();
+    const std::uint32_t* const lis = band.lis.data();
+    const std::size_t lis_size = band.lis.size();
+    Context* const chan = &chan_ctx_[band.cls * 3 * 2];
+    // The band's and its parent's quadtree shapes in locals, and node_context() over them.
+    const int levels = band.levels;
+    int lw[kMaxQuadLevels], lh[kMaxQuadLevels];
+    std::size_t lbase[kMaxQuadLevels];
+    for (int i = 0; i < levels; ++i) lw[i] = band.lw[i], lh[i] = band.lh[i], lbase[i] = band.lbase[i];
+    // Per level nl of this band: the parent band's node covering (x, y) is (x, y) >> pshift[nl] at level
+    // nl − 1 (level 0 for nl = 0), inside pw[nl] × ph[nl] (0 × 0 when the parent has no such level).
+    const Band* const pb = band.parent >= 0 ? &bands_[static_cast<std::size_t>(band.parent)] : nullptr;
+    const std::uint8_t* pbase[kMaxQuadLevels];
+    int pw[kMaxQuadLevels], ph[kMaxQuadLevels], pshift[kMaxQuadLevels], lctx[kMaxQuadLevels];
+    for (int i = 0; i < levels; ++i) {
+      const int pl = i > 0 ? i - 1 : 0;
+      const bool has = pb && pl < pb->levels;
+      pbase[i] = has ? pb->state.data() + pb->lbase[pl] : nullptr;
+      pw[i] = has ? pb->lw[pl] : 0;
+      ph[i] = has ? pb->lh[pl] : 0;
+      pshift[i] = i > 0 ? 0 : 1;
+      lctx[i] = ((band.cls * 3 + band.kcls) * 4 + std::min(i, 3)) * 6;
+    }
+    const auto node = [&](int nl, int nx, int ny) {
+      return lbase[nl] + static_cast<std::size_t>(ny) * static_cast<std::size_t>(lw[nl]) +
+             static_cast<std::size_t>(nx);
+    };
+    const auto context = [&](int nl, int nx, int ny) {  // = node_context(band, nl, nx, ny)
+      const std::uint8_t* const at = st + node(nl, nx, ny);
+      const int w = lw[nl], h = lh[nl];
+      int nbr = 0;
+      if (nx > 0) nbr += at[-1] & kSig;
+      if (nx + 1 < w) nbr += at[1] & kSig;
+      if (ny > 0) nbr += *(at - w) & kSig;
+      if (ny + 1 < h) nbr += at[w] & kSig;
+      nbr = std::min(nbr, 2);
+      const int px = nx >> pshift[nl], py = ny >> pshift[nl];
+      const int par = px < pw[nl] && py < ph[nl]
+                          ? pbase[nl][static_cast<std::size_t>(py) * static_cast<std::size_t>(pw[nl]) +
+                                      static_cast<std::size_t>(px)] &
+                                kSig
+                          : 0;
+      return lctx[nl] + nbr * 2 + par;
+    };
+    Frame stack[kMaxQuadLevels];
+    for (std::size_t n = 0; n < lis_size; ++n) {
+      const std::uint32_t packed = lis[n];
+      int l = static_cast<int>(packed >> 28), x = static_cast<int>((packed >> 14) & 0x3FFF),
+          y = static_cast<int>(packed & 0x3FFF);
+      bool inferred = false;
+      int depth = 0;
+      while (true) {
+        // Test node (l, x, y); split it (or read its sample) when significant.
+        if (!inferred && !d.decode(node_ctx_[context(l, x, y)])) {
+          band.lis_next.push_back(pack(l, x, y));
+        } else {
+          if (!inferred && p > kMaxCoefficientPlane) throw Corrupt{};
+          st[node(l, x, y)] |= kSig;
+          if (l == 0) {
+            Sample sm{band.grid_index(x, y, size_), {0, 0, 0}, {0, 0, 0}, 0};
+            bool any = false;
+            for (int c = 0; c < 3; ++c) {
+              if ((c < 2 || any) && !d.decode(chan[c * 2 + any])) continue;
+              const int negative = d.decode_bypass();
+              sm.mag[c] = 1u << p;
+              sm.q[c] = static_cast<std::uint8_t>(p);
+              sm.flags = static_cast<std::uint8_t>(sm.flags | (1 << c) | (negative << (3 + c)));
+              any = true;
+            }
+            band.lsp.push_back(sm);
+          } else {
+            Frame& f = stack[depth++];
+            f.x = static_cast<std::uint16_t>(x);
+            f.y = static_cast<std::uint16_t>(y);
+            f.l = static_cast<std::uint8_t>(l);
+            f.last = -1;
+            f.any = false;
+            f.remaining = 0;
+            const int cl = l - 1;
+            for (int q = 0; q < 4; ++q) {
+              const int cx = 2 * x + (q & 1), cy = 2 * y + (q >> 1);
+              if (cx < lw[cl] && cy < lh[cl] && (st[node(cl, cx, cy)] & kActive)) ++f.remaining;
+            }
+          }
+        }
+        // The next node: the next active child of the innermost split node with children left.
+        bool found = false;
+        while (depth > 0) {
+          Frame& f = stack[depth - 1];
+          const int cl = f.l - 1;
+          if (f.last >= 0) {
+            const int lx = 2 * f.x + (f.last & 1), ly = 2 * f.y + (f.last >> 1);
+            f.any = f.any || (st[node(cl, lx, ly)] & kSig);
+          }
+          if (f.remaining == 0) {
+            --depth;
+            continue;
+          }
+          int q = f.last + 1;
+          for (;; ++q) {
+            const int cx = 2 * f.x + (q & 1), cy = 2 * f.y + (q >> 1);
+            if (cx < lw[cl] && cy < lh[cl] && (st[node(cl, cx, cy)] & kActive)) break;
+          }
+          f.last = static_cast<std::int8_t>(q);
+          --f.remaining;
+          l = cl;
+          x = 2 * f.x + (q & 1);
+          y = 2 * f.y + (q >> 1);
+          inferred = f.remaining == 0 && !f.any;
+          found = true;
+          break;
+        }
+        if (!found) break;
+      }
+    }
+    std::swap(band.lis, band.lis_next);
+    dec_ = d;
   }
 
   template <bool kCheck>

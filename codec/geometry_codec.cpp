@@ -347,8 +347,8 @@ struct FrameField {
         wavelet_inverse(g[c], sub_level, sub_steps, filter);
       }
       const auto at = [&](int c, int i, int j) {
-        return static_cast<std::int64_t>(
-            g[c][static_cast<std::size_t>(j / s) * sub + static_cast<std::size_t>(i / s)]);
+        return static_cast<std::int64_t>(  // i, j ≥ 0 multiples of s = 2^(min_k − 1)
+            g[c][static_cast<std::size_t>(j >> (min_k - 1)) * sub + static_cast<std::size_t>(i >> (min_k - 1))]);
       };
       for (int k = min_k; k <= frame_steps; ++k) {
         if (start[static_cast<std::size_t>(k - 1)] != plane) continue;

@@ -95,7 +95,8 @@ Eigen::Vector3d ground_direction(const TriMesh& mesh, double band) {
   Eigen::Vector3d lo = points[0], hi = points[0];
   for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
   const Eigen::Vector3d extent = hi - lo;
-  // The support polygon of the box face (axis, sign) within `depth` × the extent, relative to the face's area.
+  // The support polygon of the box face (axis, sign) within `depth` × the extent, relative to the face's
+  // area.
   const auto support = [&](int axis, int sign, double depth) {
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
     const double face = extent[a] * extent[b];
@@ -113,7 +114,8 @@ Eigen::Vector3d ground_direction(const TriMesh& mesh, double band) {
     for (int s : {-1, 1})
       if (const double ratio = support(c, s, band); ratio > best) best = ratio, axis = c, sign = s;
   // 2. Its end: the one whose contact hull grows less from `band` to 4 × `band` (legs, a neck or a cut keep
-  //    their width; a back or a crown is a dome); growths within 5 % of each other: the larger support polygon.
+  //    their width; a back or a crown is a dome); growths within 5 % of each other: the larger support
+  //    polygon.
   const double near_lo = support(axis, -1, band), near_hi = support(axis, 1, band);
   const auto growth = [&](int s, double near) {
     return near > 0 ? support(axis, s, 4 * band) / near : HUGE_VAL;

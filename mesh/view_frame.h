@@ -15,9 +15,10 @@ enum class UpAxis { kAuto, kX, kY, kZ };
 /// The direction the model rests on, among ±x, ±y, ±z. The contact set of a face of the bounding box is the
 /// referenced vertices within `band` × the box's extent of that face; its support polygon is the set's 2D
 /// convex hull, relative to the box face's area.
-///  1. The axis: that of the face with the largest support polygon (ties: the first of −y, +y, −x, +x, −z, +z).
-///     A standing quadruped rests on its four feet (a hull over most of the footprint), while its back, head or
-///     flank touch their box faces in a line or a patch; a head or a bust is longest from crown to neck.
+///  1. The axis: that of the face with the largest support polygon (ties: the first of −y, +y, −x, +x,
+///     −z, +z). A standing quadruped rests on its four feet (a hull over most of the footprint), while its
+///     back, head or flank touch their box faces in a line or a patch; a head or a bust is longest from its
+///     crown to its neck.
 ///  2. The end of that axis: the one whose support polygon grows less from `band` to 4 × `band` (the ratio of
 ///     the two hulls): legs, a neck or a flat cut keep their width there, a back or the crown of a head is a
 ///     dome and widens. A face with an empty (zero-area) support polygon is the top. When the two growths are

@@ -90,8 +90,8 @@ TEST(ViewFrame, ALyingAnimalWhoseHeadIsLowerThanItsRumpFacesWithItsHead) {
 }
 
 /// A bust in its own frame, y up: a neck (a cylinder of radius 0.3, y in [0, 1], cut flat at y = 0 and closed
-/// by a disc there) under a head (a sphere of radius 1 around (0, 1.8, 0), 24 latitude bands). The crown's cap
-/// within 5 % of the height spans a wider hull (its ring of radius 0.5) than the neck's cut (0.3), so the
+/// by a disc there) under a head (a sphere of radius 1 around (0, 1.8, 0), 24 latitude bands). The crown's
+/// cap within 5 % of the height spans a wider hull (its ring of radius 0.5) than the neck's cut (0.3), so the
 /// support polygon alone rests it on its crown; but the crown widens further in (a dome, radius 0.87 within
 /// 20 %) while the neck keeps its width.
 TriMesh bust() {
@@ -135,8 +135,10 @@ TriMesh bust() {
   for (int i = 1; i < kRings; ++i) {
     const double polar = kPi * i / kRings;
     const int next = ring(1.8 - std::cos(polar), std::sin(polar));
-    if (previous < 0) fan(south, next, false);
-    else band(previous, next);
+    if (previous < 0)
+      fan(south, next, false);
+    else
+      band(previous, next);
     previous = next;
   }
   const int north = static_cast<int>(m.positions.size());

@@ -95,24 +95,38 @@ Eigen::Vector3d ground_direction(const TriMesh& mesh, double band) {
   Eigen::Vector3d lo = points[0], hi = points[0];
   for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
   const Eigen::Vector3d extent = hi - lo;
-  Eigen::Vector3d best = -Eigen::Vector3d::UnitY();
-  double best_ratio = -1;
-  for (int axis : {1, 0, 2}) {
+  // The support polygon of the box face (axis, sign) within `depth` × the extent, relative to the face's
+  // area.
+  const auto support = [&](int axis, int sign, double depth) {
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
     const double face = extent[a] * extent[b];
-    for (int sign : {-1, 1}) {
-      const double plane = sign < 0 ? lo[axis] : hi[axis];
-      std::vector<Eigen::Vector2d> contact;
-      for (const auto& p : points)
-        if (std::abs(p[axis] - plane) <= band * extent[axis]) contact.emplace_back(p[a], p[b]);
-      const double ratio = face > 0 ? hull_area(std::move(contact)) / face : 0;
-      if (ratio > best_ratio) {
-        best_ratio = ratio;
-        best = Eigen::Vector3d::Unit(axis) * sign;
-      }
-    }
-  }
-  return best;
+    if (!(face > 0)) return 0.0;
+    const double plane = sign < 0 ? lo[axis] : hi[axis];
+    std::vector<Eigen::Vector2d> contact;
+    for (const auto& p : points)
+      if (std::abs(p[axis] - plane) <= depth * extent[axis]) contact.emplace_back(p[a], p[b]);
+    return hull_area(std::move(contact)) / face;
+  };
+  // 1. The axis: that of the face with the largest support polygon.
+  int axis = 1, sign = -1;
+  double best = -1;
+  for (int c : {1, 0, 2})
+    for (int s : {-1, 1})
+      if (const double ratio = support(c, s, band); ratio > best) best = ratio, axis = c, sign = s;
+  // 2. Its end: the one whose contact hull grows less from `band` to 4 × `band` (legs, a neck or a cut keep
+  //    their width; a back or a crown is a dome); growths within 5 % of each other: the larger support
+  //    polygon.
+  const double near_lo = support(axis, -1, band), near_hi = support(axis, 1, band);
+  const auto growth = [&](int s, double near) {
+    return near > 0 ? support(axis, s, 4 * band) / near : HUGE_VAL;
+  };
+  const double grow_lo = growth(-1, near_lo), grow_hi = growth(1, near_hi);
+  if (std::isfinite(grow_lo) && std::isfinite(grow_hi) &&
+      std::abs(grow_lo - grow_hi) > 0.05 * std::max(grow_lo, grow_hi))
+    sign = grow_lo < grow_hi ? -1 : 1;
+  else if (std::isfinite(grow_lo) != std::isfinite(grow_hi))
+    sign = std::isfinite(grow_lo) ? -1 : 1;
+  return Eigen::Vector3d::Unit(axis) * sign;
 }
 
 Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up_axis, const Eigen::Vector3d& front_axis) {

@@ -12,13 +12,19 @@ namespace geomip {
 /// The model's up axis: kAuto guesses it from the shape (ground_direction()); kX/kY/kZ take +x/+y/+z.
 enum class UpAxis { kAuto, kX, kY, kZ };
 
-/// The direction the model rests on, among ±x, ±y, ±z: the face of the bounding box whose contact set — the
-/// referenced vertices within `band` × the box's extent of that face — has the largest 2D convex hull (the
-/// support polygon), relative to the box face's area. A standing quadruped rests on its four feet (a hull
-/// over most of the footprint), while its back, head or flank touch their box faces in a line or a patch.
-/// Ties go to the first of −y, +y, −x, +x, −z, +z. The animals of ../shared/meshes and what it picks for them
-/// are in docs/streaming.md ("Upright and front"). Returns a unit axis vector (−y for an empty mesh).
-/// Cost: O(#V log #V).
+/// The direction the model rests on, among ±x, ±y, ±z. The contact set of a face of the bounding box is the
+/// referenced vertices within `band` × the box's extent of that face; its support polygon is the set's 2D
+/// convex hull, relative to the box face's area.
+///  1. The axis: that of the face with the largest support polygon (ties: the first of −y, +y, −x, +x,
+///     −z, +z). A standing quadruped rests on its four feet (a hull over most of the footprint), while its
+///     back, head or flank touch their box faces in a line or a patch; a head or a bust is longest from its
+///     crown to its neck.
+///  2. The end of that axis: the one whose support polygon grows less from `band` to 4 × `band` (the ratio of
+///     the two hulls): legs, a neck or a flat cut keep their width there, a back or the crown of a head is a
+///     dome and widens. A face with an empty (zero-area) support polygon is the top. When the two growths are
+///     within 5 % of each other (or both faces are empty): the end with the larger support polygon (ties: −).
+/// The meshes of ../shared/meshes and what each step measures on them are in docs/streaming.md ("Upright and
+/// front"). Returns a unit axis vector (−y for an empty mesh). Cost: O(#V log #V).
 Eigen::Vector3d ground_direction(const TriMesh& mesh, double band = 0.05);
 
 /// The rotation (a signed permutation matrix, det +1) from model units to the viewer's axes: rows are the

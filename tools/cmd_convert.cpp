@@ -85,7 +85,7 @@ int run_convert(const ConvertArgs& args) {
   const Eigen::Vector3d front = front_axis(args);
   if (!front.isZero() && !models.inputs.empty()) {
     if (!up) throw InvalidInput("--front " + args.front + " needs a stored frame: --up x, y, z or auto");
-    if (!upright_rotation(models.inputs[0].mesh, *up, front).row(0).transpose().isApprox(front))
+    if (!upright_rotation(view_frame_mesh(models), *up, front).row(0).transpose().isApprox(front))
       throw InvalidInput("--front " + args.front + " is along the up axis; name one of the other two axes");
   }
 

@@ -77,6 +77,11 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
 
 }  // namespace
 
+const TriMesh& view_frame_mesh(const PreparedModels& models) {
+  const bool repaired = !models.originals.empty() && !models.originals[0].triangles.empty();
+  return repaired ? models.originals[0] : models.inputs.at(0).mesh;
+}
+
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options) {
   auto progress = [&](const char* stage, double fraction) {
     if (options.progress) options.progress(stage, fraction);
@@ -103,7 +108,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   std::vector<codec::PackModelInput> inputs;
   std::optional<Eigen::Matrix3d> view_rotation;
   if (options.up && !models.inputs.empty())
-    view_rotation = upright_rotation(models.inputs[0].mesh, *options.up, options.front);
+    view_rotation = upright_rotation(view_frame_mesh(models), *options.up, options.front);
   if (view_rotation && view_rotation->isIdentity()) view_rotation.reset();  // the viewer's default: no bytes
   const int mask_level = options.hole_mask_level < 0 ? options.level : std::min(options.hole_mask_level, options.level);
   for (std::size_t m = 0; m < params.size(); ++m) {

@@ -2,8 +2,9 @@
 """The three front cues of mesh/view_frame.h (upright_rotation) on meshes, as a markdown table.
 
 Plain python3, no dependencies; the same rules as the C++ code (a reimplementation for the table in
-docs/streaming.md, "Upright and front"): up = the box face with the largest support polygon (contact band 5 %),
-length = the longer horizontal axis, then per end: reach (largest up coordinate in the end quarter, / height
+docs/streaming.md, "Upright and front"): up = ground() (ground_direction(): the axis of the largest support
+polygon, contact band 5 %, at the end that widens less from 5 % to 20 %), length = the longer horizontal axis,
+then per end: reach (largest up coordinate in the end quarter, / height
 above the lowest vertex), width (side extent of the end tenth, / the box's side extent), mass (volume
 centroid's offset from the middle of the length, / length; the vote goes to the other end); front = 2 of 3.
 Usage: front_cues.py MESH_DIR NAME...   (OBJ, or binary little-endian PLY with triangle faces)
@@ -54,16 +55,28 @@ def hull_area(p):
 
 
 def ground(P, lo, hi, band=0.05):
+    """ground_direction(): the axis of the face with the largest support polygon, then the end whose support
+    polygon grows less from band to 4 × band (growths within 5 %: the larger support polygon)."""
     ext = [hi[i] - lo[i] for i in range(3)]
-    best, ratio = (1, -1), -1
-    for ax in (1, 0, 2):
+
+    def support(ax, s, d):
         a, b = (ax + 1) % 3, (ax + 2) % 3
         face = ext[a] * ext[b]
+        plane = lo[ax] if s < 0 else hi[ax]
+        return hull_area([(p[a], p[b]) for p in P if abs(p[ax] - plane) <= d * ext[ax]]) / face if face > 0 else 0
+
+    best, ratio = (1, -1), -1
+    for ax in (1, 0, 2):
         for s in (-1, 1):
-            plane = lo[ax] if s < 0 else hi[ax]
-            r = hull_area([(p[a], p[b]) for p in P if abs(p[ax] - plane) <= band * ext[ax]]) / face if face > 0 else 0
+            r = support(ax, s, band)
             if r > ratio:
                 best, ratio = (ax, s), r
+    ax = best[0]
+    g = [support(ax, s, 4 * band) / n if n > 0 else math.inf for s in (-1, 1) for n in [support(ax, s, band)]]
+    if math.isfinite(g[0]) and math.isfinite(g[1]) and abs(g[0] - g[1]) > 0.05 * max(g):
+        return ax, -1 if g[0] < g[1] else 1
+    if math.isfinite(g[0]) != math.isfinite(g[1]):
+        return ax, -1 if math.isfinite(g[0]) else 1
     return best
 
 

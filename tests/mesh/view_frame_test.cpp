@@ -12,6 +12,10 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
+#include <cmath>
+#include <utility>
+
 namespace geomip {
 namespace {
 
@@ -82,6 +86,77 @@ TEST(ViewFrame, ALyingAnimalWhoseHeadIsLowerThanItsRumpFacesWithItsHead) {
     const Eigen::Matrix3d r = upright_rotation(t, UpAxis::kAuto);
     EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n"
                                                                << r * q;
+  }
+}
+
+/// A bust in its own frame, y up: a neck (a cylinder of radius 0.3, y in [0, 1], cut flat at y = 0 and closed
+/// by a disc there) under a head (a sphere of radius 1 around (0, 1.8, 0), 24 latitude bands). The crown's
+/// cap within 5 % of the height spans a wider hull (its ring of radius 0.5) than the neck's cut (0.3), so the
+/// support polygon alone rests it on its crown; but the crown widens further in (a dome, radius 0.87 within
+/// 20 %) while the neck keeps its width.
+TriMesh bust() {
+  TriMesh m;
+  constexpr int kAround = 32, kRings = 24;
+  constexpr double kPi = 3.14159265358979323846;
+  const auto ring = [&](double y, double radius) {
+    const int base = static_cast<int>(m.positions.size());
+    for (int k = 0; k < kAround; ++k)
+      m.positions.emplace_back(radius * std::cos(2 * kPi * k / kAround), y,
+                               radius * std::sin(2 * kPi * k / kAround));
+    return base;
+  };
+  const auto band = [&](int a, int b) {  // quads between two rings
+    for (int k = 0; k < kAround; ++k) {
+      const int k1 = (k + 1) % kAround;
+      m.triangles.push_back({a + k, b + k, b + k1});
+      m.triangles.push_back({a + k, b + k1, a + k1});
+    }
+  };
+  const auto fan = [&](int centre, int r, bool flip) {
+    for (int k = 0; k < kAround; ++k) {
+      const int k1 = (k + 1) % kAround;
+      m.triangles.push_back(flip ? std::array<int, 3>{centre, r + k1, r + k}
+                                 : std::array<int, 3>{centre, r + k, r + k1});
+    }
+  };
+  // The neck: rings every 0.25, the cut's disc at y = 0.
+  m.positions.emplace_back(0, 0, 0);
+  int previous = ring(0, 0.3);
+  fan(0, previous, false);
+  for (int i = 1; i <= 4; ++i) {
+    const int next = ring(0.25 * i, 0.3);
+    band(previous, next);
+    previous = next;
+  }
+  // The head: latitude rings between the poles.
+  const int south = static_cast<int>(m.positions.size());
+  m.positions.emplace_back(0, 0.8, 0);
+  previous = -1;
+  for (int i = 1; i < kRings; ++i) {
+    const double polar = kPi * i / kRings;
+    const int next = ring(1.8 - std::cos(polar), std::sin(polar));
+    if (previous < 0)
+      fan(south, next, false);
+    else
+      band(previous, next);
+    previous = next;
+  }
+  const int north = static_cast<int>(m.positions.size());
+  m.positions.emplace_back(0, 2.8, 0);
+  fan(north, previous, true);
+  return m;
+}
+
+TEST(ViewFrame, ABustInAnyAxisOrientationRestsOnItsNeckNotOnItsCrown) {
+  const TriMesh base = bust();
+  for (const Eigen::Matrix3d& q : axis_rotations()) {
+    TriMesh m = base;
+    for (auto& p : m.positions) p = q * p;
+    EXPECT_TRUE(ground_direction(m).isApprox(-(q * Eigen::Vector3d::UnitY())))
+        << q << "\nground " << ground_direction(m).transpose();
+    const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
+    EXPECT_TRUE((r * q * Eigen::Vector3d::UnitY()).isApprox(Eigen::Vector3d::UnitY())) << r * q;
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
   }
 }
 
@@ -169,6 +244,22 @@ TEST(ViewFrame, TheAnimalsOfTheSharedMeshesGetTheirDataUpAxisAndFaceWithTheirHea
     if (!a.head.isZero()) {
       EXPECT_TRUE((r * a.head).isApprox(Eigen::Vector3d::UnitX())) << a.file << ": front " << r.row(0);
     }
+  }
+}
+
+/// The heads and busts of ../shared/meshes, up = the top of the head, read off the data (side views of the
+/// vertices, docs/streaming.md "Upright and front"): each has its neck at the −up face of its box (the camel
+/// head's neck cut is at −y, its muzzle towards +z).
+TEST(ViewFrame, TheHeadsAndBustsOfTheSharedMeshesStandOnTheirNecks) {
+  const std::pair<const char*, Eigen::Vector3d> busts[] = {{"camelhead.obj", Eigen::Vector3d::UnitY()},
+                                                           {"max-planck.obj", Eigen::Vector3d::UnitY()},
+                                                           {"venus.obj", Eigen::Vector3d::UnitZ()},
+                                                           {"igea.ply", Eigen::Vector3d::UnitY()}};
+  for (const auto& [file, up] : busts) {
+    GEOMIP_REQUIRE_SHARED_MESH(path, file);
+    const TriMesh m = read_mesh(path);
+    EXPECT_TRUE((-ground_direction(m)).isApprox(up)) << file << ": " << -ground_direction(m).transpose();
+    EXPECT_TRUE((upright_rotation(m, UpAxis::kAuto) * up).isApprox(Eigen::Vector3d::UnitY())) << file;
   }
 }
 

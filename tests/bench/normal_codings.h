@@ -15,6 +15,7 @@
 // +, −, ×, ÷ and sqrt on float inputs, each written as its own operation.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 #include "codec/geometry_codec.h"
@@ -49,5 +50,12 @@ std::vector<Grid3> normal_residual(const std::vector<Grid3>& normals, const std:
 void apply_normal_residual(std::vector<Grid3>& maps, const std::vector<Grid3>& geometry,
                            const Orientation& along_grid, const std::vector<Grid3>* axes = nullptr,
                            int max_threads = 0);
+
+/// Bytes of all segments of an encoded stream.
+std::size_t stream_bytes(const codec::EncodedGeometry& e);
+
+/// The first `budget` bytes of an encoded stream (complete segments, then a prefix of the next), decoded
+/// (what the normal chunks of a pack cut at that size hold).
+std::vector<Grid3> decode_budget(const codec::EncodedGeometry& e, std::size_t budget);
 
 }  // namespace geomip::bench

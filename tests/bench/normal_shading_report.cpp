@@ -11,17 +11,19 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <span>
 #include <string>
 #include <vector>
 
 #include "codec/pack.h"
 #include "tools/convert_pipeline.h"
 #include "tools/model_inputs.h"
+#include "tests/bench/normal_codings.h"
 
 namespace {
 
 using namespace geomip::codec;
+using geomip::bench::decode_budget;
+using geomip::bench::stream_bytes;
 
 constexpr int kReferenceLevel = 10;
 
@@ -76,30 +78,6 @@ void shading_error(const PackModelInput& in, const std::vector<Grid3>& reference
   mean /= static_cast<double>(std::max<std::size_t>(all.size(), 1));
   std::sort(all.begin(), all.end());
   p95 = all.empty() ? 0 : all[all.size() * 95 / 100];
-}
-
-std::size_t stream_bytes(const EncodedGeometry& e) {
-  std::size_t n = 0;
-  for (const auto& segment : e.segments) n += segment.size();
-  return n;
-}
-
-/// The first `budget` bytes of an encoded stream (complete segments, then a prefix of the next), decoded.
-std::vector<Grid3> decode_budget(const EncodedGeometry& e, std::size_t budget) {
-  std::vector<std::span<const std::uint8_t>> segments;
-  std::span<const std::uint8_t> tail;
-  std::size_t used = 0;
-  for (const auto& segment : e.segments) {
-    if (used + segment.size() > budget) {
-      tail = std::span<const std::uint8_t>(segment).first(budget - used);
-      break;
-    }
-    segments.push_back(segment);
-    used += segment.size();
-  }
-  DecodedGeometry d;
-  decode_geometry(e.header, segments, tail, d);
-  return d.patches;
 }
 
 }  // namespace

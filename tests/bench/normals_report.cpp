@@ -30,8 +30,10 @@ namespace {
 
 using namespace geomip::codec;
 using geomip::bench::apply_normal_residual;
+using geomip::bench::decode_budget;
 using geomip::bench::normal_frames_along_grid;
 using geomip::bench::normal_residual;
+using geomip::bench::stream_bytes;
 
 struct AngleStats {
   double mean = 0, p95 = 0, max = 0;
@@ -107,36 +109,12 @@ void row(const char* what, std::size_t size, const PackInfo& info, const std::ve
               normal_bytes(info, size), s.mean, s.p95, s.max);
 }
 
-/// The first `budget` bytes of an encoded stream (complete segments, then a prefix of the next), decoded.
-std::vector<Grid3> decode_budget(const EncodedGeometry& e, std::size_t budget) {
-  std::vector<std::span<const std::uint8_t>> segments;
-  std::span<const std::uint8_t> tail;
-  std::size_t used = 0;
-  for (const auto& segment : e.segments) {
-    if (used + segment.size() > budget) {
-      tail = std::span<const std::uint8_t>(segment).first(budget - used);
-      break;
-    }
-    segments.push_back(segment);
-    used += segment.size();
-  }
-  DecodedGeometry d;
-  decode_geometry(e.header, segments, tail, d);
-  return d.patches;
-}
-
 void normalize_grid(Grid3& g) {
   for (std::size_t k = 0; k < g.values.size(); k += 3) {
     float* n = g.values.data() + k;
     const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (len > 0) n[0] /= len, n[1] /= len, n[2] /= len;
   }
-}
-
-std::size_t stream_bytes(const EncodedGeometry& e) {
-  std::size_t n = 0;
-  for (const auto& segment : e.segments) n += segment.size();
-  return n;
 }
 
 /// The normal stream alone (model 0), four codings at normal-byte budgets: xyz (the packs' coding: 3

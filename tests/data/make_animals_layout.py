@@ -22,15 +22,22 @@ one loop around it:
   - a leg's rings are the boundaries of geodesic disks round its foot, of radius 90 % (root) and 55 % (lower
     ring) of the foot's geodesic distance to the body's midline (the belly or chest between the legs): on a long
     leg they are horizontal loops below the armpit and above the hoof, on the pig's stubs loops on the belly
-    round them;  - the head is cut by the plane normal to the head's direction halfway between the front station's corners and
-    the rearmost of ears, eyes and top of the head;
-  - the tail root ring is the boundary of the geodesic disk of radius 8 % of the body length around it;
+    round them;
+  - the head is cut by the plane normal to the head's direction 70 % of the way from the front station's
+    corners to the rearmost of ears, eyes and top of the head (at 50 % the level-4 remeshes lose 1.2 dB on
+    horse and spot, 2.2 dB on the pig: the head's cap holds more of the surface; at 90 % the cow's left ear
+    falls outside it);
+  - the tail root ring is the boundary of the geodesic disk of radius 10 % of the body length around it, with
+    whatever the disk cuts off (a tail hanging free from its root, less than a tenth of the vertices) added
+    (without that, the cow's hanging tail lies in one side patch of the tail, L-inf stretch 40, and its level-4
+    remesh loses 7 dB; a radius of 5 % puts the cow's tail root on a path, 12 % without the addition folds it);
   - a ring's 4 corners are the ring vertices seen from its centroid nearest the two diagonals of a plane
     (legs: forward and outward; head and tail: up and left), so they are in the same cyclic order everywhere;
   - the stations' top corners TL, TR are the cross-section of the torso at the station's length (the mean of
     its leg-root corners), at its upper-left and upper-right extremes, no higher than the withers.
-Each model's layout is traced as geomip does it (partition_mesh_layout: Dijkstra paths), so the check here is
-only that corners are distinct and features are not corners; `geomip param` checks the rest.
+The script checks that the layout is a closed oriented quad surface with V - E + F = 2, that corners are
+distinct and that no feature is a corner; whether the paths cut each mesh into the quads, with every feature in
+its protrusion's cap, is checked by `geomip param` and tests/tools/cli_test.cpp.
 Usage: make_animals_layout.py [MESH_DIR] > animals-layout.corr.json
 """
 import heapq, json, math, os, sys
@@ -39,8 +46,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from make_animals_corr import MODELS, FEATURES, Frame, find_points, load_obj, split_pinches, dot  # noqa: E402
 
 # Leg rings at these fractions of the foot's geodesic distance to the midline. The pig's front legs are stubs
-# against its jaw: 0.7-0.8 / 0.3-0.45 leave its front feet on or outside the lower ring's paths, 0.8 / 0.55 makes
-# two corners coincide; 0.9 / 0.55 puts every foot inside its leg's cap on all four animals.
+# against its jaw: 0.7-0.9 / 0.3-0.45 leave its front feet on or outside the lower ring's paths, 0.7-0.8 / 0.55
+# make two corners coincide; 0.9 / 0.55 puts every foot inside its leg's cap on all four animals.
 ROOT, LOW = 0.9, 0.55
 RING = ['TL', 'TR', 'R', 'BR', 'BL', 'L']  # a station's corners, going round the body
 
@@ -207,7 +214,7 @@ def place(name, V, F, fr, P):
     hf = lambda v: dot(V[v], fr.hf)
     back = min(hf(P[k]) for k in ('ear_l', 'ear_r', 'eye_l', 'eye_r', 'head_top'))
     front = max(hf(C[k]) for k in ('TL0', 'TR0', 'L0', 'R0'))
-    cut = (front + back) / 2 if front < back else back
+    cut = front + 0.7 * (back - front) if front < back else back
     comp = flood(adj, P['nose'], lambda v: hf(v) >= cut)
     assert not comp & set(feet.values()), (name, 'head cut reaches a foot')
     ring = boundary(adj, comp)
@@ -215,9 +222,19 @@ def place(name, V, F, fr, P):
     tl, bl, br, tr = extremes(ring, hcoords, ((1, 1), (-1, 1), (-1, -1), (1, -1)))
     C.update({'head_tl': tl, 'head_bl': bl, 'head_br': br, 'head_tr': tr})
     # Tail: the boundary of the geodesic disk around the tail root.
-    r = 0.08 * L
+    r = 0.1 * L
     dist = geodesic(V, adj, P['tail'], 2 * r)
-    ring = boundary(adj, {v for v, d in dist.items() if d < r})
+    disk = {v for v, d in dist.items() if d < r}
+    # A tail that hangs free from its root (the cow's) is cut off by the disk: what is left of it joins the disk.
+    used = sorted({v for t in F for v in t})
+    rest = [v for v in used if v not in disk]
+    seen = set()
+    for v in rest:
+        if v in seen: continue
+        part = flood(adj, v, lambda w: w not in disk)
+        seen |= part
+        if len(part) < len(used) // 10: disk |= part
+    ring = boundary(adj, disk)
     tcoords = lambda v: (fr.U[v], fr.Lc[v])
     tl, bl, br, tr = extremes(ring, tcoords, ((1, 1), (-1, 1), (-1, -1), (1, -1)))
     C.update({'tail_tl': tl, 'tail_bl': bl, 'tail_br': br, 'tail_tr': tr})

@@ -645,6 +645,73 @@ TEST_F(Cli, AnimalsGetIdenticalFeatureCoordinates) {
   }
 }
 
+// Issue 15: the four animals with a user layout (tests/data/animals-layout.corr.json, made by
+// make_animals_layout.py: a torso tube with each leg, the head and the tail extruded as 5 patches of their own,
+// 46 quads). Every model gets the 46 patches, no flip, and the 9 features (feet, ears, eyes, tail root) at
+// identical (patch, u, v) in all four, each in its protrusion's cap (a foot in its leg's, ears and eyes in the
+// head's, the tail root in the tail's); the uniform and the adaptive remesh give one face list for all four,
+// closed, genus 0 and outward (positive volume: no triangle turned over as a whole).
+TEST_F(CliGimage, AnimalsWithAUserLayoutShareFeaturesAndFaceLists) {
+  GEOMIP_REQUIRE_SHARED_MESH(horse, "horse.obj");
+  const std::string corr = std::string(GEOMIP_SOURCE_DIR) + "/tests/data/animals-layout.corr.json";
+  const auto spec = nlohmann::json::parse(slurp(corr));
+  const auto& quad_names = spec["layout"]["quad_names"];
+  const auto& feature_names = spec["layout"]["feature_names"];
+  ASSERT_EQ(quad_names.size(), 46u);
+  ASSERT_EQ(feature_names.size(), 9u);
+  auto designated = [](const std::string& feature) -> std::string {
+    if (feature.rfind("foot_", 0) == 0) return "leg_" + feature.substr(5) + "_cap";
+    if (feature.rfind("ear_", 0) == 0 || feature.rfind("eye_", 0) == 0) return "head_cap";
+    return feature + "_cap";
+  };
+  const std::string out = dir_ + "/animals";
+  const Outcome r = geomip("param --quiet --points '" + corr + "' -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const char* stems[] = {"horse", "cow", "pig", "spot"};
+  std::vector<nlohmann::json> models;
+  for (const char* stem : stems) {
+    models.push_back(nlohmann::json::parse(slurp(out + "/" + stem + ".param.json")));
+    const auto& m = models.back();
+    EXPECT_EQ(m["flipped_triangles"], 0) << stem;
+    EXPECT_EQ(m["seam_mismatches"], 0) << stem;
+    EXPECT_EQ(m["patches"].size(), 46u) << stem;
+    EXPECT_EQ(m["layout_quads"], spec["layout"]["quads"]) << stem;
+    ASSERT_EQ(m["features"].size(), 9u) << stem;
+    for (std::size_t k = 0; k < 9; ++k) {
+      const std::string name = feature_names[k];
+      EXPECT_EQ(quad_names[m["features"][k]["patch"].get<std::size_t>()], designated(name)) << stem << " " << name;
+    }
+  }
+  for (std::size_t k = 0; k < 9; ++k)
+    for (std::size_t m = 1; m < models.size(); ++m) {
+      const auto &f0 = models[0]["features"][k], &f = models[m]["features"][k];
+      EXPECT_EQ(f["patch"], f0["patch"]) << "feature " << k << " " << stems[m];
+      EXPECT_LE(std::abs(f["u"].get<double>() - f0["u"].get<double>()), 1e-9) << "feature " << k << " " << stems[m];
+      EXPECT_LE(std::abs(f["v"].get<double>() - f0["v"].get<double>()), 1e-9) << "feature " << k << " " << stems[m];
+    }
+
+  const std::string meshes = dir_ + "/remesh";
+  const Outcome s = geomip("remesh --quiet --points '" + corr + "' --level 4 --adaptive 0.01 --max-depth 5 -o '" +
+                           meshes + "'");
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  for (const char* kind : {".M4.obj", ".adaptive.obj"}) {
+    const TriMesh first = read_mesh(meshes + "/horse" + kind);
+    if (std::string(kind) == ".M4.obj") EXPECT_EQ(first.triangles.size(), 46u * 2 * 16 * 16);
+    for (const char* stem : stems) {
+      const TriMesh m = read_mesh(meshes + "/" + stem + kind);
+      EXPECT_EQ(m.triangles, first.triangles) << stem << kind;
+      const TopologyReport t = analyze_topology(m);
+      EXPECT_EQ(t.boundary_loops, 0u) << stem << kind;
+      EXPECT_TRUE(t.manifold) << stem << kind;
+      EXPECT_EQ(t.genus, 0) << stem << kind;
+      double volume = 0;
+      for (const auto& tri : m.triangles)
+        volume += m.positions[tri[0]].dot(m.positions[tri[1]].cross(m.positions[tri[2]])) / 6;
+      EXPECT_GT(volume, 0) << stem << kind;
+    }
+  }
+}
+
 TEST_F(CliGimage, AdaptiveRemeshIsWatertightSharedAndCoarserForLargerEps) {
   const std::string corr = sphere_pair();
   std::size_t previous = 0;

@@ -465,6 +465,54 @@ TEST_F(ViewPackTest, AnimalsStandUprightFacingTheCameraAt60To80PercentOfTheHeigh
               << "\n";
   }
 }
+
+// Issue 15: the four animals with a user layout (tests/data/animals-layout.corr.json: 46 quads, each leg, the
+// head and the tail with patches of their own) through `geomip convert`: one pack of 4 models with 46
+// patches each, and the viewer morphs them. Horse → cow and pig → spot at t = 0, 0.5, 1 (linear schedule):
+// each frame covers the CPU-evaluated morph's silhouette (IoU > 0.95) with no crack inside it, the end frames
+// are the models alone, and the three frames differ from each other.
+TEST_F(ViewPackTest, AnimalsWithAUserLayoutMorphWithoutCracks) {
+  const fs::path horse = fs::path(GEOMIP_SHARED_MESHES) / "horse.obj";
+  if (!fs::exists(horse)) GTEST_SKIP() << horse << " not found (../shared/meshes)";
+  const fs::path pack = work_dir() / "animals-layout.gip";
+  const std::string convert = std::string(GEOMIP_BINARY) + " convert -q --points " + GEOMIP_SOURCE_DIR +
+                              "/tests/data/animals-layout.corr.json --level 4 -o " + pack.string();
+  ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+  const auto models = decode_file(pack);
+  ASSERT_EQ(models.size(), 4u);
+  for (const auto& m : models) EXPECT_EQ(m.num_patches, 46);
+  const Camera camera = framed(models);
+  for (int source : {0, 2}) {
+    std::vector<std::vector<std::uint8_t>> frames;
+    for (float t : {0.0f, 0.5f, 1.0f}) {
+      const std::string tag = std::to_string(source) + "_" + std::to_string(int(t * 10));
+      const fs::path png = work_dir() / ("animals_layout_" + tag + ".png");
+      std::ostringstream args;
+      args << pack.string() << " " << size_args() << " --model " << source << " --morph " << t
+           << " --schedule linear --screenshot " << png.string();
+      const ViewRun r = view(args.str());
+      ASSERT_EQ(r.code, 0) << r.err;
+      frames.push_back(load(png));
+      const auto image = image_coverage(frames.back());
+      const auto geometry = morph::evaluate_morph(models[source], models[source + 1], t, morph::MorphSchedule::kLinear);
+      const auto reference = cpu_coverage(models[source], models[source].level, camera, kW, kH, &geometry);
+      EXPECT_GT(count(reference), std::size_t(kW * kH / 20)) << tag;
+      EXPECT_GT(iou(image, reference), 0.95) << "model " << source << " t " << t;
+      EXPECT_EQ(interior_misses(image, reference, kW, kH), 0u) << "no cracks: model " << source << " t " << t;
+    }
+    for (int end = 0; end < 2; ++end) {
+      const fs::path png = work_dir() / ("animals_layout_alone_" + std::to_string(source + end) + ".png");
+      const ViewRun r = view(pack.string() + " " + size_args() + " --model " + std::to_string(source + end) +
+                             " --screenshot " + png.string());
+      ASSERT_EQ(r.code, 0) << r.err;
+      EXPECT_LT(differing(frames[static_cast<std::size_t>(2 * end)], load(png), 2), 0.001)
+          << "model " << source << ": the morph ends at the model alone (t = " << end << ")";
+    }
+    EXPECT_GT(differing(frames[0], frames[1], 2), 0.02) << "model " << source;
+    EXPECT_GT(differing(frames[1], frames[2], 2), 0.02) << "model " << source;
+    EXPECT_GT(differing(frames[0], frames[2], 2), 0.02) << "model " << source;
+  }
+}
 #endif
 
 // The committed golden pack (format version 1, two pillows, level 5): the viewer reads the codec's own

@@ -1028,6 +1028,41 @@ TEST_F(CliPack, ConvertFrontNamesTheViewersFront) {
   }
 }
 
+// `geomip info PACK` prints the viewer's frame stored in each model's normalization: the model axes shown as
+// up (+y), front (+x, what --front names) and camera side (+z), or "none" when no frame is stored.
+TEST_F(CliPack, InfoPrintsTheStoredViewFrame) {
+  struct Case {
+    const char* args;
+    const char* up;
+    const char* front;
+    const char* camera_side;
+  };
+  // Spot stands on −y, its head at −z (mesh/view_frame.h; docs/streaming.md "Upright and front").
+  const Case cases[] = {{"", "+y", "-z", "+x"},
+                        {"--up y --front -x", "+y", "-x", "-z"},
+                        {"--up x --front +y", "+x", "+y", "-z"},
+                        {"--up none", "none", "none", "none"}};
+  for (const Case& c : cases) {
+    const std::string pack = dir_ + "/framed.gip";
+    ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 3 " + c.args + " -o '" + pack + "'").exit_code, 0)
+        << c.args;
+    const Outcome json = geomip("info --json '" + pack + "'");
+    ASSERT_EQ(json.exit_code, 0) << json.err;
+    const auto model = nlohmann::json::parse(json.out)["models"][0];
+    EXPECT_EQ(model["up"], c.up) << c.args;
+    EXPECT_EQ(model["front"], c.front) << c.args;
+    EXPECT_EQ(model["camera_side"], c.camera_side) << c.args;
+    const Outcome text = geomip("info '" + pack + "'");
+    ASSERT_EQ(text.exit_code, 0) << text.err;
+    const std::string frame = std::string(c.up) == "none" ? "; frame none\n"
+                                                          : std::string("; up ") + c.up + ", front " + c.front +
+                                                                ", camera side " + c.camera_side + "\n";
+    EXPECT_NE(text.out.find("model 0 'spot': "), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find(frame), std::string::npos) << c.args << ":\n" << text.out;
+    fs::remove(pack);
+  }
+}
+
 TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {
   const std::string pack = dir_ + "/spot.gip";
   ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 --no-normals -o '" + pack + "'").exit_code, 0);

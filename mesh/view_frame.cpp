@@ -110,8 +110,8 @@ bool area_centroid(const TriMesh& mesh, Eigen::Vector3d& centroid) {
 }
 
 /// Per axis in `axes`: the mean distance (capped at 2 % of the box's diagonal, relative to the diagonal) from
-/// every k-th point (k = ⌈#points / 4000⌉), reflected across the plane through `centre` normal to that axis, to
-/// the nearest point. Small across the left-right axis of a mirror-symmetric body.
+/// every k-th point (k = ⌈#points / 4000⌉), reflected across the plane through `centre` normal to that axis,
+/// to the nearest point. Small across the left-right axis of a mirror-symmetric body.
 std::array<double, 2> mirror_mismatch(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& lo,
                                       const Eigen::Vector3d& hi, const Eigen::Vector3d& centre,
                                       std::array<int, 2> axes) {
@@ -129,7 +129,8 @@ std::array<double, 2> mirror_mismatch(const std::vector<Eigen::Vector3d>& points
     return true;
   };
   const auto index = [&](const Eigen::Vector3i& c) {
-    return (static_cast<std::size_t>(c.z()) * static_cast<std::size_t>(dims.y()) + static_cast<std::size_t>(c.y())) *
+    return (static_cast<std::size_t>(c.z()) * static_cast<std::size_t>(dims.y()) +
+            static_cast<std::size_t>(c.y())) *
                static_cast<std::size_t>(dims.x()) +
            static_cast<std::size_t>(c.x());
   };
@@ -180,8 +181,8 @@ std::array<double, 2> mirror_mismatch(const std::vector<Eigen::Vector3d>& points
 /// The face cue of an upright shape along axis `axis`: per end (−, +), among the points at least 40 % of the
 /// height above the lowest, the area of the 2D convex hull (side axis × up) of those within 2 % of the axis's
 /// extent from the extreme one. A nose, a muzzle or a snout is a small tip; the back of a head is a dome.
-std::array<double, 2> tip_areas(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up, int axis,
-                                int side, double extent, double u0, double height) {
+std::array<double, 2> tip_areas(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up,
+                                int axis, int side, double extent, double u0, double height) {
   std::array<double, 2> out{0, 0};
   for (int end = 0; end < 2; ++end) {
     const double s = end == 0 ? -1 : 1;
@@ -287,7 +288,8 @@ Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up_axis, const Eige
   const double height = u1 - u0;
   double foot_lo = HUGE_VAL, foot_hi = -HUGE_VAL;
   for (const auto& p : points)
-    if (up.dot(p) <= u0 + 0.05 * height) foot_lo = std::min(foot_lo, p[axis]), foot_hi = std::max(foot_hi, p[axis]);
+    if (up.dot(p) <= u0 + 0.05 * height)
+      foot_lo = std::min(foot_lo, p[axis]), foot_hi = std::max(foot_hi, p[axis]);
   const bool upright = extent > 0 && height > 0 && foot_hi - foot_lo < 0.45 * extent;
   int sign = front_votes(mesh, points, up, up_index, axis, lo, hi) < 0 ? -1 : 1;
   if (upright) {

@@ -41,9 +41,9 @@ Eigen::Vector3d ground_direction(const TriMesh& mesh, double band = 0.05);
 ///     of the box along that axis (a neck, or two feet under the body); four legs or a lying body span more.
 ///  3. Its end: on an upright shape, the face — per end, among the vertices at least 40 % of the height above
 ///     the lowest, the 2D convex hull (across the axis: side × up) of those within 2 % of the axis's extent
-///     from the extreme one; the end with the smaller hull (a nose, a muzzle, a snout; the back of a head is a
-///     dome) when the other is at least 1.5 × as large. Otherwise (lying, or no clear tip) the end that wins
-///     two of three cues, each a vote for the end where it is larger (ties: no vote; all three even: the
+///     from the extreme one; the end with the smaller hull (a nose, a muzzle, a snout; the back of a head is
+///     a dome) when the other is at least 1.5 × as large. Otherwise (lying, or no clear tip) the end that
+///     wins two of three cues, each a vote for the end where it is larger (ties: no vote; all three even: the
 ///     positive end):
 ///       reach — the largest up coordinate in the quarter of the axis at that end (a head above the tail);
 ///       width — the side extent (the third axis) of the tenth of the axis at that end (ears, horns, a

@@ -4,8 +4,8 @@
 // animals of ../shared/meshes the guessed up axis is the one their data has (seen in the meshes: the horse
 // stands on −z, the pig lies on its back with its legs towards +y, cow and bunny stand on −y) and the front
 // is the head's end (the pig's head rests lower than its rump: a lying animal with ears covers that case).
-// Upright shapes (a bust with a nose, a biped whose arm span is its longest extent; the shared heads, busts and
-// the armadillo) turn their face to +z, the default camera's side.
+// Upright shapes (a bust with a nose, a biped whose arm span is its longest extent; the shared heads, busts
+// and the armadillo) turn their face to +z, the default camera's side.
 #include "mesh/view_frame.h"
 #include "mesh/mesh_io.h"
 #include "tests/param/test_meshes.h"
@@ -170,7 +170,8 @@ TEST(ViewFrame, ABustWithANoseInAnyAxisOrientationTurnsItsFaceToTheCamera) {
     TriMesh m = base;
     for (auto& p : m.positions) p = q * p;  // up = q·y, face = q·z
     const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
-    EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n" << r * q;
+    EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n"
+                                                               << r * q;
   }
 }
 
@@ -179,20 +180,21 @@ TEST(ViewFrame, ABustWithANoseInAnyAxisOrientationTurnsItsFaceToTheCamera) {
 /// its back (the deepest point at −z; a flat back would rest it on its back). Mirror-symmetric across x only.
 TEST(ViewFrame, ABipedInAnyAxisOrientationTurnsItsFaceNotItsArmSpanToTheCamera) {
   TriMesh base;
-  add_box(base, {-0.35, 0, -0.1}, {-0.15, 0.8, 0.1});     // legs
+  add_box(base, {-0.35, 0, -0.1}, {-0.15, 0.8, 0.1});  // legs
   add_box(base, {0.15, 0, -0.1}, {0.35, 0.8, 0.1});
   add_box(base, {-0.4, 0.8, -0.15}, {0.4, 1.6, 0.15});    // torso
   add_box(base, {-0.2, 1.1, -0.2}, {0.2, 1.3, -0.15});    // back
   add_box(base, {-1.2, 1.35, -0.08}, {-0.4, 1.5, 0.08});  // arms
   add_box(base, {0.4, 1.35, -0.08}, {1.2, 1.5, 0.08});
-  add_box(base, {-0.2, 1.6, -0.15}, {0.2, 2.0, 0.15});    // head
-  add_box(base, {-0.06, 1.7, 0.15}, {0.06, 1.8, 0.35});   // snout
+  add_box(base, {-0.2, 1.6, -0.15}, {0.2, 2.0, 0.15});   // head
+  add_box(base, {-0.06, 1.7, 0.15}, {0.06, 1.8, 0.35});  // snout
   for (const Eigen::Matrix3d& q : axis_rotations()) {
     TriMesh m = base;
     for (auto& p : m.positions) p = q * p;
     EXPECT_TRUE(ground_direction(m).isApprox(-(q * Eigen::Vector3d::UnitY()))) << q;
     const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
-    EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n" << r * q;
+    EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n"
+                                                               << r * q;
   }
 }
 
@@ -282,9 +284,9 @@ TEST(ViewFrame, TheAnimalsOfTheSharedMeshesGetTheirDataUpAxisAndFaceWithTheirHea
 
 /// The heads, busts and the standing biped of ../shared/meshes, up = the top of the head and the face's
 /// direction read off the data (side views of the vertices, docs/streaming.md "Upright and front"): each has
-/// its neck (the armadillo its feet) at the −up face of its box (the camel head's neck cut is at −y, its muzzle
-/// towards +z; Max Planck faces −z; the armadillo's arm span along x is its longest extent). The face becomes
-/// +z, the default camera's side.
+/// its neck (the armadillo its feet) at the −up face of its box (the camel head's neck cut is at −y, its
+/// muzzle towards +z; Max Planck faces −z; the armadillo's arm span along x is its longest extent). The face
+/// becomes +z, the default camera's side.
 TEST(ViewFrame, TheHeadsBustsAndTheBipedOfTheSharedMeshesStandOnTheirNecksAndFeetFacingTheCamera) {
   struct Upright {
     const char* file;
@@ -301,7 +303,8 @@ TEST(ViewFrame, TheHeadsBustsAndTheBipedOfTheSharedMeshesStandOnTheirNecksAndFee
     EXPECT_TRUE((-ground_direction(m)).isApprox(u.up)) << u.file << ": " << -ground_direction(m).transpose();
     const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
     EXPECT_TRUE((r * u.up).isApprox(Eigen::Vector3d::UnitY())) << u.file;
-    EXPECT_TRUE((r * u.face).isApprox(Eigen::Vector3d::UnitZ())) << u.file << ": towards the camera " << r.row(2);
+    EXPECT_TRUE((r * u.face).isApprox(Eigen::Vector3d::UnitZ()))
+        << u.file << ": towards the camera " << r.row(2);
     EXPECT_NEAR(r.determinant(), 1.0, 1e-12) << u.file;
   }
 }

@@ -1063,6 +1063,20 @@ TEST_F(CliPack, InfoPrintsTheStoredViewFrame) {
   }
 }
 
+// `convert --up auto` on a bust: Max Planck (up +y, its face towards −z in the data) is upright, so its face
+// becomes the viewer's +z, the default camera's side (mesh/view_frame.h); `geomip info` shows that frame.
+TEST_F(CliPack, ConvertAutoTurnsABustsFaceToTheCameraSide) {
+  GEOMIP_REQUIRE_SHARED_MESH(bust, "max-planck.obj");
+  const std::string pack = dir_ + "/max-planck.gip";
+  ASSERT_EQ(geomip("convert -q '" + bust + "' --level 3 -o '" + pack + "'").exit_code, 0);
+  const Outcome r = geomip("info --json '" + pack + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto model = nlohmann::json::parse(r.out)["models"][0];
+  EXPECT_EQ(model["up"], "+y");
+  EXPECT_EQ(model["camera_side"], "-z") << "the face";
+  EXPECT_EQ(model["front"], "-x") << "up × face";
+}
+
 TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {
   const std::string pack = dir_ + "/spot.gip";
   ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 --no-normals -o '" + pack + "'").exit_code, 0);

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -87,6 +88,116 @@ int front_votes(const TriMesh& mesh, const std::vector<Eigen::Vector3d>& points,
   return votes != 0 ? votes : reach;
 }
 
+/// The centroid of the triangles' area; false when the mesh has no area.
+bool area_centroid(const TriMesh& mesh, Eigen::Vector3d& centroid) {
+  double area = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& t : mesh.triangles) {
+    bool valid = true;
+    for (int v : t) valid = valid && v >= 0 && static_cast<std::size_t>(v) < mesh.positions.size();
+    if (!valid) continue;
+    const Eigen::Vector3d& a = mesh.positions[static_cast<std::size_t>(t[0])];
+    const Eigen::Vector3d& b = mesh.positions[static_cast<std::size_t>(t[1])];
+    const Eigen::Vector3d& c = mesh.positions[static_cast<std::size_t>(t[2])];
+    const double s = (b - a).cross(c - a).norm() / 2;
+    if (!std::isfinite(s)) continue;
+    area += s;
+    sum += s * (a + b + c) / 3;
+  }
+  if (!(area > 0)) return false;
+  centroid = sum / area;
+  return true;
+}
+
+/// Per axis in `axes`: the mean distance (capped at 2 % of the box's diagonal, relative to the diagonal) from
+/// every k-th point (k = ⌈#points / 4000⌉), reflected across the plane through `centre` normal to that axis,
+/// to the nearest point. Small across the left-right axis of a mirror-symmetric body.
+std::array<double, 2> mirror_mismatch(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& lo,
+                                      const Eigen::Vector3d& hi, const Eigen::Vector3d& centre,
+                                      std::array<int, 2> axes) {
+  const double diag = (hi - lo).norm(), cap = 0.02 * diag;
+  if (!(cap > 0) || !std::isfinite(cap)) return {0, 0};
+  // A uniform grid of cells of side `cap` (at most 51 per axis: the diagonal bounds every extent).
+  Eigen::Vector3i dims;
+  for (int i = 0; i < 3; ++i) dims[i] = static_cast<int>(std::floor((hi[i] - lo[i]) / cap)) + 1;
+  const auto cell_of = [&](const Eigen::Vector3d& q, Eigen::Vector3i& c) {
+    for (int i = 0; i < 3; ++i) {
+      const double f = std::floor((q[i] - lo[i]) / cap);
+      if (!(f >= -1 && f <= dims[i])) return false;  // no neighbouring cell holds a point
+      c[i] = static_cast<int>(f);
+    }
+    return true;
+  };
+  const auto index = [&](const Eigen::Vector3i& c) {
+    return (static_cast<std::size_t>(c.z()) * static_cast<std::size_t>(dims.y()) +
+            static_cast<std::size_t>(c.y())) *
+               static_cast<std::size_t>(dims.x()) +
+           static_cast<std::size_t>(c.x());
+  };
+  const std::size_t cells = static_cast<std::size_t>(dims.x()) * static_cast<std::size_t>(dims.y()) *
+                            static_cast<std::size_t>(dims.z());
+  std::vector<std::size_t> start(cells + 1, 0), order(points.size());
+  std::vector<std::size_t> of(points.size());
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    Eigen::Vector3i c = Eigen::Vector3i::Zero();
+    cell_of(points[p], c);
+    for (int i = 0; i < 3; ++i) c[i] = std::clamp(c[i], 0, dims[i] - 1);
+    of[p] = index(c);
+    ++start[of[p] + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t p = 0; p < points.size(); ++p) order[fill[of[p]]++] = p;
+  }
+  const std::size_t step = std::max<std::size_t>(1, (points.size() + 3999) / 4000);
+  std::array<double, 2> out{0, 0};
+  for (int k = 0; k < 2; ++k) {
+    const int a = axes[static_cast<std::size_t>(k)];
+    double total = 0;
+    std::size_t n = 0;
+    for (std::size_t p = 0; p < points.size(); p += step, ++n) {
+      Eigen::Vector3d q = points[p];
+      q[a] = 2 * centre[a] - q[a];
+      double best = cap * cap;
+      Eigen::Vector3i c = Eigen::Vector3i::Zero();
+      if (cell_of(q, c))
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const Eigen::Vector3i d = c + Eigen::Vector3i(dx, dy, dz);
+              if ((d.array() < 0).any() || (d.array() >= dims.array()).any()) continue;
+              const std::size_t i = index(d);
+              for (std::size_t j = start[i]; j < start[i + 1]; ++j)
+                best = std::min(best, (points[order[j]] - q).squaredNorm());
+            }
+      total += std::sqrt(best);
+    }
+    out[static_cast<std::size_t>(k)] = n > 0 ? total / static_cast<double>(n) / diag : 0;
+  }
+  return out;
+}
+
+/// The face cue of an upright shape along axis `axis`: per end (−, +), among the points at least 40 % of the
+/// height above the lowest, the area of the 2D convex hull (side axis × up) of those within 2 % of the axis's
+/// extent from the extreme one. A nose, a muzzle or a snout is a small tip; the back of a head is a dome.
+std::array<double, 2> tip_areas(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& up,
+                                int axis, int side, double extent, double u0, double height) {
+  std::array<double, 2> out{0, 0};
+  for (int end = 0; end < 2; ++end) {
+    const double s = end == 0 ? -1 : 1;
+    double extreme = -HUGE_VAL;
+    for (const auto& p : points)
+      if (up.dot(p) >= u0 + 0.4 * height) extreme = std::max(extreme, s * p[axis]);
+    std::vector<Eigen::Vector2d> cap;
+    for (const auto& p : points)
+      if (up.dot(p) >= u0 + 0.4 * height && s * p[axis] >= extreme - 0.02 * extent)
+        cap.emplace_back(p[side], up.dot(p));
+    out[static_cast<std::size_t>(end)] = hull_area(std::move(cap));
+  }
+  return out;
+}
+
 }  // namespace
 
 Eigen::Vector3d ground_direction(const TriMesh& mesh, double band) {
@@ -146,20 +257,51 @@ Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up_axis, const Eige
   int length = -1;
   for (int c = 0; c < 3; ++c)
     if (c != up_index && (length < 0 || hi[c] - lo[c] > hi[length] - lo[length])) length = c;
-  // A given front: a signed unit axis across up.
+  // A given front: a signed unit axis across up, shown as +x.
   int front_index = 0;
   front_axis.cwiseAbs().maxCoeff(&front_index);
   const bool given =
       front_index != up_index && std::abs(front_axis[front_index]) == 1 && front_axis.cwiseAbs().sum() == 1;
-  const Eigen::Vector3d front =
-      given ? front_axis
-            : Eigen::Vector3d(Eigen::Vector3d::Unit(length) *
-                              (front_votes(mesh, points, up, up_index, length, lo, hi) < 0 ? -1.0 : 1.0));
-  Eigen::Matrix3d r;
-  r.row(0) = front.transpose();
-  r.row(1) = up.transpose();
-  r.row(2) = front.cross(up).transpose();
-  return r;
+  const auto rows = [&](const Eigen::Vector3d& x) {
+    Eigen::Matrix3d r;
+    r.row(0) = x.transpose();
+    r.row(1) = up.transpose();
+    r.row(2) = x.cross(up).transpose();
+    return r;
+  };
+  if (given) return rows(front_axis);
+  // The front-back axis: the length, unless the body is clearly more mirror-symmetric across it than across
+  // the other horizontal axis (then the length is a left-right span: a biped's arms).
+  const int other = 3 - length - up_index;
+  int axis = length;
+  Eigen::Vector3d centre;
+  if (!points.empty() && area_centroid(mesh, centre)) {
+    const std::array<double, 2> mirror = mirror_mismatch(points, lo, hi, centre, {length, other});
+    if (mirror[0] < 0.8 * mirror[1]) axis = other;
+  }
+  const int side = 3 - axis - up_index;
+  const double extent = hi[axis] - lo[axis];
+  // Upright: the vertices within 5 % of the height from the ground span under 45 % of the axis (a neck, two
+  // feet under the body); four legs or a lying body span more.
+  double u0 = HUGE_VAL, u1 = -HUGE_VAL;
+  for (const auto& p : points) u0 = std::min(u0, up.dot(p)), u1 = std::max(u1, up.dot(p));
+  const double height = u1 - u0;
+  double foot_lo = HUGE_VAL, foot_hi = -HUGE_VAL;
+  for (const auto& p : points)
+    if (up.dot(p) <= u0 + 0.05 * height)
+      foot_lo = std::min(foot_lo, p[axis]), foot_hi = std::max(foot_hi, p[axis]);
+  const bool upright = extent > 0 && height > 0 && foot_hi - foot_lo < 0.45 * extent;
+  int sign = front_votes(mesh, points, up, up_index, axis, lo, hi) < 0 ? -1 : 1;
+  if (upright) {
+    // The face: the end with the smaller tip, when the other's is at least 1.5 × as large.
+    const std::array<double, 2> tip = tip_areas(points, up, axis, side, extent, u0, height);
+    const double small = std::min(tip[0], tip[1]), large = std::max(tip[0], tip[1]);
+    if (large > 0 && large >= 1.5 * small) sign = tip[0] < tip[1] ? -1 : 1;
+    // Turned to +z, the default camera's side: +x = up × front.
+    const Eigen::Vector3d front = Eigen::Vector3d::Unit(axis) * sign;
+    return rows(up.cross(front));
+  }
+  return rows(Eigen::Vector3d::Unit(axis) * sign);
 }
 
 std::array<double, 16> view_normalization(const TriMesh& mesh, const Eigen::Matrix3d& rotation) {

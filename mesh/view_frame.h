@@ -29,20 +29,33 @@ Eigen::Vector3d ground_direction(const TriMesh& mesh, double band = 0.05);
 
 /// The rotation (a signed permutation matrix, det +1) from model units to the viewer's axes: rows are the
 /// model directions that become +x, +y, +z. +y = up (the opposite of ground_direction() for kAuto, else the
-/// named axis). +x = the front: `front` when it is a signed unit axis perpendicular to up; otherwise (zero,
-/// the default, or along up) of the two remaining axes the one along which the box is longer (the length of
-/// an animal; ties: the first in x, y, z order), pointing to the end that wins two of three cues, each a
-/// vote for the end where it is larger (ties: no vote; all three even: the positive end):
-///   reach — the largest up coordinate in the quarter of the length at that end (a head held above the tail);
-///   width — the side extent (the third axis) of the tenth of the length at that end (ears, horns, a turned
-///           head; a tail is thin);
-///   mass  — the distance of that end from the centroid of the enclosed volume (the body is behind the head;
-///           signed tetrahedra from the box's centre, so an open mesh counts as closed by cones to it; no
-///           vote when |volume| ≤ 1e-9 of the box's: a flat mesh).
-/// A head resting on the ground (the pig of ../shared/meshes) loses the reach but wins the other two. +z =
-/// x × y. A camera at positive yaw (in the xz plane from +z towards +x) then sees the model from the side,
-/// its head turned towards the camera. The animals of ../shared/meshes, each cue and the result are in
-/// docs/streaming.md ("Upright and front"). Cost: O(#V + #F) after ground_direction().
+/// named axis). When `front` is a signed unit axis perpendicular to up, it becomes +x. Otherwise (zero, the
+/// default, or along up) the front comes from the shape:
+///  1. The front-back axis: of the two horizontal axes the one along which the box is longer (the length of
+///     an animal; ties: the first in x, y, z order) — unless the body is clearly mirror-symmetric across it:
+///     when the mean distance from its vertices (every ⌈#V / 4000⌉-th), reflected across the plane through
+///     the area centroid normal to the length, to the nearest vertex (capped at 2 % of the box's diagonal) is
+///     below 0.8 × that across the other axis, the length is a left-right span (a biped's arms) and the other
+///     axis is the front-back one.
+///  2. Upright or lying: upright when the vertices within 5 % of the height from the lowest span under 45 %
+///     of the box along that axis (a neck, or two feet under the body); four legs or a lying body span more.
+///  3. Its end: on an upright shape, the face — per end, among the vertices at least 40 % of the height above
+///     the lowest, the 2D convex hull (across the axis: side × up) of those within 2 % of the axis's extent
+///     from the extreme one; the end with the smaller hull (a nose, a muzzle, a snout; the back of a head is
+///     a dome) when the other is at least 1.5 × as large. Otherwise (lying, or no clear tip) the end that
+///     wins two of three cues, each a vote for the end where it is larger (ties: no vote; all three even: the
+///     positive end):
+///       reach — the largest up coordinate in the quarter of the axis at that end (a head above the tail);
+///       width — the side extent (the third axis) of the tenth of the axis at that end (ears, horns, a
+///               turned head; a tail is thin);
+///       mass  — the distance of that end from the centroid of the enclosed volume (the body is behind the
+///               head; signed tetrahedra from the box's centre, so an open mesh counts as closed by cones to
+///               it; no vote when |volume| ≤ 1e-9 of the box's: a flat mesh).
+///  4. A lying shape's front becomes +x and +z = x × y: a camera at positive yaw (in the xz plane from +z
+///     towards +x) sees it from the side, its head turned towards the camera. An upright shape's front (its
+///     face) becomes +z and +x = up × front: that camera sees the face, turned by its yaw.
+/// The meshes of ../shared/meshes, each cue and the result are in docs/streaming.md ("Upright and front").
+/// Cost: O(#V + #F) after ground_direction() (the mirror test looks at ≤ 4000 vertices against a grid).
 Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up,
                                  const Eigen::Vector3d& front = Eigen::Vector3d::Zero());
 

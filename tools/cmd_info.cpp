@@ -1,5 +1,5 @@
 // geomip info MESH|PACK... [--json]: topology and size of mesh files, counted on the triangles as read; for a
-// .gip pack, its models, levels and chunk table (what a viewer receives, in order).
+// .gip pack, its models (levels, the viewer's frame) and chunk table (what a viewer receives, in order).
 #include "codec/pack.h"
 #include "mesh/errors.h"
 #include "mesh/mesh_io.h"
@@ -9,7 +9,9 @@
 #include "tools/report.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -38,6 +40,32 @@ bool is_pack(const std::string& path) {
   return ext == ".gip";
 }
 
+// A model axis as "+x" … "-z" when `row` (a row of a normalization's linear part) has one non-zero entry,
+// else its unit direction as "(x, y, z)" (3 decimals).
+std::string axis_name(const double* row) {
+  const double norm = std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);
+  for (int c = 0; c < 3; ++c)
+    if (row[c] != 0 && row[(c + 1) % 3] == 0 && row[(c + 2) % 3] == 0)
+      return std::string(row[c] > 0 ? "+" : "-") + static_cast<char>('x' + c);
+  char text[64];
+  std::snprintf(text, sizeof text, "(%.3f, %.3f, %.3f)", norm > 0 ? row[0] / norm : 0.0,
+                norm > 0 ? row[1] / norm : 0.0, norm > 0 ? row[2] / norm : 0.0);
+  return text;
+}
+
+// The viewer's frame stored in a model's normalization (mesh/view_frame.h, `geomip convert --up, --front`):
+// the model axes shown as up (+y, row 1), front (+x, row 0: what --front names; a lying animal's head) and
+// camera side (+z, row 2: the side the default camera looks at, turned towards +x; an upright shape's face);
+// all "none" when the normalization is the identity or all zero (no frame stored: the viewer fits the decoded
+// box, y up).
+void add_view_frame(const std::array<double, 16>& n, nlohmann::json& model) {
+  const std::array<double, 16> identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  const bool none = n == identity || n == std::array<double, 16>{};
+  model["up"] = none ? "none" : axis_name(&n[4]);
+  model["front"] = none ? "none" : axis_name(&n[0]);
+  model["camera_side"] = none ? "none" : axis_name(&n[8]);
+}
+
 // The pack's header and manifest as JSON: per model its grids and streams, then every chunk in file order with
 // the byte count a reader has once that chunk is complete ("cumulative").
 nlohmann::json pack_info(const std::string& path) {
@@ -63,6 +91,7 @@ nlohmann::json pack_info(const std::string& path) {
     mj["normals"] = m.has_normals;
     if (m.has_normals) mj["normal_level"] = m.normals.level;
     mj["hole_mask"] = !m.hole_mask.empty();
+    add_view_frame(m.normalization, mj);
     models.push_back(std::move(mj));
   }
   nlohmann::json chunks = nlohmann::json::array();
@@ -91,10 +120,14 @@ void print_pack(const nlohmann::json& j) {
               static_cast<unsigned long long>(j["first_level_bytes"].get<std::uint64_t>()));
   for (std::size_t m = 0; m < j["models"].size(); ++m) {
     const auto& mj = j["models"][m];
-    std::printf("  model %zu '%s': %d patches of (2^%d+1)^2 samples, %d geometry passes%s%s\n", m,
+    const std::string up = mj["up"].get<std::string>();
+    const std::string frame = up == "none" ? "frame none"
+                                           : "up " + up + ", front " + mj["front"].get<std::string>() +
+                                                 ", camera side " + mj["camera_side"].get<std::string>();
+    std::printf("  model %zu '%s': %d patches of (2^%d+1)^2 samples, %d geometry passes%s%s; %s\n", m,
                 mj["name"].get<std::string>().c_str(), mj["patches"].get<int>(), mj["level"].get<int>(),
                 mj["geometry_passes"].get<int>(), mj["normals"].get<bool>() ? ", normal maps" : "",
-                mj["hole_mask"].get<bool>() ? ", hole mask" : "");
+                mj["hole_mask"].get<bool>() ? ", hole mask" : "", frame.c_str());
   }
   std::printf("  chunks (file order): model kind pass bytes -> cumulative\n");
   for (const auto& c : j["chunks"]) {
@@ -133,7 +166,8 @@ CommandRunner add_info_command(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* cmd = app.add_subcommand("info", "Report a mesh's topology: vertices, faces, components, boundary "
                                              "loops, genus, manifoldness, degeneracies, bounding box; or a .gip "
-                                             "pack's models, levels and chunk table");
+                                             "pack's models, levels, view frames (up and front axes) and chunk "
+                                             "table");
   cmd->add_option("mesh", args->meshes, "Mesh file(s): .obj .ply .off .stl .gltf .glb, or packs: .gip")->required();
   cmd->add_flag("--json", args->json, "Machine-readable output (one object, or an array for several meshes)");
   return [args] { return run_info(*args); };

@@ -80,37 +80,51 @@ def ground(P, lo, hi, band=0.05):
     return best
 
 
+def three_votes(V, F, P, lo, hi, gax, gs, L):
+    """The reach, width and mass votes (+1: the + end of axis L, −1, 0) of upright_rotation() for up = −gs·axis
+    gax, with the values behind them: reach per end (up coordinates; u0, uh the lowest up coordinate and the
+    height), width per end (/ the side extent), mass (the volume centroid's offset / the length)."""
+    S = 3 - L - gax
+    ln = hi[L] - lo[L]
+    U = [-gs * p[gax] for p in P]
+    u0, uh = min(U), max(U) - min(U)
+    reach = [max(U[k] for k, p in enumerate(P) if p[L] <= lo[L] + 0.25 * ln),
+             max(U[k] for k, p in enumerate(P) if p[L] >= hi[L] - 0.25 * ln)]
+    a = [p[S] for p in P if p[L] <= lo[L] + 0.1 * ln]
+    b = [p[S] for p in P if p[L] >= hi[L] - 0.1 * ln]
+    width = [(max(a) - min(a)) / (hi[S] - lo[S]), (max(b) - min(b)) / (hi[S] - lo[S])]
+    c = [(lo[i] + hi[i]) / 2 for i in range(3)]
+    vol = mom = 0
+    for t in F:
+        x, y, z = ([V[k][i] - c[i] for i in range(3)] for k in t)
+        v6 = x[0] * (y[1] * z[2] - y[2] * z[1]) - x[1] * (y[0] * z[2] - y[2] * z[0]) + x[2] * (y[0] * z[1] - y[1] * z[0])
+        vol += v6
+        mom += v6 * (x[L] + y[L] + z[L]) / 4
+    box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2])
+    mass = mom / vol / ln if abs(vol) / 6 > 1e-9 * box else 0.0
+    sign = lambda v: (v > 0) - (v < 0)
+    return [sign(reach[1] - reach[0]), sign(width[1] - width[0]), -sign(mass)], reach, width, mass, u0, uh
+
+
+def read_upright(path):
+    """The mesh (V, F), its referenced vertices P, their box lo–hi, the ground (axis gax, end gs) and the longer
+    horizontal axis L."""
+    V, F = load(path)
+    P = [V[v] for v in sorted({v for t in F for v in t})]
+    lo = [min(p[i] for p in P) for i in range(3)]
+    hi = [max(p[i] for p in P) for i in range(3)]
+    gax, gs = ground(P, lo, hi)
+    L = max((c for c in range(3) if c != gax), key=lambda c: (hi[c] - lo[c], -c))
+    return V, F, P, lo, hi, gax, gs, L
+
+
 def main():
     mesh_dir = sys.argv[1]
     print('| mesh | up | reach | width | mass | front |')
     print('|---|---|---|---|---|---|')
     for name in sys.argv[2:]:
-        V, F = load(os.path.join(mesh_dir, name))
-        P = [V[v] for v in sorted({v for t in F for v in t})]
-        lo = [min(p[i] for p in P) for i in range(3)]
-        hi = [max(p[i] for p in P) for i in range(3)]
-        gax, gs = ground(P, lo, hi)
-        L = max((c for c in range(3) if c != gax), key=lambda c: (hi[c] - lo[c], -c))
-        S = 3 - L - gax
-        ln = hi[L] - lo[L]
-        U = [-gs * p[gax] for p in P]
-        u0, uh = min(U), max(U) - min(U)
-        reach = [max(U[k] for k, p in enumerate(P) if p[L] <= lo[L] + 0.25 * ln),
-                 max(U[k] for k, p in enumerate(P) if p[L] >= hi[L] - 0.25 * ln)]
-        a = [p[S] for p in P if p[L] <= lo[L] + 0.1 * ln]
-        b = [p[S] for p in P if p[L] >= hi[L] - 0.1 * ln]
-        width = [(max(a) - min(a)) / (hi[S] - lo[S]), (max(b) - min(b)) / (hi[S] - lo[S])]
-        c = [(lo[i] + hi[i]) / 2 for i in range(3)]
-        vol = mom = 0
-        for t in F:
-            x, y, z = ([V[k][i] - c[i] for i in range(3)] for k in t)
-            v6 = x[0] * (y[1] * z[2] - y[2] * z[1]) - x[1] * (y[0] * z[2] - y[2] * z[0]) + x[2] * (y[0] * z[1] - y[1] * z[0])
-            vol += v6
-            mom += v6 * (x[L] + y[L] + z[L]) / 4
-        box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2])
-        mass = mom / vol / ln if abs(vol) / 6 > 1e-9 * box else 0.0
-        sign = lambda v: (v > 0) - (v < 0)
-        votes = [sign(reach[1] - reach[0]), sign(width[1] - width[0]), -sign(mass)]
+        V, F, P, lo, hi, gax, gs, L = read_upright(os.path.join(mesh_dir, name))
+        votes, reach, width, mass, u0, uh = three_votes(V, F, P, lo, hi, gax, gs, L)
         total = sum(votes) or votes[0]
         end = lambda v: ('+' if v >= 0 else '−') + 'xyz'[L] if v else '—'
         print(f"| {name} | {'+' if gs < 0 else '−'}{'xyz'[gax]} | {end(votes[0])} ({(reach[0] - u0) / uh:.2f} / "

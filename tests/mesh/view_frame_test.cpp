@@ -4,6 +4,8 @@
 // animals of ../shared/meshes the guessed up axis is the one their data has (seen in the meshes: the horse
 // stands on −z, the pig lies on its back with its legs towards +y, cow and bunny stand on −y) and the front
 // is the head's end (the pig's head rests lower than its rump: a lying animal with ears covers that case).
+// Upright shapes (a bust with a nose, a biped whose arm span is its longest extent; the shared heads, busts
+// and the armadillo) turn their face to +z, the default camera's side.
 #include "mesh/view_frame.h"
 #include "mesh/mesh_io.h"
 #include "tests/param/test_meshes.h"
@@ -160,6 +162,42 @@ TEST(ViewFrame, ABustInAnyAxisOrientationRestsOnItsNeckNotOnItsCrown) {
   }
 }
 
+/// The bust above with a nose: a block on the face's side (+z) at the height of the head's equator.
+TEST(ViewFrame, ABustWithANoseInAnyAxisOrientationTurnsItsFaceToTheCamera) {
+  TriMesh base = bust();
+  add_box(base, {-0.1, 1.7, 0.95}, {0.1, 1.9, 1.25});
+  for (const Eigen::Matrix3d& q : axis_rotations()) {
+    TriMesh m = base;
+    for (auto& p : m.positions) p = q * p;  // up = q·y, face = q·z
+    const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
+    EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n"
+                                                               << r * q;
+  }
+}
+
+/// A biped in its own frame, y up, facing +z: two legs under a torso, arms held out sideways (its longest
+/// extent, 2.4 across x against a height of 2 and a depth of 0.55), a head with a snout at +z and a bump on
+/// its back (the deepest point at −z; a flat back would rest it on its back). Mirror-symmetric across x only.
+TEST(ViewFrame, ABipedInAnyAxisOrientationTurnsItsFaceNotItsArmSpanToTheCamera) {
+  TriMesh base;
+  add_box(base, {-0.35, 0, -0.1}, {-0.15, 0.8, 0.1});  // legs
+  add_box(base, {0.15, 0, -0.1}, {0.35, 0.8, 0.1});
+  add_box(base, {-0.4, 0.8, -0.15}, {0.4, 1.6, 0.15});    // torso
+  add_box(base, {-0.2, 1.1, -0.2}, {0.2, 1.3, -0.15});    // back
+  add_box(base, {-1.2, 1.35, -0.08}, {-0.4, 1.5, 0.08});  // arms
+  add_box(base, {0.4, 1.35, -0.08}, {1.2, 1.5, 0.08});
+  add_box(base, {-0.2, 1.6, -0.15}, {0.2, 2.0, 0.15});   // head
+  add_box(base, {-0.06, 1.7, 0.15}, {0.06, 1.8, 0.35});  // snout
+  for (const Eigen::Matrix3d& q : axis_rotations()) {
+    TriMesh m = base;
+    for (auto& p : m.positions) p = q * p;
+    EXPECT_TRUE(ground_direction(m).isApprox(-(q * Eigen::Vector3d::UnitY()))) << q;
+    const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
+    EXPECT_TRUE((r * q).isApprox(Eigen::Matrix3d::Identity())) << "turned back into its own frame:\n"
+                                                               << r * q;
+  }
+}
+
 TEST(ViewFrame, AGivenFrontAcrossUpIsTakenAsItIs) {
   const TriMesh m = animal();  // y up, head at +x
   for (const Eigen::Vector3d& front :
@@ -233,33 +271,41 @@ TEST(ViewFrame, TheAnimalsOfTheSharedMeshesGetTheirDataUpAxisAndFaceWithTheirHea
                             {"pig.obj", -Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ()},
                             {"cow.obj", Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitX()},
                             {"spot.obj", Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ()},
-                            {"bunny.obj", Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitX()},
-                            {"armadillo.obj", Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero()}};
+                            {"bunny.obj", Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitX()}};
   for (const Animal& a : animals) {
     GEOMIP_REQUIRE_SHARED_MESH(path, a.file);
     const TriMesh m = read_mesh(path);
     EXPECT_TRUE((-ground_direction(m)).isApprox(a.up)) << a.file << ": " << -ground_direction(m).transpose();
     const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
     EXPECT_TRUE((r * a.up).isApprox(Eigen::Vector3d::UnitY())) << a.file;
-    if (!a.head.isZero()) {
-      EXPECT_TRUE((r * a.head).isApprox(Eigen::Vector3d::UnitX())) << a.file << ": front " << r.row(0);
-    }
+    EXPECT_TRUE((r * a.head).isApprox(Eigen::Vector3d::UnitX())) << a.file << ": front " << r.row(0);
   }
 }
 
-/// The heads and busts of ../shared/meshes, up = the top of the head, read off the data (side views of the
-/// vertices, docs/streaming.md "Upright and front"): each has its neck at the −up face of its box (the camel
-/// head's neck cut is at −y, its muzzle towards +z).
-TEST(ViewFrame, TheHeadsAndBustsOfTheSharedMeshesStandOnTheirNecks) {
-  const std::pair<const char*, Eigen::Vector3d> busts[] = {{"camelhead.obj", Eigen::Vector3d::UnitY()},
-                                                           {"max-planck.obj", Eigen::Vector3d::UnitY()},
-                                                           {"venus.obj", Eigen::Vector3d::UnitZ()},
-                                                           {"igea.ply", Eigen::Vector3d::UnitY()}};
-  for (const auto& [file, up] : busts) {
-    GEOMIP_REQUIRE_SHARED_MESH(path, file);
+/// The heads, busts and the standing biped of ../shared/meshes, up = the top of the head and the face's
+/// direction read off the data (side views of the vertices, docs/streaming.md "Upright and front"): each has
+/// its neck (the armadillo its feet) at the −up face of its box (the camel head's neck cut is at −y, its
+/// muzzle towards +z; Max Planck faces −z; the armadillo's arm span along x is its longest extent). The face
+/// becomes +z, the default camera's side.
+TEST(ViewFrame, TheHeadsBustsAndTheBipedOfTheSharedMeshesStandOnTheirNecksAndFeetFacingTheCamera) {
+  struct Upright {
+    const char* file;
+    Eigen::Vector3d up, face;
+  };
+  const Upright shapes[] = {{"camelhead.obj", Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()},
+                            {"max-planck.obj", Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ()},
+                            {"venus.obj", Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()},
+                            {"igea.ply", Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()},
+                            {"armadillo.obj", Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()}};
+  for (const Upright& u : shapes) {
+    GEOMIP_REQUIRE_SHARED_MESH(path, u.file);
     const TriMesh m = read_mesh(path);
-    EXPECT_TRUE((-ground_direction(m)).isApprox(up)) << file << ": " << -ground_direction(m).transpose();
-    EXPECT_TRUE((upright_rotation(m, UpAxis::kAuto) * up).isApprox(Eigen::Vector3d::UnitY())) << file;
+    EXPECT_TRUE((-ground_direction(m)).isApprox(u.up)) << u.file << ": " << -ground_direction(m).transpose();
+    const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kAuto);
+    EXPECT_TRUE((r * u.up).isApprox(Eigen::Vector3d::UnitY())) << u.file;
+    EXPECT_TRUE((r * u.face).isApprox(Eigen::Vector3d::UnitZ()))
+        << u.file << ": towards the camera " << r.row(2);
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-12) << u.file;
   }
 }
 

@@ -1095,6 +1095,55 @@ TEST_F(CliPack, ConvertFrontNamesTheViewersFront) {
   }
 }
 
+// `geomip info PACK` prints the viewer's frame stored in each model's normalization: the model axes shown as
+// up (+y), front (+x, what --front names) and camera side (+z), or "none" when no frame is stored.
+TEST_F(CliPack, InfoPrintsTheStoredViewFrame) {
+  struct Case {
+    const char* args;
+    const char* up;
+    const char* front;
+    const char* camera_side;
+  };
+  // Spot stands on −y, its head at −z (mesh/view_frame.h; docs/streaming.md "Upright and front").
+  const Case cases[] = {{"", "+y", "-z", "+x"},
+                        {"--up y --front -x", "+y", "-x", "-z"},
+                        {"--up x --front +y", "+x", "+y", "-z"},
+                        {"--up none", "none", "none", "none"}};
+  for (const Case& c : cases) {
+    const std::string pack = dir_ + "/framed.gip";
+    ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 3 " + c.args + " -o '" + pack + "'").exit_code, 0)
+        << c.args;
+    const Outcome json = geomip("info --json '" + pack + "'");
+    ASSERT_EQ(json.exit_code, 0) << json.err;
+    const auto model = nlohmann::json::parse(json.out)["models"][0];
+    EXPECT_EQ(model["up"], c.up) << c.args;
+    EXPECT_EQ(model["front"], c.front) << c.args;
+    EXPECT_EQ(model["camera_side"], c.camera_side) << c.args;
+    const Outcome text = geomip("info '" + pack + "'");
+    ASSERT_EQ(text.exit_code, 0) << text.err;
+    const std::string frame = std::string(c.up) == "none" ? "; frame none\n"
+                                                          : std::string("; up ") + c.up + ", front " + c.front +
+                                                                ", camera side " + c.camera_side + "\n";
+    EXPECT_NE(text.out.find("model 0 'spot': "), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find(frame), std::string::npos) << c.args << ":\n" << text.out;
+    fs::remove(pack);
+  }
+}
+
+// `convert --up auto` on a bust: Max Planck (up +y, its face towards −z in the data) is upright, so its face
+// becomes the viewer's +z, the default camera's side (mesh/view_frame.h); `geomip info` shows that frame.
+TEST_F(CliPack, ConvertAutoTurnsABustsFaceToTheCameraSide) {
+  GEOMIP_REQUIRE_SHARED_MESH(bust, "max-planck.obj");
+  const std::string pack = dir_ + "/max-planck.gip";
+  ASSERT_EQ(geomip("convert -q '" + bust + "' --level 3 -o '" + pack + "'").exit_code, 0);
+  const Outcome r = geomip("info --json '" + pack + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto model = nlohmann::json::parse(r.out)["models"][0];
+  EXPECT_EQ(model["up"], "+y");
+  EXPECT_EQ(model["camera_side"], "-z") << "the face";
+  EXPECT_EQ(model["front"], "-x") << "up × face";
+}
+
 TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {
   const std::string pack = dir_ + "/spot.gip";
   ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 --no-normals -o '" + pack + "'").exit_code, 0);

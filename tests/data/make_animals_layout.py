@@ -4,7 +4,7 @@
 Plain python3, no dependencies; deterministic. Reuses make_animals_corr.py's frames and points (feet, nose, ears,
 eyes, tail root, withers) and its 8 features, plus the tail root as a 9th feature.
 
-The layout (62 corners, 60 quads, 120 edges: V - E + F = 2). The torso is a tube of four segments between five
+The layout (66 corners, 64 quads, 128 edges: V - E + F = 2). The torso is a tube of four segments between five
 stations S0..S4 along the body (S0: in front of the forelegs, S1: behind them, S2: halfway along the belly, S3:
 in front of the hind legs, S4: behind them), each station a ring of 6 corners TL, TR, R, BR, BL, L (top left,
 top right, right, bottom right, bottom left, left), closed at both ends by two quads each (upper: TL TR R L,
@@ -12,11 +12,13 @@ lower: L R BR BL). Protrusions are extruded from it, each replacing one quad Q b
 new corners:
   - each leg from the lower side quad (BL L) of its segment (forelegs: S0-S1, hind legs: S3-S4);
   - the tail from the rear end's upper quad;
-  - the head three times: the neck from the front end's upper quad, the head from the neck's cap, the face
-    from the head's cap. The face's cap is a strip along the top of the head between the ears and the eyes;
-    its sides are named face_back, face_right, face_front (the snout and jaw), face_left.
-So every leg and the tail have 5 patches of their own, the head 13; the foot lies in its leg's cap, the left
-ear in face_left, the right ear in face_right, both eyes in face_front, the tail root in the tail's cap.
+  - the head four times: the neck from the front end's upper quad, the head from the neck's cap, the face
+    from the head's cap, the snout from the face's front side. The face's cap is a strip along the top of the
+    head between the ears and the eyes, its sides face_back, face_right, face_front, face_left; the snout's
+    cap is round the nose, its sides snout_bottom (the jaw), snout_left, snout_top, snout_right.
+So every leg and the tail have 5 patches of their own, the head 17; the foot lies in its leg's cap, the left
+ear in face_left, the right ear in face_right, the left eye in snout_left, the right eye in snout_right, the
+tail root in the tail's cap.
 
 Why geometry and not a map through the 2-patch parameterization: corners placed on each animal by the same
 rules land on the same anatomical place (the ring around each leg just below where it leaves the body, around
@@ -36,6 +38,8 @@ one loop around it:
     ears' and eyes' least distance to the head's midplane from it: a strip on the forehead with the ears and
     eyes beside it, so that the head's surface is split four ways (the single cap over the ears and eyes held
     8 % of the horse and 24 % of spot), with each ear and the eyes in the same side on all four animals;
+  - the snout ring is the boundary of the geodesic disk round the nose of radius 45 % of the nose's distance
+    to the nearer eye (the face's front side alone held 15 % of spot);
   - the tail root ring is the boundary of the geodesic disk of radius 10 % of the body length around it, with
     whatever the disk cuts off (a tail hanging free from its root, less than a tenth of the vertices) added
     (without that, the cow's hanging tail lies in one side patch of the tail, L-inf stretch 40, and its level-4
@@ -67,11 +71,17 @@ NST = 4 + MID  # stations 0, 1 round the forelegs, H0, H1 round the hind legs (a
 # middle segment held 10-13 % of horse and cow in each of its flanks)
 H0, H1 = NST - 2, NST - 1
 # The head's rings, from the torso forward: (name, where the cut lies as a fraction of the way from the front
-# station to the rearmost of ears, eyes and top of the head; None: in front of the ears and eyes, FACE of the
-# way from the foremost of them to the nose).
+# station to the rearmost of ears, eyes and top of the head; None: the face strip).
 HEAD_CUTS = [('neck', 0.35), ('head', 0.7), ('face', None)]
 HEAD_RINGS = [h for h, _ in HEAD_CUTS]
+# The face strip: FACE of the ears' and eyes' least distance to their midplane either side of it, from GAP of the
+# ears-to-eyes distance behind the ears to FWD of the eyes-to-nose distance in front of the eyes (FWD 0.25 puts
+# the pig's right eye on a path, 0.5 its left eye in face_left while the horse's is in face_front).
 FACE, GAP, FWD = 0.5, 0.25, 0.1
+# The snout: a geodesic disk round the nose of SNOUT of its distance to the nearer eye, extruded from face_front
+# (0.4-0.5 put each eye in the snout's side on its side on all four animals, 0.6-0.7 puts spot's left eye on a
+# path).
+SNOUT = 0.45
 
 
 def corner_names():
@@ -81,6 +91,7 @@ def corner_names():
     for h in HEAD_RINGS:
         names += ['%s_%s' % (h, c) for c in ('tl', 'tr', 'br', 'bl')]
     names += ['tail_%s' % c for c in ('tl', 'tr', 'br', 'bl')]
+    names += ['snout_%s' % c for c in ('tl', 'tr', 'br', 'bl')]
     return names
 
 
@@ -109,13 +120,18 @@ def layout_quads():
         cur = ['%s_%s' % (h, c) for c in ('tl', 'tr', 'br', 'bl')]
         extrusions.append((h, dict(zip(prev, cur)), base))
         prev, base = cur, '%s_cap' % h
+    # the snout from face_front, seen from the front: the face's front corners up, the head ring's below
+    extrusions.append(('snout', {'face_bl': 'snout_tl', 'face_br': 'snout_tr', 'head_br': 'snout_br',
+                                 'head_bl': 'snout_bl'}, 'face_front'))
     for name, new, base in extrusions:
         q = dict(quads)[base]
         assert set(q) == set(new), name
         quads = [x for x in quads if x[0] != base]
         for i in range(4):
             a, b = q[i], q[(i + 1) % 4]
-            side = ('face_back', 'face_right', 'face_front', 'face_left')[i] if name == 'face' else '%s_side%d' % (name, i)
+            side = {'face': ('face_back', 'face_right', 'face_front', 'face_left'),
+                    'snout': ('snout_bottom', 'snout_left', 'snout_top', 'snout_right')}
+            side = side[name][i] if name in side else '%s_side%d' % (name, i)
             quads.append((side, [a, b, new[b], new[a]]))
         quads.append(('%s_cap' % name, [new[c] for c in q]))
     return quads
@@ -285,20 +301,16 @@ def place(name, V, F, fr, P):
                 d[0] += wt * (a - ends[k][1][0]) / n; d[1] += wt * (b - ends[k][1][1]) / n
             dirs.append(tuple(d))
         C.update({'%s%d' % (c, 1 + m): v for c, v in zip(RING, extremes(sl, tcoords, dirs, centre))})
-    # Head: cuts normal to the head's direction behind the ears, eyes and top of the head, the last in front of
-    # the ears and eyes.
+    # Head: cuts normal to the head's direction behind the ears, eyes and top of the head, then the face strip.
     hf = lambda v: dot(V[v], fr.hf)
     back = min(hf(P[k]) for k in ('ear_l', 'ear_r', 'eye_l', 'eye_r', 'head_top'))
-    fore = max(hf(P[k]) for k in ('ear_l', 'ear_r', 'eye_l', 'eye_r'))
     front = max(hf(C[k]) for k in ('TL0', 'TR0', 'L0', 'R0'))
     hcoords = lambda v: (fr.U[v], dot(V[v], fr.hl))
     for h, frac in HEAD_CUTS:
         if frac is None:
-            # The face: the top of the head in front of the head ring, above the eyes' level lowered by FACE of
-            # the way to the head's lowest point and in front of a cut FACE of the way from the head ring to the
-            # rearmost of ears, eyes and top of the head; it holds the ears and eyes. Its corners back / front,
-            # left / right: seen from above, with the back up, in the same cyclic order as a ring's seen from
-            # the front.
+            # The face: a strip along the top of the head (above the eyes' level, off the head's ring) between
+            # the ears and between the eyes (see FACE). Its corners back / front, left / right: seen from above,
+            # with the back up, in the same cyclic order as a ring's seen from the front.
             hl = lambda v: dot(V[v], fr.hl)
             feats = [P[k] for k in ('ear_l', 'ear_r', 'eye_l', 'eye_r')]
             m = sum(hl(v) for v in feats) / 4
@@ -322,6 +334,11 @@ def place(name, V, F, fr, P):
         ring = boundary(adj, comp)
         tl, bl, br, tr = extremes(ring, hcoords, ((1, 1), (-1, 1), (-1, -1), (1, -1)))
         C.update({h + '_tl': tl, h + '_bl': bl, h + '_br': br, h + '_tr': tr})
+    # Snout: the boundary of the geodesic disk round the nose.
+    eyes = geodesic(V, adj, P['nose'], 4 * L)
+    disk = disk_with_cutoffs(V, F, adj, P['nose'], SNOUT * min(eyes[P[k]] for k in ('eye_l', 'eye_r')))
+    tl, bl, br, tr = extremes(boundary(adj, disk), hcoords, ((1, 1), (-1, 1), (-1, -1), (1, -1)))
+    C.update({'snout_tl': tl, 'snout_bl': bl, 'snout_br': br, 'snout_tr': tr})
     # Tail: the boundary of the geodesic disk around the tail root.
     disk = disk_with_cutoffs(V, F, adj, P['tail'], 0.1 * L)
     ring = boundary(adj, disk)

@@ -4,15 +4,21 @@
 Plain python3, no dependencies; deterministic. Reuses make_animals_corr.py's frames and points (feet, nose, ears,
 eyes, tail root, withers) and its 8 features, plus the tail root as a 9th feature.
 
-The layout (48 corners, 46 quads, 92 edges: V - E + F = 2). The torso is a tube of three segments between four
-stations S0..S3 along the body (S0: in front of the forelegs, S1: behind them, S2: in front of the hind legs,
-S3: behind them), each station a ring of 6 corners TL, TR, R, BR, BL, L (top left, top right, right, bottom
-right, bottom left, left), closed at both ends by two quads each (upper: TL TR R L, lower: L R BR BL). Six
-protrusions are extruded from it, each replacing one quad Q by 4 side quads and a cap over 4 new corners:
-  - each leg from the lower side quad (BL L) of its segment (forelegs: S0-S1, hind legs: S2-S3);
-  - the head from the front end's upper quad, the tail from the rear end's upper quad.
-So every leg, the head and the tail have 5 patches of their own; the foot lies in its leg's cap, ears and eyes
-in the head's cap, the tail root in the tail's cap.
+The layout (66 corners, 64 quads, 128 edges: V - E + F = 2). The torso is a tube of four segments between five
+stations S0..S4 along the body (S0: in front of the forelegs, S1: behind them, S2: halfway along the belly, S3:
+in front of the hind legs, S4: behind them), each station a ring of 6 corners TL, TR, R, BR, BL, L (top left,
+top right, right, bottom right, bottom left, left), closed at both ends by two quads each (upper: TL TR R L,
+lower: L R BR BL). Protrusions are extruded from it, each replacing one quad Q by 4 side quads and a cap over 4
+new corners:
+  - each leg from the lower side quad (BL L) of its segment (forelegs: S0-S1, hind legs: S3-S4);
+  - the tail from the rear end's upper quad;
+  - the head four times: the neck from the front end's upper quad, the head from the neck's cap, the face
+    from the head's cap, the snout from the face's front side. The face's cap is a strip along the top of the
+    head between the ears and the eyes, its sides face_back, face_right, face_front, face_left; the snout's
+    cap is round the nose, its sides snout_bottom (the jaw), snout_left, snout_top, snout_right.
+So every leg and the tail have 5 patches of their own, the head 17; the foot lies in its leg's cap, the left
+ear in face_left, the right ear in face_right, the left eye in snout_left, the right eye in snout_right, the
+tail root in the tail's cap.
 
 Why geometry and not a map through the 2-patch parameterization: corners placed on each animal by the same
 rules land on the same anatomical place (the ring around each leg just below where it leaves the body, around
@@ -23,21 +29,31 @@ one loop around it:
     ring) of the foot's geodesic distance to the body's midline (the belly or chest between the legs): on a long
     leg they are horizontal loops below the armpit and above the hoof, on the pig's stubs loops on the belly
     round them;
-  - the head is cut by the plane normal to the head's direction 70 % of the way from the front station's
-    corners to the rearmost of ears, eyes and top of the head (at 50 % the level-4 remeshes lose 1.2 dB on
-    horse and spot, 2.2 dB on the pig: the head's cap holds more of the surface; at 90 % the cow's left ear
-    falls outside it);
+  - the neck and the head are cut by planes normal to the head's direction 35 % and 70 % of the way from the
+    front station's corners to the rearmost of ears, eyes and top of the head (with a single cut at 50 % in
+    the 46-quad layout the level-4 remeshes lost 1.2 dB on horse and spot, 2.2 dB on the pig; at 90 % the
+    cow's left ear fell outside it);
+  - the face is the part of the head (off its ring) above the eyes' level, from a quarter of the ears-to-eyes
+    distance behind the ears to a tenth of the eyes-to-nose distance in front of the eyes, within half the
+    ears' and eyes' least distance to the head's midplane from it: a strip on the forehead with the ears and
+    eyes beside it, so that the head's surface is split four ways (the single cap over the ears and eyes held
+    8 % of the horse and 24 % of spot), with each ear and the eyes in the same side on all four animals;
+  - the snout ring is the boundary of the geodesic disk round the nose of radius 45 % of the nose's distance
+    to the nearer eye (the face's front side alone held 15 % of spot);
   - the tail root ring is the boundary of the geodesic disk of radius 10 % of the body length around it, with
     whatever the disk cuts off (a tail hanging free from its root, less than a tenth of the vertices) added
     (without that, the cow's hanging tail lies in one side patch of the tail, L-inf stretch 40, and its level-4
     remesh loses 7 dB; a radius of 5 % puts the cow's tail root on a path, 12 % without the addition folds it);
   - a ring's 4 corners are the ring vertices seen from its centroid nearest the two diagonals of a plane
-    (legs: forward and outward; head and tail: up and left), so they are in the same cyclic order everywhere;
+    (legs: forward and outward; head and tail: up and left; the face, seen from above: back and left), so they
+    are in the same cyclic order everywhere;
+  - the middle station is the torso's cross-section halfway between S1 and S3, its corners the section's
+    vertices seen from its centre at the mean angle of the same corner at S1 and S3;
   - the stations' top corners TL, TR are the cross-section of the torso at the station's length (the mean of
     its leg-root corners), at its upper-left and upper-right extremes, no higher than the withers.
 The script checks that the layout is a closed oriented quad surface with V - E + F = 2, that corners are
 distinct and that no feature is a corner; whether the paths cut each mesh into the quads, with every feature in
-its protrusion's cap, is checked by `geomip param` and tests/tools/cli_test.cpp.
+its designated patch, is checked by `geomip param` and tests/tools/cli_test.cpp.
 Usage: make_animals_layout.py [MESH_DIR] > animals-layout.corr.json
 """
 import heapq, json, math, os, sys
@@ -50,42 +66,73 @@ from make_animals_corr import MODELS, FEATURES, Frame, find_points, load_obj, sp
 # make two corners coincide; 0.9 / 0.55 puts every foot inside its leg's cap on all four animals.
 ROOT, LOW = 0.9, 0.55
 RING = ['TL', 'TR', 'R', 'BR', 'BL', 'L']  # a station's corners, going round the body
+MID = 1  # stations between the forelegs' and the hind legs' (cross-sections evenly spaced along the belly)
+NST = 4 + MID  # stations 0, 1 round the forelegs, H0, H1 round the hind legs (a 5th station: the torso's
+# middle segment held 10-13 % of horse and cow in each of its flanks)
+H0, H1 = NST - 2, NST - 1
+# The head's rings, from the torso forward: (name, where the cut lies as a fraction of the way from the front
+# station to the rearmost of ears, eyes and top of the head; None: the face strip).
+HEAD_CUTS = [('neck', 0.35), ('head', 0.7), ('face', None)]
+HEAD_RINGS = [h for h, _ in HEAD_CUTS]
+# The face strip: FACE of the ears' and eyes' least distance to their midplane either side of it, from GAP of the
+# ears-to-eyes distance behind the ears to FWD of the eyes-to-nose distance in front of the eyes (FWD 0.25 puts
+# the pig's right eye on a path, 0.5 its left eye in face_left while the horse's is in face_front).
+FACE, GAP, FWD = 0.5, 0.25, 0.1
+# The snout: a geodesic disk round the nose of SNOUT of its distance to the nearer eye, extruded from face_front
+# (0.4-0.5 put each eye in the snout's side on its side on all four animals, 0.6-0.7 puts spot's left eye on a
+# path).
+SNOUT = 0.45
 
 
 def corner_names():
-    names = ['%s%d' % (c, k) for k in range(4) for c in RING]
+    names = ['%s%d' % (c, k) for k in range(NST) for c in RING]
     for leg in ('lf', 'rf', 'lb', 'rb'):
         names += ['%s_%s' % (leg, c) for c in ('fo', 'fi', 'bi', 'bo')]  # front/back, outer/inner
-    names += ['head_%s' % c for c in ('tl', 'tr', 'br', 'bl')]
+    for h in HEAD_RINGS:
+        names += ['%s_%s' % (h, c) for c in ('tl', 'tr', 'br', 'bl')]
     names += ['tail_%s' % c for c in ('tl', 'tr', 'br', 'bl')]
+    names += ['snout_%s' % c for c in ('tl', 'tr', 'br', 'bl')]
     return names
 
 
 def layout_quads():
     """(name, [corner names]) for every quad, unoriented: the orientation is fixed by orient()."""
     quads = []
-    for k in range(3):
+    for k in range(NST - 1):
         for i in range(6):
             a, b = RING[i], RING[(i + 1) % 6]
             quads.append(('torso%d_%s%s' % (k, a, b), ['%s%d' % (a, k), '%s%d' % (b, k), '%s%d' % (b, k + 1),
                                                        '%s%d' % (a, k + 1)]))
-    for k, end in ((0, 'front'), (3, 'rear')):
+    for k, end in ((0, 'front'), (NST - 1, 'rear')):
         quads.append(('%s_upper' % end, ['TL%d' % k, 'TR%d' % k, 'R%d' % k, 'L%d' % k]))
         quads.append(('%s_lower' % end, ['L%d' % k, 'R%d' % k, 'BR%d' % k, 'BL%d' % k]))
     # protrusion: the quad it replaces (base corner -> new corner)
     extrusions = [('leg_lf', {'L0': 'lf_fo', 'BL0': 'lf_fi', 'BL1': 'lf_bi', 'L1': 'lf_bo'}, 'torso0_BLL'),
                   ('leg_rf', {'R0': 'rf_fo', 'BR0': 'rf_fi', 'BR1': 'rf_bi', 'R1': 'rf_bo'}, 'torso0_RBR'),
-                  ('leg_lb', {'L2': 'lb_fo', 'BL2': 'lb_fi', 'BL3': 'lb_bi', 'L3': 'lb_bo'}, 'torso2_BLL'),
-                  ('leg_rb', {'R2': 'rb_fo', 'BR2': 'rb_fi', 'BR3': 'rb_bi', 'R3': 'rb_bo'}, 'torso2_RBR'),
-                  ('head', {'TL0': 'head_tl', 'TR0': 'head_tr', 'R0': 'head_br', 'L0': 'head_bl'}, 'front_upper'),
-                  ('tail', {'TL3': 'tail_tl', 'TR3': 'tail_tr', 'R3': 'tail_br', 'L3': 'tail_bl'}, 'rear_upper')]
+                  ('leg_lb', {'L%d' % H0: 'lb_fo', 'BL%d' % H0: 'lb_fi', 'BL%d' % H1: 'lb_bi', 'L%d' % H1: 'lb_bo'},
+                   'torso%d_BLL' % H0),
+                  ('leg_rb', {'R%d' % H0: 'rb_fo', 'BR%d' % H0: 'rb_fi', 'BR%d' % H1: 'rb_bi', 'R%d' % H1: 'rb_bo'},
+                   'torso%d_RBR' % H0),
+                  ('tail', {'TL%d' % H1: 'tail_tl', 'TR%d' % H1: 'tail_tr', 'R%d' % H1: 'tail_br',
+                            'L%d' % H1: 'tail_bl'}, 'rear_upper')]
+    prev, base = ['TL0', 'TR0', 'R0', 'L0'], 'front_upper'
+    for h in HEAD_RINGS:
+        cur = ['%s_%s' % (h, c) for c in ('tl', 'tr', 'br', 'bl')]
+        extrusions.append((h, dict(zip(prev, cur)), base))
+        prev, base = cur, '%s_cap' % h
+    # the snout from face_front, seen from the front: the face's front corners up, the head ring's below
+    extrusions.append(('snout', {'face_bl': 'snout_tl', 'face_br': 'snout_tr', 'head_br': 'snout_br',
+                                 'head_bl': 'snout_bl'}, 'face_front'))
     for name, new, base in extrusions:
         q = dict(quads)[base]
         assert set(q) == set(new), name
         quads = [x for x in quads if x[0] != base]
         for i in range(4):
             a, b = q[i], q[(i + 1) % 4]
-            quads.append(('%s_side%d' % (name, i), [a, b, new[b], new[a]]))
+            side = {'face': ('face_back', 'face_right', 'face_front', 'face_left'),
+                    'snout': ('snout_bottom', 'snout_left', 'snout_top', 'snout_right')}
+            side = side[name][i] if name in side else '%s_side%d' % (name, i)
+            quads.append((side, [a, b, new[b], new[a]]))
         quads.append(('%s_cap' % name, [new[c] for c in q]))
     return quads
 
@@ -144,8 +191,9 @@ def boundary(adj, comp):
 
 
 def geodesic(V, adj, s, limit):
-    dist = {s: 0.0}
-    pq = [(0.0, s)]
+    """Dijkstra's distances along edges from the vertex s (or the vertices of the list s), up to `limit`."""
+    dist = {v: 0.0 for v in (s if isinstance(s, list) else [s])}
+    pq = [(0.0, v) for v in dist]
     while pq:
         d, x = heapq.heappop(pq)
         if d > dist[x] or d > limit: continue
@@ -173,6 +221,22 @@ def extremes(ring, coords, dirs, centre=None):
     return out
 
 
+def disk_with_cutoffs(V, F, adj, centre, r):
+    """The geodesic disk of radius r round `centre`, with whatever it cuts off from the rest of the mesh (each
+    piece under a tenth of the vertices: a tail hanging free from its root, an ear flap) added."""
+    dist = geodesic(V, adj, centre, 2 * r)
+    disk = {v for v, d in dist.items() if d < r}
+    used = sorted({v for t in F for v in t})
+    rest = [v for v in used if v not in disk]
+    seen = set()
+    for v in rest:
+        if v in seen: continue
+        part = flood(adj, v, lambda w: w not in disk)
+        seen |= part
+        if len(part) < len(used) // 10: disk |= part
+    return disk
+
+
 def place(name, V, F, fr, P):
     adj = adjacency(V, F)
     L, H = fr.length, fr.height
@@ -193,13 +257,13 @@ def place(name, V, F, fr, P):
             if tag == 'low':
                 C.update({'%s_fo' % leg: fo, '%s_fi' % leg: fi, '%s_bi' % leg: bi, '%s_bo' % leg: bo})
             else:
-                s0, s1 = (0, 1) if leg[1] == 'f' else (2, 3)
+                s0, s1 = (0, 1) if leg[1] == 'f' else (H0, H1)
                 o, i = ('L', 'BL') if left else ('R', 'BR')
                 C.update({'%s%d' % (o, s0): fo, '%s%d' % (i, s0): fi, '%s%d' % (i, s1): bi, '%s%d' % (o, s1): bo})
         print('%s leg %s: midline %.3f L away' % (name, leg, reach / L), file=sys.stderr)
     # Stations' top corners: the torso's cross-section at the station, upper-left / upper-right extremes.
     top = fr.U[P['withers']]
-    for k in range(4):
+    for k in (0, 1, H0, H1):
         fs = (fr.F[C['L%d' % k]] + fr.F[C['R%d' % k]]) / 2
         low = max(fr.U[C['L%d' % k]], fr.U[C['R%d' % k]])
         w = 0.01 * L
@@ -210,30 +274,73 @@ def place(name, V, F, fr, P):
             w *= 1.5
         C['TL%d' % k] = max((v for v in sl if fr.Lc[v] > fr.lmid), key=lambda v: (fr.U[v] + fr.Lc[v] - fr.lmid, -v))
         C['TR%d' % k] = max((v for v in sl if fr.Lc[v] < fr.lmid), key=lambda v: (fr.U[v] - fr.Lc[v] + fr.lmid, -v))
-    # Head: cut normal to the head's direction behind the ears, eyes and top of the head.
+    # Middle stations: cross-sections evenly spaced between stations 1 and H0, each corner at the mean angle
+    # (seen from the section's centre) of the same corner at stations 1 and H0.
+    tcoords = lambda v: (fr.Lc[v] - fr.lmid, fr.U[v])
+    def section(fs):
+        w = 0.01 * L
+        while True:
+            sl = [v for v in range(len(V)) if abs(fr.F[v] - fs) < w]
+            if len(sl) >= 24: break
+            w *= 1.5
+        return sl, (sum(tcoords(v)[0] for v in sl) / len(sl), sum(tcoords(v)[1] for v in sl) / len(sl))
+    ends = {}
+    for k in (1, H0):
+        fs = sum(fr.F[C['%s%d' % (c, k)]] for c in RING) / 6
+        _, centre = section(fs)
+        ends[k] = (fs, centre)
+    for m in range(1, MID + 1):
+        t = m / (MID + 1)
+        fs = (1 - t) * ends[1][0] + t * ends[H0][0]
+        sl, centre = section(fs)
+        dirs = []
+        for c in RING:
+            d = [0.0, 0.0]
+            for k, wt in ((1, 1 - t), (H0, t)):
+                a, b = tcoords(C['%s%d' % (c, k)]); n = math.hypot(a - ends[k][1][0], b - ends[k][1][1])
+                d[0] += wt * (a - ends[k][1][0]) / n; d[1] += wt * (b - ends[k][1][1]) / n
+            dirs.append(tuple(d))
+        C.update({'%s%d' % (c, 1 + m): v for c, v in zip(RING, extremes(sl, tcoords, dirs, centre))})
+    # Head: cuts normal to the head's direction behind the ears, eyes and top of the head, then the face strip.
     hf = lambda v: dot(V[v], fr.hf)
     back = min(hf(P[k]) for k in ('ear_l', 'ear_r', 'eye_l', 'eye_r', 'head_top'))
     front = max(hf(C[k]) for k in ('TL0', 'TR0', 'L0', 'R0'))
-    cut = front + 0.7 * (back - front) if front < back else back
-    comp = flood(adj, P['nose'], lambda v: hf(v) >= cut)
-    assert not comp & set(feet.values()), (name, 'head cut reaches a foot')
-    ring = boundary(adj, comp)
     hcoords = lambda v: (fr.U[v], dot(V[v], fr.hl))
-    tl, bl, br, tr = extremes(ring, hcoords, ((1, 1), (-1, 1), (-1, -1), (1, -1)))
-    C.update({'head_tl': tl, 'head_bl': bl, 'head_br': br, 'head_tr': tr})
+    for h, frac in HEAD_CUTS:
+        if frac is None:
+            # The face: a strip along the top of the head (above the eyes' level, off the head's ring) between
+            # the ears and between the eyes (see FACE). Its corners back / front, left / right: seen from above,
+            # with the back up, in the same cyclic order as a ring's seen from the front.
+            hl = lambda v: dot(V[v], fr.hl)
+            feats = [P[k] for k in ('ear_l', 'ear_r', 'eye_l', 'eye_r')]
+            m = sum(hl(v) for v in feats) / 4
+            half = FACE * min(abs(hl(v) - m) for v in feats)
+            ue = min(fr.U[P[k]] for k in ('eye_l', 'eye_r'))
+            hb = min(hf(P[k]) for k in ('ear_l', 'ear_r')); hn = max(hf(P[k]) for k in ('eye_l', 'eye_r'))
+            hb, hn = hb - GAP * (hn - hb), hn + FWD * (hf(P['nose']) - hn)
+            body = flood(adj, C['TL0'], lambda v: v not in comp)  # (not a horn tip the head's cut cuts off)
+            keep = lambda v: (v in comp and abs(hl(v) - m) < half and hb <= hf(v) <= hn and fr.U[v] >= ue and
+                              not any(w in body for w in adj[v]))
+            start = max((v for v in comp if keep(v)), key=lambda v: (fr.U[v], -v))
+            disk = flood(adj, start, keep)
+            assert not set(feats) & disk, (name, 'the ears and eyes beside the face')
+            ring = boundary(adj, disk)
+            tl, bl, br, tr = extremes(ring, lambda v: (-hf(v), dot(V[v], fr.hl)), ((1, 1), (-1, 1), (-1, -1), (1, -1)))
+            C.update({h + '_tl': tl, h + '_bl': bl, h + '_br': br, h + '_tr': tr})
+            continue
+        cut = front + frac * (back - front) if front < back else back
+        comp = flood(adj, P['nose'], lambda v: hf(v) >= cut)
+        assert not comp & set(feet.values()), (name, 'head cut reaches a foot')
+        ring = boundary(adj, comp)
+        tl, bl, br, tr = extremes(ring, hcoords, ((1, 1), (-1, 1), (-1, -1), (1, -1)))
+        C.update({h + '_tl': tl, h + '_bl': bl, h + '_br': br, h + '_tr': tr})
+    # Snout: the boundary of the geodesic disk round the nose.
+    eyes = geodesic(V, adj, P['nose'], 4 * L)
+    disk = disk_with_cutoffs(V, F, adj, P['nose'], SNOUT * min(eyes[P[k]] for k in ('eye_l', 'eye_r')))
+    tl, bl, br, tr = extremes(boundary(adj, disk), hcoords, ((1, 1), (-1, 1), (-1, -1), (1, -1)))
+    C.update({'snout_tl': tl, 'snout_bl': bl, 'snout_br': br, 'snout_tr': tr})
     # Tail: the boundary of the geodesic disk around the tail root.
-    r = 0.1 * L
-    dist = geodesic(V, adj, P['tail'], 2 * r)
-    disk = {v for v, d in dist.items() if d < r}
-    # A tail that hangs free from its root (the cow's) is cut off by the disk: what is left of it joins the disk.
-    used = sorted({v for t in F for v in t})
-    rest = [v for v in used if v not in disk]
-    seen = set()
-    for v in rest:
-        if v in seen: continue
-        part = flood(adj, v, lambda w: w not in disk)
-        seen |= part
-        if len(part) < len(used) // 10: disk |= part
+    disk = disk_with_cutoffs(V, F, adj, P['tail'], 0.1 * L)
     ring = boundary(adj, disk)
     tcoords = lambda v: (fr.U[v], fr.Lc[v])
     tl, bl, br, tr = extremes(ring, tcoords, ((1, 1), (-1, 1), (-1, -1), (1, -1)))

@@ -646,22 +646,26 @@ TEST_F(Cli, AnimalsGetIdenticalFeatureCoordinates) {
 }
 
 // Issue 15: the four animals with a user layout (tests/data/animals-layout.corr.json, made by
-// make_animals_layout.py: a torso tube with each leg, the head and the tail extruded as 5 patches of their own,
-// 46 quads). Every model gets the 46 patches, no flip, and the 9 features (feet, ears, eyes, tail root) at
-// identical (patch, u, v) in all four, each in its protrusion's cap (a foot in its leg's, ears and eyes in the
-// head's, the tail root in the tail's); the uniform and the adaptive remesh give one face list for all four,
-// closed, genus 0 and outward (positive volume: no triangle turned over as a whole).
+// make_animals_layout.py: a torso tube with each leg and the tail extruded as 5 patches of their own and the head
+// as 17 (neck, head, a face strip between the ears and eyes, a snout), 64 quads). Every model gets the 64
+// patches, no flip, and the 9 features at identical (patch, u, v) in all four, each in its designated patch (a
+// foot in its leg's cap, an ear in the face's side on its side, an eye in the snout's side on its side, the tail
+// root in the tail's cap); the uniform and the adaptive remesh give one face list for all four, closed, genus 0
+// and outward (positive volume: no triangle turned over as a whole).
 TEST_F(CliGimage, AnimalsWithAUserLayoutShareFeaturesAndFaceLists) {
   GEOMIP_REQUIRE_SHARED_MESH(horse, "horse.obj");
   const std::string corr = std::string(GEOMIP_SOURCE_DIR) + "/tests/data/animals-layout.corr.json";
   const auto spec = nlohmann::json::parse(slurp(corr));
   const auto& quad_names = spec["layout"]["quad_names"];
   const auto& feature_names = spec["layout"]["feature_names"];
-  ASSERT_EQ(quad_names.size(), 46u);
+  ASSERT_EQ(quad_names.size(), 64u);
   ASSERT_EQ(feature_names.size(), 9u);
   auto designated = [](const std::string& feature) -> std::string {
     if (feature.rfind("foot_", 0) == 0) return "leg_" + feature.substr(5) + "_cap";
-    if (feature.rfind("ear_", 0) == 0 || feature.rfind("eye_", 0) == 0) return "head_cap";
+    if (feature == "ear_l") return "face_left";
+    if (feature == "ear_r") return "face_right";
+    if (feature == "eye_l") return "snout_left";
+    if (feature == "eye_r") return "snout_right";
     return feature + "_cap";
   };
   const std::string out = dir_ + "/animals";
@@ -674,7 +678,7 @@ TEST_F(CliGimage, AnimalsWithAUserLayoutShareFeaturesAndFaceLists) {
     const auto& m = models.back();
     EXPECT_EQ(m["flipped_triangles"], 0) << stem;
     EXPECT_EQ(m["seam_mismatches"], 0) << stem;
-    EXPECT_EQ(m["patches"].size(), 46u) << stem;
+    EXPECT_EQ(m["patches"].size(), 64u) << stem;
     EXPECT_EQ(m["layout_quads"], spec["layout"]["quads"]) << stem;
     ASSERT_EQ(m["features"].size(), 9u) << stem;
     for (std::size_t k = 0; k < 9; ++k) {
@@ -696,7 +700,7 @@ TEST_F(CliGimage, AnimalsWithAUserLayoutShareFeaturesAndFaceLists) {
   ASSERT_EQ(s.exit_code, 0) << s.err;
   for (const char* kind : {".M4.obj", ".adaptive.obj"}) {
     const TriMesh first = read_mesh(meshes + "/horse" + kind);
-    if (std::string(kind) == ".M4.obj") EXPECT_EQ(first.triangles.size(), 46u * 2 * 16 * 16);
+    if (std::string(kind) == ".M4.obj") EXPECT_EQ(first.triangles.size(), 64u * 2 * 16 * 16);
     for (const char* stem : stems) {
       const TriMesh m = read_mesh(meshes + "/" + stem + kind);
       EXPECT_EQ(m.triangles, first.triangles) << stem << kind;

@@ -466,8 +466,8 @@ TEST_F(ViewPackTest, AnimalsStandUprightFacingTheCameraAt60To80PercentOfTheHeigh
   }
 }
 
-// Issue 15: the four animals with a user layout (tests/data/animals-layout.corr.json: 46 quads, each leg, the
-// head and the tail with patches of their own) through `geomip convert`: one pack of 4 models with 46
+// Issue 15: the four animals with a user layout (tests/data/animals-layout.corr.json: 64 quads, each leg, the
+// head and the tail with patches of their own) through `geomip convert`: one pack of 4 models with 64
 // patches each, and the viewer morphs them. Horse → cow and pig → spot at t = 0, 0.5, 1 (linear schedule):
 // each frame covers the CPU-evaluated morph's silhouette (IoU > 0.95) with no crack inside it, the end frames
 // are the models alone, and the three frames differ from each other.
@@ -480,7 +480,7 @@ TEST_F(ViewPackTest, AnimalsWithAUserLayoutMorphWithoutCracks) {
   ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
   const auto models = decode_file(pack);
   ASSERT_EQ(models.size(), 4u);
-  for (const auto& m : models) EXPECT_EQ(m.num_patches, 46);
+  for (const auto& m : models) EXPECT_EQ(m.num_patches, 64);
   const Camera camera = framed(models);
   for (int source : {0, 2}) {
     std::vector<std::vector<std::uint8_t>> frames;

@@ -681,10 +681,12 @@ std::vector<Eigen::Vector2d> average_feature_targets(
   return average;
 }
 
-FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
-                                const std::vector<int>& features, const std::vector<Eigen::Vector2d>& targets,
-                                const FeatureWarpOptions& options) {
-  check_inputs(triangles, uv, features, targets, options);
+namespace {
+
+/// One pass of `warp_features`: the features move in the order given. Sets `proved` to the number of
+/// unreached features whose reason is a proof (no order can reach them).
+FeatureWarpResult warp_pass(const std::vector<Tri>& triangles, std::vector<Vec2>& uv, const std::vector<int>& features,
+                            const std::vector<Vec2>& targets, const FeatureWarpOptions& options, std::size_t& proved) {
   std::vector<Vec2> feature_uv;
   for (int f : features) feature_uv.push_back(uv[f]);
   std::vector<Vec2> points = warp_points(feature_uv, "warp_features");
@@ -785,6 +787,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         }
       }
       if (all_fixed && orient2d(p[0], p[1], p[2]) <= 0) {
+        ++proved;
         reason[k] = "a base triangle of it and other features or boundary vertices would be flipped or flat with "
                     "every feature at its target, so no fold-free embedding reaches it";
         break;
@@ -815,8 +818,8 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         return;
       }
     }
-    give_up(k, "the warp " + warper.stuck_reason() + ", also after " + std::to_string(sidesteps[k]) +
-                   " steps aside");
+    give_up(k, "the warp " + warper.stuck_reason() +
+                   (sidesteps[k] > 0 ? ", also after " + std::to_string(sidesteps[k]) + " steps aside" : ""));
   };
   while (!pending.empty()) {
     if (rounds++ > 8 * n + 8) {
@@ -891,14 +894,82 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
   for (int k = 0; k < n; ++k) {
     result.max_feature_error = std::max(result.max_feature_error, (uv[features[k]] - targets[k]).norm());
   }
-  for (const Tri& t : triangles) {
-    if (orient2d(uv[t[0]], uv[t[1]], uv[t[2]]) <= 0) ++result.flipped_triangles;
+  return result;
+}
+
+}  // namespace
+
+FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
+                                const std::vector<int>& features, const std::vector<Eigen::Vector2d>& targets,
+                                const FeatureWarpOptions& options) {
+  check_inputs(triangles, uv, features, targets, options);
+  // Passes: each starts again from the input uv and moves first the features the previous pass left unreached
+  // (in the order they failed), then the others in the previous pass's order; only the last pass steps aside.
+  const int n = int(features.size());
+  const int passes = 1 + std::max(0, options.reorder_passes);
+  std::vector<int> order(n);
+  for (int k = 0; k < n; ++k) order[k] = k;
+  FeatureWarpResult best, effort;
+  effort.min_warp_triangle_area = std::numeric_limits<double>::infinity();
+  std::vector<Vec2> best_uv;
+  std::vector<int> failed;  // indices into `features` the last pass left unreached, in the order they moved
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<int> next = failed;
+    for (int k : order) {
+      if (std::find(next.begin(), next.end(), k) == next.end()) next.push_back(k);
+    }
+    order.swap(next);
+    std::vector<int> pass_features;
+    std::vector<Vec2> pass_targets;
+    for (int k : order) {
+      pass_features.push_back(features[k]);
+      pass_targets.push_back(targets[k]);
+    }
+    FeatureWarpOptions pass_options = options;
+    if (pass + 1 < passes) pass_options.sidesteps = 0;
+    std::vector<Vec2> trial = uv;
+    std::size_t proved = 0;
+    FeatureWarpResult r = warp_pass(triangles, trial, pass_features, pass_targets, pass_options, proved);
+    effort.events += r.events;
+    effort.repaired_vertices += r.repaired_vertices;
+    effort.steps += r.steps;
+    effort.detours += r.detours;
+    effort.min_warp_triangle_area = std::min(effort.min_warp_triangle_area, r.min_warp_triangle_area);
+    failed.clear();
+    std::vector<std::pair<int, std::string>> unreached;  // back to indices into `features`
+    for (std::size_t i = 0; i < r.unreached.size(); ++i) {
+      failed.push_back(order[r.unreached[i]]);
+      unreached.emplace_back(order[r.unreached[i]], r.unreached_reasons[i]);
+    }
+    std::sort(unreached.begin(), unreached.end());
+    r.unreached.clear();
+    r.unreached_reasons.clear();
+    for (auto& [k, why] : unreached) {
+      r.unreached.push_back(k);
+      r.unreached_reasons.push_back(std::move(why));
+    }
+    if (pass == 0 || r.unreached.size() < best.unreached.size()) {
+      best = std::move(r);
+      best_uv.swap(trial);
+    }
+    effort.passes = pass + 1;
+    if (best.unreached.empty() || proved == failed.size()) break;  // done, or no order can do better
   }
-  if (options.keep_base_mesh_valid && result.flipped_triangles > 0) {
-    throw SolverFailure("warp_features: " + std::to_string(result.flipped_triangles) +
+  uv.swap(best_uv);
+  best.events = effort.events;
+  best.repaired_vertices = effort.repaired_vertices;
+  best.steps = effort.steps;
+  best.detours = effort.detours;
+  best.min_warp_triangle_area = effort.min_warp_triangle_area;
+  best.passes = effort.passes;
+  for (const Tri& t : triangles) {
+    if (orient2d(uv[t[0]], uv[t[1]], uv[t[2]]) <= 0) ++best.flipped_triangles;
+  }
+  if (options.keep_base_mesh_valid && best.flipped_triangles > 0) {
+    throw SolverFailure("warp_features: " + std::to_string(best.flipped_triangles) +
                         " base triangles flipped despite repair");
   }
-  return result;
+  return best;
 }
 
 }  // namespace geomip

@@ -66,8 +66,9 @@ struct FeatureWarpOptions {
   /// move first the features the previous pass left unreached (in the order they moved there), then the
   /// others in the previous pass's order: a feature moved early crosses a fresh base mesh, and the features
   /// that stall are the ones whose way leads through the stars that earlier moves dragged and squeezed. Only
-  /// the last pass steps aside (`sidesteps`); the earlier ones give a stalled feature up at once. The pass
-  /// with the fewest unreached features is kept. 0: one pass in the given order, with steps aside.
+  /// the last pass steps aside (`sidesteps`); the earlier ones give a stalled feature up at once. A pass stops
+  /// as soon as it has left as many features unreached as the best one so far; the pass with the fewest
+  /// unreached features is kept. 0: one pass in the given order, with steps aside.
   int reorder_passes = 3;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after

@@ -126,8 +126,10 @@ struct FeatureWarpResult {
 /// around it inside the kernels of their stars (`repaired_vertices`); every relocation is checked with exact
 /// predicates. The base mesh therefore has no flipped triangle afterwards. Points outside the warp triangles
 /// incident to a moving feature move only when repaired (they are then within a few rings of a moving one).
-/// A target may be left unreached (reported in `unreached`, never folded); how often that happens for near
-/// and far targets is in docs/measurements.md.
+/// A pass that leaves targets unreached is followed by passes in other orders from the input uv
+/// (`FeatureWarpOptions::reorder_passes`); `uv` and the result are those of the pass with the fewest unreached
+/// features. A target may still be left unreached (reported in `unreached`, never folded); how often that
+/// happens for near and far targets is in docs/measurements.md.
 ///
 /// \param triangles  #F base-mesh triangles, 0-based indices into `uv`, counter-clockwise (positive area).
 /// \param uv         #V positions in [0,1]²: corners at the square's corners, boundary vertices with a

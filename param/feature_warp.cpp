@@ -916,7 +916,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
                                 const FeatureWarpOptions& options) {
   check_inputs(triangles, uv, features, targets, options);
   // Passes: each starts again from the input uv and moves first the features the previous pass left unreached
-  // (in the order they failed), then the others in the previous pass's order; only the last pass steps aside.
+  // (in the order they moved), then the others in the previous pass's order; only the last pass steps aside.
   const int n = int(features.size());
   const int passes = 1 + std::max(0, options.reorder_passes);
   std::vector<int> order(n);

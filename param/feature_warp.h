@@ -72,7 +72,8 @@ struct FeatureWarpOptions {
   int reorder_passes = 3;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after
-  /// the Delaunay flips that follow a move. May be empty. For tests and visualization.
+  /// the Delaunay flips that follow a move, in every pass (`reorder_passes`; a later pass lists the features in
+  /// its own order). May be empty. For tests and visualization.
   std::function<void(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles)>
       observer;
 };

@@ -681,10 +681,15 @@ std::vector<Eigen::Vector2d> average_feature_targets(
   return average;
 }
 
-FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
-                                const std::vector<int>& features, const std::vector<Eigen::Vector2d>& targets,
-                                const FeatureWarpOptions& options) {
-  check_inputs(triangles, uv, features, targets, options);
+namespace {
+
+/// One pass of `warp_features`: the features move in the order given. Sets `proved` to the number of
+/// unreached features whose reason is a proof (no order can reach them) and lists in `failed` the others that
+/// it gave up, in the order it gave them up. Stops early (`aborted`) once `limit` features are unreached: such
+/// a pass cannot beat one that left `limit` unreached.
+FeatureWarpResult warp_pass(const std::vector<Tri>& triangles, std::vector<Vec2>& uv, const std::vector<int>& features,
+                            const std::vector<Vec2>& targets, const FeatureWarpOptions& options, std::size_t limit,
+                            std::size_t& proved, std::vector<int>& failed, bool& aborted) {
   std::vector<Vec2> feature_uv;
   for (int f : features) feature_uv.push_back(uv[f]);
   std::vector<Vec2> points = warp_points(feature_uv, "warp_features");
@@ -763,6 +768,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
     std::snprintf(at, sizeof at, " (stopped at (%.4f, %.4f), %.3g short of the target)", x.x(), x.y(),
                   (x - targets[k]).norm());
     reason[k] = why + at;
+    failed.push_back(k);
   };
   // Targets that no embedding can reach: a base triangle whose three vertices are all fixed (features at their
   // targets, boundary vertices where they are) and that would not be positive there. The features of such a
@@ -785,6 +791,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         }
       }
       if (all_fixed && orient2d(p[0], p[1], p[2]) <= 0) {
+        ++proved;
         reason[k] = "a base triangle of it and other features or boundary vertices would be flipped or flat with "
                     "every feature at its target, so no fold-free embedding reaches it";
         break;
@@ -815,10 +822,11 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         return;
       }
     }
-    give_up(k, "the warp " + warper.stuck_reason() + ", also after " + std::to_string(sidesteps[k]) +
-                   " steps aside");
+    give_up(k, "the warp " + warper.stuck_reason() +
+                   (sidesteps[k] > 0 ? ", also after " + std::to_string(sidesteps[k]) + " steps aside" : ""));
   };
-  while (!pending.empty()) {
+  auto over_limit = [&] { return (aborted = aborted || proved + failed.size() >= limit); };
+  while (!pending.empty() && !over_limit()) {
     if (rounds++ > 8 * n + 8) {
       for (int k : pending) give_up(k, "features waiting for each other's places could not be untangled");
       break;
@@ -827,6 +835,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
     bool progress = false;
     const bool was_forced = force;
     for (int k : pending) {
+      if (over_limit()) break;
       const int w = kCorners + k;
       const Vec2 x0 = warp.pos[w];
       const int hard = blocker(w, x0, targets[k], false);
@@ -882,7 +891,13 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
     pending.swap(waiting);
   }
   for (int k = 0; k < n; ++k) {
-    if (reason[k].empty() && uv[features[k]] != targets[k]) give_up(k, "the warp stopped short");
+    if (reason[k].empty() && uv[features[k]] != targets[k]) {
+      if (aborted) {
+        reason[k] = "not moved: the pass stopped early";
+      } else {
+        give_up(k, "the warp stopped short");
+      }
+    }
     if (reason[k].empty()) continue;
     result.unreached.push_back(k);
     result.unreached_reasons.push_back(reason[k]);
@@ -891,14 +906,85 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
   for (int k = 0; k < n; ++k) {
     result.max_feature_error = std::max(result.max_feature_error, (uv[features[k]] - targets[k]).norm());
   }
-  for (const Tri& t : triangles) {
-    if (orient2d(uv[t[0]], uv[t[1]], uv[t[2]]) <= 0) ++result.flipped_triangles;
+  return result;
+}
+
+}  // namespace
+
+FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
+                                const std::vector<int>& features, const std::vector<Eigen::Vector2d>& targets,
+                                const FeatureWarpOptions& options) {
+  check_inputs(triangles, uv, features, targets, options);
+  // Passes: each starts again from the input uv and moves first the features the previous pass left unreached
+  // (in the order they moved), then the others in the previous pass's order; only the last pass steps aside.
+  const int n = int(features.size());
+  const int passes = 1 + std::max(0, options.reorder_passes);
+  std::vector<int> order(n);
+  for (int k = 0; k < n; ++k) order[k] = k;
+  FeatureWarpResult best, effort;
+  effort.min_warp_triangle_area = std::numeric_limits<double>::infinity();
+  std::vector<Vec2> best_uv;
+  std::vector<int> failed;  // indices into `features` the last pass gave up, in the order they moved
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<int> next = failed;
+    for (int k : order) {
+      if (std::find(next.begin(), next.end(), k) == next.end()) next.push_back(k);
+    }
+    order.swap(next);
+    std::vector<int> pass_features;
+    std::vector<Vec2> pass_targets;
+    for (int k : order) {
+      pass_features.push_back(features[k]);
+      pass_targets.push_back(targets[k]);
+    }
+    FeatureWarpOptions pass_options = options;
+    if (pass + 1 < passes) pass_options.sidesteps = 0;
+    std::vector<Vec2> trial = uv;
+    std::size_t proved = 0;
+    bool aborted = false;
+    std::vector<int> pass_failed;
+    FeatureWarpResult r = warp_pass(triangles, trial, pass_features, pass_targets, pass_options,
+                                    pass == 0 ? features.size() + 1 : best.unreached.size(), proved, pass_failed,
+                                    aborted);
+    effort.events += r.events;
+    effort.repaired_vertices += r.repaired_vertices;
+    effort.steps += r.steps;
+    effort.detours += r.detours;
+    effort.min_warp_triangle_area = std::min(effort.min_warp_triangle_area, r.min_warp_triangle_area);
+    failed.clear();
+    std::sort(pass_failed.begin(), pass_failed.end());
+    for (int i : pass_failed) failed.push_back(order[i]);
+    std::vector<std::pair<int, std::string>> unreached;  // back to indices into `features`
+    for (std::size_t i = 0; i < r.unreached.size(); ++i) unreached.emplace_back(order[r.unreached[i]], r.unreached_reasons[i]);
+    std::sort(unreached.begin(), unreached.end());
+    r.unreached.clear();
+    r.unreached_reasons.clear();
+    for (auto& [k, why] : unreached) {
+      r.unreached.push_back(k);
+      r.unreached_reasons.push_back(std::move(why));
+    }
+    if (pass == 0 || (!aborted && r.unreached.size() < best.unreached.size())) {
+      best = std::move(r);
+      best_uv.swap(trial);
+    }
+    effort.passes = pass + 1;
+    if (best.unreached.size() == proved) break;  // every target reached, or no order can do better
   }
-  if (options.keep_base_mesh_valid && result.flipped_triangles > 0) {
-    throw SolverFailure("warp_features: " + std::to_string(result.flipped_triangles) +
+  uv.swap(best_uv);
+  best.events = effort.events;
+  best.repaired_vertices = effort.repaired_vertices;
+  best.steps = effort.steps;
+  best.detours = effort.detours;
+  best.min_warp_triangle_area = effort.min_warp_triangle_area;
+  best.passes = effort.passes;
+  for (const Tri& t : triangles) {
+    if (orient2d(uv[t[0]], uv[t[1]], uv[t[2]]) <= 0) ++best.flipped_triangles;
+  }
+  if (options.keep_base_mesh_valid && best.flipped_triangles > 0) {
+    throw SolverFailure("warp_features: " + std::to_string(best.flipped_triangles) +
                         " base triangles flipped despite repair");
   }
-  return result;
+  return best;
 }
 
 }  // namespace geomip

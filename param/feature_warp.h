@@ -62,9 +62,18 @@ struct FeatureWarpOptions {
   /// right of its way (alternately, by 1, 1, 2, 2, ... `sidestep_length`), then on toward its target.
   int sidesteps = 4;
   double sidestep_length = 0.03;
+  /// When a pass leaves features unreached, up to this many more passes start again from the input uv and
+  /// move first the features the previous pass left unreached (in the order they moved there), then the
+  /// others in the previous pass's order: a feature moved early crosses a fresh base mesh, and the features
+  /// that stall are the ones whose way leads through the stars that earlier moves dragged and squeezed. Only
+  /// the last pass steps aside (`sidesteps`); the earlier ones give a stalled feature up at once. A pass stops
+  /// as soon as it has left as many features unreached as the best one so far; the pass with the fewest
+  /// unreached features is kept. 0: one pass in the given order, with steps aside.
+  int reorder_passes = 3;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after
-  /// the Delaunay flips that follow a move. May be empty. For tests and visualization.
+  /// the Delaunay flips that follow a move, in every pass (`reorder_passes`; a later pass lists the features in
+  /// its own order). May be empty. For tests and visualization.
   std::function<void(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles)>
       observer;
 };
@@ -93,6 +102,10 @@ struct FeatureWarpResult {
   /// boundary vertices would be flipped or flat with every feature at its target; the features of it that have
   /// to move are reported and not moved), or where and why the warp gave up on it.
   std::vector<std::string> unreached_reasons;
+  /// Passes run (see `FeatureWarpOptions::reorder_passes`): 1 when the first pass reached every target. The
+  /// result is the best pass's; `events`, `repaired_vertices`, `steps`, `detours` and
+  /// `min_warp_triangle_area` are over all passes.
+  int passes = 0;
   /// Base triangles with signed area <= 0 after the warp, checked with exact predicates: always 0 unless
   /// `keep_base_mesh_valid` is false.
   std::size_t flipped_triangles = 0;
@@ -114,8 +127,10 @@ struct FeatureWarpResult {
 /// around it inside the kernels of their stars (`repaired_vertices`); every relocation is checked with exact
 /// predicates. The base mesh therefore has no flipped triangle afterwards. Points outside the warp triangles
 /// incident to a moving feature move only when repaired (they are then within a few rings of a moving one).
-/// A target may be left unreached (reported in `unreached`, never folded); how often that happens for near
-/// and far targets is in docs/measurements.md.
+/// A pass that leaves targets unreached is followed by passes in other orders from the input uv
+/// (`FeatureWarpOptions::reorder_passes`); `uv` and the result are those of the pass with the fewest unreached
+/// features. A target may still be left unreached (reported in `unreached`, never folded); how often that
+/// happens for near and far targets is in docs/measurements.md.
 ///
 /// \param triangles  #F base-mesh triangles, 0-based indices into `uv`, counter-clockwise (positive area).
 /// \param uv         #V positions in [0,1]²: corners at the square's corners, boundary vertices with a

@@ -193,6 +193,7 @@ RandomCase random_case(int n, std::mt19937& rng, double reach) {
 
 struct TrialFigures {
   std::size_t features = 0, unreached = 0, events = 0, repaired = 0, max_events = 0, max_repaired = 0;
+  std::size_t reordered = 0, rescued = 0;  // warps that needed more than one pass; of those, reaching every target
   std::map<std::string, std::size_t> reasons;  // why features stopped short: the reason up to its position
   double seconds = 0;
 };
@@ -220,6 +221,12 @@ TrialFigures run_random_trials(int trials, double reach, unsigned seed) {
       ++fig.reasons[why.substr(0, why.find(" ("))];
     }
     EXPECT_EQ(r.max_feature_error > 0, !r.unreached.empty());
+    EXPECT_GE(r.passes, 1);
+    EXPECT_LE(r.passes, 1 + FeatureWarpOptions{}.reorder_passes);
+    if (r.passes > 1) {
+      ++fig.reordered;
+      fig.rescued += r.unreached.empty();
+    }
     fig.features += c.features.size();
     fig.unreached += r.unreached.size();
     fig.events += r.events;
@@ -229,8 +236,9 @@ TrialFigures run_random_trials(int trials, double reach, unsigned seed) {
   }
   std::cout << "[ figures  ] " << trials << " trials, 20x20 grid, 3-6 features, reach " << reach << ": unreached "
             << fig.unreached << "/" << fig.features << ", events " << fig.events << " (max " << fig.max_events
-            << "), repaired vertices " << fig.repaired << " (max " << fig.max_repaired << "), "
-            << 1e3 * fig.seconds / trials << " ms per warp\n";
+            << "), repaired vertices " << fig.repaired << " (max " << fig.max_repaired << "), warps in more than one pass "
+            << fig.reordered << " (all targets reached in " << fig.rescued << "), " << 1e3 * fig.seconds / trials
+            << " ms per warp\n";
   for (const auto& [why, count] : fig.reasons) std::cout << "[ figures  ]   " << count << " x " << why << "\n";
   return fig;
 }
@@ -246,10 +254,14 @@ TEST(WarpFeatures, RandomNearbyTargetsAreReachedWithoutFlippedTriangles) {
 }
 
 // Targets anywhere: features sweep past each other's stars across the grid. Nothing may fold; a feature that
-// cannot get through is reported (its error is in the result), never forced.
+// cannot get through is reported (its error is in the result), never forced. Every target here is reachable
+// (no base triangle of features only), so the count is what the warp still fails: 4 of 93 with the reordered
+// passes (14 of 93 with one pass; docs/measurements.md, "Feature warp stress test"). Some warps must need the
+// later passes and reach every target there, or the passes are untested.
 TEST(WarpFeatures, RandomFarTargetsNeverFoldTheBaseMesh) {
   const TrialFigures fig = run_random_trials(20, 2.0, 77);
-  EXPECT_LT(fig.unreached, fig.features);
+  EXPECT_LE(fig.unreached, 4u);
+  EXPECT_GT(fig.rescued, 0u);
 }
 
 // The caveat of §3.4: the plain PL warp maps vertices only, and straight-edged base triangles can invert.
@@ -367,6 +379,7 @@ TEST(WarpFeatures, ImpossibleTargetIsReportedNotFolded) {
   EXPECT_EQ(uv[features[0]], e.uv[features[0]]);
   EXPECT_GT(r.max_feature_error, 0.0);
   EXPECT_EQ(uv[features[1]], targets[1]);
+  EXPECT_EQ(r.passes, 1);  // a proof holds in every order: no second pass
   expect_warp_properties(e, uv, features, targets, r);
 }
 

@@ -255,12 +255,10 @@ class PatchProgress {
   PatchProgress(const Progress& progress, const char* stage, double start, double span, std::size_t patches)
       : progress_(progress), stage_(stage), start_(start), span_(span), fractions_(patches, 0.0) {}
   void operator()(std::size_t patch, double fraction) {
+    const std::lock_guard<std::mutex> lock(mutex_);  // held while reporting: the reports never go back
+    fractions_[patch] = fraction;
     double sum = 0;
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      fractions_[patch] = fraction;
-      for (double f : fractions_) sum += f;
-    }
+    for (double f : fractions_) sum += f;
     progress_(stage_, start_ + span_ * sum / static_cast<double>(fractions_.size()));
   }
 

@@ -183,7 +183,8 @@ CommandRunner add_param_command(CLI::App& app) {
   add_model_options(cmd, args->common);
   cmd->add_flag("--no-baseline", args->no_baseline, "Skip the full-patch MVC embedding used as stretch baseline");
   cmd->add_option("--threads", args->threads,
-                  "Threads over the patches (default 0: all cores); the output is the same for any count");
+                  "Threads over the patches (default 0: all cores); the output is the same for any count")
+      ->check(CLI::Range(0u, 256u));
   return [args] { return run_param(*args); };
 }
 

@@ -380,6 +380,7 @@ ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::s
   std::vector<StageSeconds> seconds(num_patches);
   PatchProgress patch_progress(progress, "progressive mesh", static_cast<double>(i), 1.0, num_patches);
   for_each_patch(num_patches, options.threads, [&](std::size_t p) {
+    patch_progress(p, 0.0);  // names the stage
     w.patches[p] = prepare_patch(in, w, p, vertex_feature, options, seconds[p]);
     patch_progress(p, 1.0);
   });
@@ -471,8 +472,8 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
 }
 
 // Phase C, coarse to fine: inserts the patch's vertices one by one with local stretch optimization, and
-// optimizes each level globally whenever it has grown by `level_growth`. Progress runs over [start,
-// start + share).
+// optimizes each level globally whenever it has grown by `level_growth`. Reports the patch's fraction done to
+// `progress`.
 CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<char>& locked,
                                 const ParameterizationOptions& options, PatchProgress& progress) {
   CoarseToFine c2f(pw.local, pw.pm, pw.uv);

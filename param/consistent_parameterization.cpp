@@ -7,11 +7,16 @@
 #include "param/unit_square.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <mutex>
 #include <random>
 #include <string>
+#include <system_error>
+#include <thread>
 
 namespace geomip {
 namespace {
@@ -42,6 +47,51 @@ struct ModelWork {
 
 void report(const ParameterizationOptions& o, const char* stage, double f) {
   if (o.progress) o.progress(stage, f);
+}
+
+// Calls task(p) once for every patch p in [0, n), on up to `threads` threads (0 = one per hardware thread;
+// the caller's thread is one of them). Patches are independent (each has its own seeds and writes only its
+// own slots), so the results do not depend on the thread count or the schedule. After a task throws, no
+// patch with a higher index starts; once all threads are joined the exception of the lowest failing patch is
+// rethrown, which is the one a sequential run throws. (codec::parallel_for is the codec's loop; codec builds
+// from its own folder, so param cannot share it.)
+template <typename Task>
+void for_each_patch(std::size_t n, unsigned threads, const Task& task) {
+  std::vector<std::exception_ptr> errors(n);
+  std::atomic<std::size_t> next{0}, first_error{n};
+  const auto worker = [&] {
+    for (std::size_t p = next++; p < n && p < first_error; p = next++) {
+      try {
+        task(p);
+      } catch (...) {
+        errors[p] = std::current_exception();
+        for (std::size_t e = first_error; p < e && !first_error.compare_exchange_weak(e, p);) {
+        }
+      }
+    }
+  };
+  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t count = std::min<std::size_t>(threads > 0 ? threads : hardware, n);
+  std::vector<std::thread> pool;
+  try {
+    for (std::size_t t = 1; t < count; ++t) pool.emplace_back(worker);
+  } catch (const std::system_error&) {  // no more threads: the ones started and this one do the rest
+  }
+  worker();
+  for (auto& thread : pool) thread.join();
+  for (const auto& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+}
+
+void add_seconds(StageSeconds& to, const StageSeconds& s) {
+  to.partition += s.partition;
+  to.progressive_mesh += s.progressive_mesh;
+  to.base_embedding += s.base_embedding;
+  to.feature_warp += s.feature_warp;
+  to.coarse_to_fine += s.coarse_to_fine;
+  to.final_optimization += s.final_optimization;
+  to.mvc_baseline += s.mvc_baseline;
 }
 
 PatchWork extract_patch(const PartitionResult& partition, const Patch& patch) {
@@ -185,11 +235,39 @@ std::size_t reconcile_seams(ModelParameterization& m) {
   return mismatches;
 }
 
-// Progress of the whole run: 3 steps per model (one for phase A, two for phase C) plus phase B.
+// Progress of the whole run: 3 steps per model (one for phase A, two for phase C) plus phase B. Calls are
+// serialized, so the user's callback never runs on two threads at once.
 struct Progress {
+  Progress(const ParameterizationOptions& o, double steps) : options(o), total_steps(steps) {}
   const ParameterizationOptions& options;
   double total_steps;
-  void operator()(const char* stage, double f) const { report(options, stage, f / total_steps); }
+  mutable std::mutex mutex;
+  void operator()(const char* stage, double f) const {
+    const std::lock_guard<std::mutex> lock(mutex);
+    report(options, stage, f / total_steps);
+  }
+};
+
+// Progress of one stage that runs over the patches of a model, possibly several at once: the stage covers
+// [start, start + span) and reports the mean of the patches' own fractions.
+class PatchProgress {
+ public:
+  PatchProgress(const Progress& progress, const char* stage, double start, double span, std::size_t patches)
+      : progress_(progress), stage_(stage), start_(start), span_(span), fractions_(patches, 0.0) {}
+  void operator()(std::size_t patch, double fraction) {
+    const std::lock_guard<std::mutex> lock(mutex_);  // held while reporting: the reports never go back
+    fractions_[patch] = fraction;
+    double sum = 0;
+    for (double f : fractions_) sum += f;
+    progress_(stage_, start_ + span_ * sum / static_cast<double>(fractions_.size()));
+  }
+
+ private:
+  const Progress& progress_;
+  const char* stage_;
+  double start_, span_;
+  std::mutex mutex_;
+  std::vector<double> fractions_;
 };
 
 void check_feature_counts(const std::vector<ParameterizationInput>& models) {
@@ -226,7 +304,7 @@ std::vector<int> feature_of_vertex(const ParameterizationInput& in, std::size_t 
 // optimization. Sets w.feature_patch for the patch's features.
 PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size_t p,
                         const std::vector<int>& vertex_feature, const ParameterizationOptions& options,
-                        ModelParameterization& o) {
+                        StageSeconds& seconds) {
   PatchWork pw = extract_patch(w.partition, w.partition.patches[p]);
   const std::vector<char> on_boundary = boundary_mask(pw);
   for (std::size_t v = 0; v < pw.to_mesh.size(); ++v) {
@@ -243,7 +321,7 @@ PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size
   }
   auto t0 = Clock::now();
   pw.pm = progressive_mesh(pw.local, pw.sides, pw.features, options.progressive_mesh);
-  o.seconds.progressive_mesh += seconds_since(t0);
+  seconds.progressive_mesh += seconds_since(t0);
 
   t0 = Clock::now();
   const std::vector<FixedUv> boundary = square_boundary_uv(pw.local.positions, pw.pm.sides);
@@ -261,7 +339,7 @@ PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size
   }
   optimize_stretch(base.positions, base.triangles, base.uv, locked, base_options);
   store_base(base, pw);
-  o.seconds.base_embedding += seconds_since(t0);
+  seconds.base_embedding += seconds_since(t0);
   return pw;
 }
 
@@ -296,11 +374,17 @@ ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::s
   // Features: interior vertices of a patch, in the same patch in every model.
   const std::vector<int> vertex_feature = feature_of_vertex(in, w.partition.mesh.positions.size());
   w.feature_patch.assign(in.features.size(), -1);
+  // The patches in parallel; each writes only its own slots (and feature_patch of its own features).
   const std::size_t num_patches = w.partition.patches.size();
-  for (std::size_t p = 0; p < num_patches; ++p) {
-    progress("progressive mesh", static_cast<double>(i) + (p + 0.5) / static_cast<double>(num_patches));
-    w.patches.push_back(prepare_patch(in, w, p, vertex_feature, options, o));
-  }
+  w.patches.resize(num_patches);
+  std::vector<StageSeconds> seconds(num_patches);
+  PatchProgress patch_progress(progress, "progressive mesh", static_cast<double>(i), 1.0, num_patches);
+  for_each_patch(num_patches, options.threads, [&](std::size_t p) {
+    patch_progress(p, 0.0);  // names the stage
+    w.patches[p] = prepare_patch(in, w, p, vertex_feature, options, seconds[p]);
+    patch_progress(p, 1.0);
+  });
+  for (const StageSeconds& s : seconds) add_seconds(o.seconds, s);
   if (first) {
     for (std::size_t k = 0; k < in.features.size(); ++k) {
       if (w.feature_patch[k] != first->feature_patch[k]) {
@@ -388,11 +472,10 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
 }
 
 // Phase C, coarse to fine: inserts the patch's vertices one by one with local stretch optimization, and
-// optimizes each level globally whenever it has grown by `level_growth`. Progress runs over [start,
-// start + share).
+// optimizes each level globally whenever it has grown by `level_growth`. Reports the patch's fraction done to
+// `progress`.
 CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<char>& locked,
-                                const ParameterizationOptions& options, const Progress& progress,
-                                double start, double share) {
+                                const ParameterizationOptions& options, PatchProgress& progress) {
   CoarseToFine c2f(pw.local, pw.pm, pw.uv);
   std::mt19937 rng(options.seed * 7919u + static_cast<unsigned>(p));
   const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
@@ -410,8 +493,7 @@ CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<
     c2f.split_next(optimize);
     ++level_vertices;
     if ((c2f.splits_done() & 1023u) == 0) {
-      progress("coarse-to-fine",
-               start + share * static_cast<double>(c2f.splits_done()) / double(c2f.num_splits()));
+      progress(p, static_cast<double>(c2f.splits_done()) / static_cast<double>(c2f.num_splits()));
     }
     if (options.level_sweeps > 0 && level_vertices >= next_level * options.level_growth && !c2f.finished()) {
       optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices),
@@ -425,15 +507,15 @@ CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<
 // Phase C for patch p of model `name`: coarse-to-fine, final sweeps, the MVC baseline and fallback; returns
 // the patch's parameterization in mesh ids. \throw SolverFailure when a triangle ends flipped.
 PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std::string& name,
-                                         const ParameterizationOptions& options, const Progress& progress,
-                                         double start, double share, ModelParameterization& o) {
+                                         const ParameterizationOptions& options, PatchProgress& progress,
+                                         StageSeconds& seconds, std::vector<FeatureLocation>& features) {
   std::vector<char> locked = boundary_mask(pw);
   for (int v : pw.features) locked[v] = 1;
   const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
 
   auto t0 = Clock::now();
-  CoarseToFineResult r = refine_patch(pw, p, locked, options, progress, start, share);
-  o.seconds.coarse_to_fine += seconds_since(t0);
+  CoarseToFineResult r = refine_patch(pw, p, locked, options, progress);
+  seconds.coarse_to_fine += seconds_since(t0);
 
   t0 = Clock::now();
   if (options.final_sweeps > 0) {
@@ -443,7 +525,7 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
     final_options.vertex.vertex_weights = weights;
     optimize_stretch(pw.local.positions, r.triangles, r.uv, locked, final_options);
   }
-  o.seconds.final_optimization += seconds_since(t0);
+  seconds.final_optimization += seconds_since(t0);
 
   PatchParameterization pp;
   pp.vertices = pw.to_mesh;
@@ -469,7 +551,7 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
     auto mvc = mean_value_embedding(pw.local.positions, pw.local.triangles,
                                     square_boundary_uv(pw.local.positions, pw.pm.sides));
     pp.mvc_stretch = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
-    o.seconds.mvc_baseline += seconds_since(t0);
+    seconds.mvc_baseline += seconds_since(t0);
     if (pw.features.empty() && pp.mvc_stretch.l2 < pp.stretch.l2) {
       t0 = Clock::now();
       StretchOptimizationOptions fallback = options.base_optimization;
@@ -484,11 +566,11 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
         pp.boundary_off_chord = 0;
         pp.mvc_fallback = true;
       }
-      o.seconds.final_optimization += seconds_since(t0);
+      seconds.final_optimization += seconds_since(t0);
     }
   }
   for (std::size_t j = 0; j < pw.features.size(); ++j) {
-    FeatureLocation& f = o.features[pw.feature_index[j]];
+    FeatureLocation& f = features[pw.feature_index[j]];
     f.vertex = pw.to_mesh[pw.features[j]];
     f.patch = static_cast<int>(p);
     f.uv = pp.uv[pw.features[j]];
@@ -530,12 +612,18 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
     o.adjacency = w.partition.adjacency;
     o.split_vertices = w.partition.split_vertices;
     o.features.assign(num_features, FeatureLocation{});
-    const double share = 2.0 / static_cast<double>(w.patches.size());
-    for (std::size_t p = 0; p < w.patches.size(); ++p) {
-      const double start = n + 2.0 * static_cast<double>(i) + share * static_cast<double>(p);
-      o.patches.push_back(
-          parameterize_patch(w.patches[p], p, models[i].name, options, progress, start, share, o));
-    }
+    // The patches in parallel; each writes only its own slots (and the features inside it).
+    const std::size_t num_patches = w.patches.size();
+    o.patches.resize(num_patches);
+    std::vector<StageSeconds> seconds(num_patches);
+    PatchProgress patch_progress(progress, "coarse-to-fine", n + 2.0 * static_cast<double>(i), 2.0,
+                                 num_patches);
+    for_each_patch(num_patches, options.threads, [&](std::size_t p) {
+      o.patches[p] = parameterize_patch(w.patches[p], p, models[i].name, options, patch_progress, seconds[p],
+                                        o.features);
+      patch_progress(p, 1.0);
+    });
+    for (const StageSeconds& s : seconds) add_seconds(o.seconds, s);
     o.seam_mismatches = reconcile_seams(o);
   }
   report(options, "done", 1.0);

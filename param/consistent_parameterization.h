@@ -86,6 +86,11 @@ struct ParameterizationOptions {
   SamplingWeightOptions sampling_weights;
   /// Seed of the random search directions (results are deterministic for a given seed).
   unsigned seed = 1;
+  /// Threads over the patches of a model (progressive meshes and base embeddings, then coarse-to-fine, final
+  /// sweeps and MVC baseline); 0 = one per hardware thread. Patches are independent, so the result is
+  /// bit-identical for every thread count.
+  unsigned threads = 0;
+  /// Called from one thread at a time (possibly a worker thread, not the caller's).
   ProgressCallback progress;
 };
 
@@ -113,8 +118,8 @@ struct FeatureLocation {
   Eigen::Vector2d uv{0, 0};
 };
 
-/// Seconds spent in each stage (summed over the patches of the model; the warp is shared by all models and
-/// counted in each).
+/// Seconds spent in each stage (summed over the patches of the model, so with several threads a stage's
+/// figure can exceed its wall-clock time; the warp is shared by all models and counted in each).
 struct StageSeconds {
   double partition = 0, progressive_mesh = 0, base_embedding = 0, feature_warp = 0, coarse_to_fine = 0,
          final_optimization = 0, mvc_baseline = 0;

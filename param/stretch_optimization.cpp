@@ -48,7 +48,8 @@ struct RingTriangle {
 /// N is the cotangent form Σ_i L_i² (d_ij·d_ik) of 4·A2²·‖J‖_F² (L_i: 3D length opposite corner i, d_ij: uv
 /// edge vectors leaving corner i).
 struct LineTerm {
-  double n0, n1, n2, c0, c1, area3, weight;
+  double n0, n1, n2, c0, c1, area3;
+  double weighted_area3;  ///< area3 · weight (the product accumulate() forms first)
 };
 
 struct Weights {
@@ -74,10 +75,11 @@ Weights ring_weights(const RingTriangle* ring, std::size_t n, double w) {
   return {sum_a3 > 0 ? (1 - w) / sum_a3 : 0.0, w};
 }
 
-/// E(v) from per-triangle (Γ²+γ², 2·A2) values; adds one triangle to running sums.
-inline void accumulate(double trace, double twice_a2, double area3, double weight, const Weights& w,
+/// E(v) from per-triangle (Γ²+γ², 2·A2) values; adds one triangle to running sums. `weighted_area3` is
+/// area3 · weight.
+inline void accumulate(double trace, double twice_a2, double area3, double weighted_area3, const Weights& w,
                        double& sum, double& max_sq) {
-  sum += area3 * weight * trace;
+  sum += weighted_area3 * trace;
   if (w.linf > 0) {
     const double det = 2 * area3 / twice_a2;  // Γγ = A3 / A2
     const double big_sq = 0.5 * (trace + std::sqrt(std::max(0.0, trace * trace - 4 * det * det)));
@@ -94,7 +96,7 @@ double ring_energy(const Eigen::Vector2d& p, const RingTriangle* ring, std::size
     const double c = cross2(u1, u2);
     if (!(c > 0)) return kInf;
     const double num = r.len0_sq * u1.dot(u2) - r.len1_sq * u1.dot(u2 - u1) - r.len2_sq * u2.dot(u1 - u2);
-    accumulate(num / (c * c), c, r.area3, r.weight, w, sum, max_sq);
+    accumulate(num / (c * c), c, r.area3, r.area3 * r.weight, w, sum, max_sq);
   }
   return 0.5 * w.l2 * sum + w.linf * max_sq;
 }
@@ -106,7 +108,7 @@ double line_energy(double t, const LineTerm* terms, std::size_t n, const Weights
     const LineTerm& l = terms[i];
     const double c = l.c0 + l.c1 * t;
     if (!(c > 0)) return kInf;
-    accumulate((l.n0 + t * (l.n1 + t * l.n2)) / (c * c), c, l.area3, l.weight, w, sum, max_sq);
+    accumulate((l.n0 + t * (l.n1 + t * l.n2)) / (c * c), c, l.area3, l.weighted_area3, w, sum, max_sq);
   }
   return 0.5 * w.l2 * sum + w.linf * max_sq;
 }
@@ -192,7 +194,7 @@ double optimize_point(Eigen::Vector2d& p, const RingTriangle* ring, std::size_t 
       l.n1 = -r.len0_sq * d.dot(u1 + u2) + (r.len1_sq - r.len2_sq) * d.dot(u21);
       l.n2 = r.len0_sq;
       l.area3 = r.area3;
-      l.weight = r.weight;
+      l.weighted_area3 = r.area3 * r.weight;
       if (l.c1 < 0) hi = std::min(hi, -l.c0 / l.c1);
       if (l.c1 > 0) lo = std::max(lo, -l.c0 / l.c1);
       reach = std::max(reach, std::max(u1.squaredNorm(), u2.squaredNorm()));
@@ -225,48 +227,51 @@ void check_vertex_options(const char* function, const VertexOptimizationOptions&
   if (!ok) throw InvalidInput(std::string(function) + ": invalid VertexOptimizationOptions");
 }
 
-/// Ring of v in RingTriangle form, from raw positions (optimize_vertex, local_stretch).
-std::vector<RingTriangle> build_ring(const char* function, int v, const std::vector<int>& ring,
-                                     const std::vector<Eigen::Vector3d>& positions,
-                                     const std::vector<std::array<int, 3>>& triangles,
-                                     const std::vector<Eigen::Vector2d>& uv,
-                                     const std::vector<double>* vertex_weights) {
-  const std::string name(function);
+/// Ring of v in RingTriangle form, from raw positions (optimize_vertex, local_stretch), into `out`.
+void build_ring(const char* function, int v, const std::vector<int>& ring,
+                const std::vector<Eigen::Vector3d>& positions, const std::vector<std::array<int, 3>>& triangles,
+                const std::vector<Eigen::Vector2d>& uv, const std::vector<double>* vertex_weights,
+                std::vector<RingTriangle>& out) {
+  const auto fail = [function](const std::string& what) {
+    throw InvalidInput(std::string(function) + ": " + what);
+  };
   if (vertex_weights && vertex_weights->size() != positions.size()) {
-    throw InvalidInput(name + ": " + std::to_string(vertex_weights->size()) + " vertex weights for " +
-                       std::to_string(positions.size()) + " vertices");
+    fail(std::to_string(vertex_weights->size()) + " vertex weights for " + std::to_string(positions.size()) +
+         " vertices");
   }
   if (uv.size() != positions.size()) {
-    throw InvalidInput(name + ": " + std::to_string(uv.size()) + " uv coordinates for " +
-                       std::to_string(positions.size()) + " vertices");
+    fail(std::to_string(uv.size()) + " uv coordinates for " + std::to_string(positions.size()) + " vertices");
   }
-  if (v < 0 || static_cast<std::size_t>(v) >= uv.size()) {
-    throw InvalidInput(name + ": vertex " + std::to_string(v) + " out of range");
-  }
-  std::vector<RingTriangle> out;
-  out.reserve(ring.size());
+  if (v < 0 || static_cast<std::size_t>(v) >= uv.size()) fail("vertex " + std::to_string(v) + " out of range");
+  out.clear();
   for (int f : ring) {
-    if (f < 0 || static_cast<std::size_t>(f) >= triangles.size()) {
-      throw InvalidInput(name + ": ring triangle " + std::to_string(f) + " out of range");
-    }
+    if (f < 0 || static_cast<std::size_t>(f) >= triangles.size())
+      fail("ring triangle " + std::to_string(f) + " out of range");
     const auto& t = triangles[f];
     for (int i : t) {
-      if (i < 0 || static_cast<std::size_t>(i) >= uv.size()) {
-        throw InvalidInput(name + ": triangle " + std::to_string(f) + " has a vertex index out of range");
-      }
+      if (i < 0 || static_cast<std::size_t>(i) >= uv.size())
+        fail("triangle " + std::to_string(f) + " has a vertex index out of range");
     }
     const int corner = t[0] == v ? 0 : t[1] == v ? 1 : t[2] == v ? 2 : -1;
-    if (corner < 0) {
-      throw InvalidInput(name + ": ring triangle " + std::to_string(f) + " does not contain vertex " +
-                         std::to_string(v));
-    }
+    if (corner < 0)
+      fail("ring triangle " + std::to_string(f) + " does not contain vertex " + std::to_string(v));
     const int a = t[(corner + 1) % 3], b = t[(corner + 2) % 3];
     const TriangleMetric m = triangle_metric(positions[v], positions[a], positions[b]);
     const double weight =
         vertex_weights ? ((*vertex_weights)[v] + (*vertex_weights)[a] + (*vertex_weights)[b]) / 3 : 1.0;
     out.push_back({uv[a], uv[b], m.opposite_sq[0], m.opposite_sq[1], m.opposite_sq[2], m.area3, weight});
   }
-  return out;
+}
+
+/// Per-thread scratch of optimize_vertex() and local_stretch(), so that the per-vertex calls of
+/// coarse-to-fine allocate nothing once the largest ring has been seen.
+struct RingScratch {
+  std::vector<RingTriangle> ring;
+  std::vector<LineTerm> terms;
+};
+RingScratch& ring_scratch() {
+  thread_local RingScratch scratch;
+  return scratch;
 }
 
 }  // namespace
@@ -275,13 +280,14 @@ double optimize_vertex(int v, const std::vector<int>& ring, const std::vector<Ei
                        const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
                        const VertexOptimizationOptions& options, std::mt19937& rng) {
   check_vertex_options("optimize_vertex", options);
-  const std::vector<RingTriangle> r = build_ring("optimize_vertex", v, ring, positions, triangles, uv,
-                                                    options.vertex_weights);
+  RingScratch& scratch = ring_scratch();
+  const std::vector<RingTriangle>& r = scratch.ring;
+  build_ring("optimize_vertex", v, ring, positions, triangles, uv, options.vertex_weights, scratch.ring);
   if (!uv[v].allFinite())
     throw InvalidInput("optimize_vertex: uv of vertex " + std::to_string(v) + " not finite");
-  std::vector<LineTerm> terms(r.size());
+  if (scratch.terms.size() < r.size()) scratch.terms.resize(r.size());
   Eigen::Vector2d p = uv[v];
-  const double energy = optimize_point(p, r.data(), r.size(), options, rng, terms.data());
+  const double energy = optimize_point(p, r.data(), r.size(), options, rng, scratch.terms.data());
   uv[v] = p;
   return std::sqrt(energy);
 }
@@ -290,8 +296,8 @@ double local_stretch(int v, const std::vector<int>& ring, const std::vector<Eige
                      const std::vector<std::array<int, 3>>& triangles, const std::vector<Eigen::Vector2d>& uv,
                      const VertexOptimizationOptions& options) {
   check_vertex_options("local_stretch", options);
-  const std::vector<RingTriangle> r = build_ring("local_stretch", v, ring, positions, triangles, uv,
-                                                    options.vertex_weights);
+  std::vector<RingTriangle>& r = ring_scratch().ring;
+  build_ring("local_stretch", v, ring, positions, triangles, uv, options.vertex_weights, r);
   return std::sqrt(
       ring_energy(uv[v], r.data(), r.size(), ring_weights(r.data(), r.size(), blend_weight(options))));
 }

@@ -23,6 +23,7 @@ namespace {
 struct ParamArgs {
   ModelArgs common;
   bool no_baseline = false;
+  unsigned threads = 0;  // 0 = one per hardware thread
 };
 
 nlohmann::json stretch_json(const StretchValues& s) { return {{"l2", s.l2}, {"linf", s.linf}}; }
@@ -130,6 +131,7 @@ int run_param(const ParamArgs& args) {
   ParameterizationOptions options;
   apply_sampling(args.common, options);
   options.measure_mvc_baseline = !args.no_baseline;
+  options.threads = args.threads;
   ProgressBar bar("param", !args.common.quiet && !args.common.json);
   options.progress = bar.callback();
   const auto t0 = std::chrono::steady_clock::now();
@@ -180,6 +182,9 @@ CommandRunner add_param_command(CLI::App& app) {
       "DIR/<stem>.param.json per model. Open or non-manifold meshes are repaired first.");
   add_model_options(cmd, args->common);
   cmd->add_flag("--no-baseline", args->no_baseline, "Skip the full-patch MVC embedding used as stretch baseline");
+  cmd->add_option("--threads", args->threads,
+                  "Threads over the patches (default 0: all cores); the output is the same for any count")
+      ->check(CLI::Range(0u, 256u));
   return [args] { return run_param(*args); };
 }
 

@@ -158,6 +158,55 @@ TEST(ConsistentParameterization, RejectsBadInput) {
   }
 }
 
+// The patches run on several threads (ParameterizationOptions::threads), each with its own seeds: the result
+// is bit-identical whatever the thread count, and a failure is the one a sequential run reports.
+TEST(ConsistentParameterization, ThreadCountDoesNotChangeTheResult) {
+  const std::vector<ParameterizationInput> models = {test::automatic_input(test::torus(48, 24), "torus")};
+  ParameterizationOptions options;
+  options.threads = 1;
+  const auto one = parameterize_consistently(models, options);
+  ASSERT_EQ(one[0].patches.size(), 4u);
+  for (unsigned threads : {2u, 3u, 0u}) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    options.threads = threads;
+    const auto many = parameterize_consistently(models, options);
+    ASSERT_EQ(many[0].patches.size(), one[0].patches.size());
+    for (std::size_t p = 0; p < one[0].patches.size(); ++p) {
+      const PatchParameterization &a = one[0].patches[p], &b = many[0].patches[p];
+      EXPECT_EQ(a.vertices, b.vertices) << "patch " << p;
+      EXPECT_EQ(a.triangles, b.triangles) << "patch " << p;
+      ASSERT_EQ(a.uv.size(), b.uv.size()) << "patch " << p;
+      for (std::size_t v = 0; v < a.uv.size(); ++v) {
+        ASSERT_EQ(a.uv[v].x(), b.uv[v].x()) << "patch " << p << " vertex " << v;
+        ASSERT_EQ(a.uv[v].y(), b.uv[v].y()) << "patch " << p << " vertex " << v;
+      }
+      EXPECT_EQ(a.stretch.l2, b.stretch.l2) << "patch " << p;
+      EXPECT_EQ(a.stretch.linf, b.stretch.linf) << "patch " << p;
+    }
+  }
+}
+
+TEST(ConsistentParameterization, ThreadCountDoesNotChangeTheError) {
+  ParameterizationInput bad = test::automatic_input(test::sphere(3), "s");
+  bad.features = {bad.partition_points[2], bad.partition_points[0]};  // on the cut, in every patch
+  std::string sequential, parallel;
+  ParameterizationOptions options;
+  options.threads = 1;
+  try {
+    parameterize_consistently({bad}, options);
+  } catch (const InvalidInput& e) {
+    sequential = e.what();
+  }
+  options.threads = 2;
+  try {
+    parameterize_consistently({bad}, options);
+  } catch (const InvalidInput& e) {
+    parallel = e.what();
+  }
+  EXPECT_NE(sequential.find("lies on the partition cut"), std::string::npos) << sequential;
+  EXPECT_EQ(parallel, sequential);
+}
+
 class SharedMeshParameterization : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SharedMeshParameterization, EveryPatchIsAValidSquareAndSeamsAgree) {

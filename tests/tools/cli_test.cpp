@@ -265,6 +265,32 @@ class CliParam : public Cli {
   }
 };
 
+// --threads runs the patches on that many threads: the files are byte-identical for every count.
+TEST_F(CliParam, ThreadsGiveByteIdenticalOutput) {
+  std::string obj, json;
+  for (const char* threads : {"1", "2"}) {
+    const std::string out = dir_ + "/threads" + threads;
+    const Outcome r = geomip("param --quiet --no-baseline --threads " + std::string(threads) + " '" + spot_ +
+                             "' -o '" + out + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto j = nlohmann::json::parse(slurp(out + "/spot.param.json"));
+    j.erase("seconds");  // the only field that may differ
+    if (obj.empty()) {
+      obj = slurp(out + "/spot.param.obj");
+      json = j.dump();
+    } else {
+      EXPECT_EQ(slurp(out + "/spot.param.obj"), obj);
+      EXPECT_EQ(j.dump(), json);
+    }
+  }
+  const Outcome bad = geomip("param --quiet --threads -1 '" + spot_ + "' -o '" + dir_ + "/bad'");
+  EXPECT_FALSE(bad.crashed);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+  EXPECT_NE(bad.err.find("--threads"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/bad"));
+}
+
 TEST_F(CliParam, WritesObjWithPerPatchTexcoordsAndJson) {
   const std::string out = dir_ + "/out";
   const Outcome r = geomip("param --quiet '" + spot_ + "' -o '" + out + "'");

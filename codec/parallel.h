@@ -15,7 +15,8 @@ namespace geomip::codec {
 /// Calls f(i) for i in [0, n) on up to `max_threads` threads (0 = one per hardware thread), then joins.
 /// When threads cannot be started the caller's thread does the remaining tasks. The first exception a task
 /// throws is rethrown here after every thread has finished; tasks already running finish, no new one starts.
-/// The project's one fork-join loop (codec's per-patch work, `geomip rd`'s jobs).
+/// The codec's fork-join loop (its per-patch work, `geomip rd`'s jobs); param has its own (for_each_patch in
+/// consistent_parameterization.cpp), which rethrows the lowest failing index's exception instead.
 template <typename F>
 void parallel_for(int n, int max_threads, F&& f) {
   int threads = max_threads > 0 ? max_threads : static_cast<int>(std::thread::hardware_concurrency());

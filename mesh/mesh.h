@@ -37,7 +37,8 @@ BoundingBox referenced_bounding_box(const TriMesh& mesh);
 std::vector<Eigen::Vector3d> vertex_normals(const TriMesh& mesh);
 
 /// Progress callback for long operations: `stage` is a short human-readable name, `fraction` ∈ [0,1] of that
-/// stage. Called from the calling thread; may be empty.
+/// stage. Called from the calling thread unless the operation's options say otherwise (parameterize_consistently
+/// calls it from its worker threads, one call at a time); may be empty.
 using ProgressCallback = std::function<void(const char* stage, double fraction)>;
 
 }  // namespace geomip

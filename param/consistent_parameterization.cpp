@@ -73,9 +73,20 @@ void for_each_patch(std::size_t n, unsigned threads, const Task& task) {
   const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t count = std::min<std::size_t>(threads > 0 ? threads : hardware, n);
   std::vector<std::thread> pool;
+  // Joins every started thread on every way out, so none is left joinable (std::terminate) or running on
+  // this frame's locals.
+  struct JoinAll {
+    std::vector<std::thread>& pool;
+    ~JoinAll() {
+      for (auto& thread : pool) {
+        if (thread.joinable()) thread.join();
+      }
+    }
+  } join_all{pool};
   try {
+    pool.reserve(count - 1);
     for (std::size_t t = 1; t < count; ++t) pool.emplace_back(worker);
-  } catch (const std::system_error&) {  // no more threads: the ones started and this one do the rest
+  } catch (const std::exception&) {  // no more threads (system_error, bad_alloc): those started and this one do the rest
   }
   worker();
   for (auto& thread : pool) thread.join();
@@ -312,8 +323,8 @@ PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size
     if (k < 0) continue;
     if (on_boundary[v]) {
       throw InvalidInput("parameterize_consistently: feature " + std::to_string(k) + " of model '" + in.name +
-                         "' (vertex " + std::to_string(in.features[k]) +
-                         ") lies on the partition cut; features must be inside a patch");
+                         "' (vertex " + std::to_string(in.features[k]) + ") lies on the partition cut (patch " +
+                         std::to_string(p) + "); features must be inside a patch");
     }
     w.feature_patch[k] = static_cast<int>(p);
     pw.features.push_back(static_cast<int>(v));

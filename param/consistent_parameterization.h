@@ -88,9 +88,11 @@ struct ParameterizationOptions {
   unsigned seed = 1;
   /// Threads over the patches of a model (progressive meshes and base embeddings, then coarse-to-fine, final
   /// sweeps and MVC baseline); 0 = one per hardware thread. Patches are independent, so the result is
-  /// bit-identical for every thread count.
+  /// bit-identical for every thread count, and so is a failure: the exception thrown is the one a
+  /// `threads = 1` run throws (the lowest failing patch's).
   unsigned threads = 0;
-  /// Called from one thread at a time (possibly a worker thread, not the caller's).
+  /// Called from one thread at a time (possibly a worker thread, not the caller's). An exception it throws
+  /// fails the patch it reports on; patches already running finish before it reaches the caller.
   ProgressCallback progress;
 };
 

@@ -102,7 +102,9 @@ TEST(ConsistentParameterization, TorusGivesFourValidSquares) {
 
 // Two differently deformed spheres with corresponding partition points and features: after the warp the
 // features sit at identical (u,v).
-TEST(ConsistentParameterization, FeaturesAlignAcrossModels) {
+// A sphere and a deformation of it (same vertex ids), with 4 corresponding partition points on the equator
+// and 4 corresponding features off it.
+std::vector<ParameterizationInput> deformed_sphere_pair() {
   const TriMesh a = test::sphere(4);
   TriMesh b = a;
   for (auto& p : b.positions) p = Eigen::Vector3d(1.6 * p.x() + 0.2 * p.y() * p.y(), p.y(), 0.7 * p.z() + 0.3 * p.x() * p.y());
@@ -111,13 +113,17 @@ TEST(ConsistentParameterization, FeaturesAlignAcrossModels) {
   models[1].mesh = b;
   models[0].name = "a";
   models[1].name = "b";
-  // Corresponding points: same vertex ids (b is a deformation of a), on the equator z = 0 and off it.
   const Eigen::Vector3d corners[4] = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
   const Eigen::Vector3d features[4] = {{0.5, 0.5, 0.7}, {-0.5, 0.3, 0.8}, {0.2, -0.6, -0.75}, {-0.4, -0.4, -0.8}};
   for (auto& m : models) {
     for (const auto& c : corners) m.partition_points.push_back(test::nearest_vertex(a, c.normalized()));
     for (const auto& f : features) m.features.push_back(test::nearest_vertex(a, f.normalized()));
   }
+  return models;
+}
+
+TEST(ConsistentParameterization, FeaturesAlignAcrossModels) {
+  const std::vector<ParameterizationInput> models = deformed_sphere_pair();
   const auto result = parameterize_consistently(models);
   ASSERT_EQ(result.size(), 2u);
   expect_valid(result[0], "a");
@@ -186,6 +192,45 @@ TEST(ConsistentParameterization, ThreadCountDoesNotChangeTheResult) {
   }
 }
 
+// Two models with features: what the patch threads write besides the uv (features, MVC figures, seams) is
+// the same for 1, 2 and more threads than patches.
+TEST(ConsistentParameterization, ThreadCountDoesNotChangeFeaturesOrFigures) {
+  const std::vector<ParameterizationInput> models = deformed_sphere_pair();
+  ParameterizationOptions options;
+  options.threads = 1;
+  const auto one = parameterize_consistently(models, options);
+  ASSERT_EQ(one.size(), 2u);
+  for (unsigned threads : {2u, 16u}) {
+    options.threads = threads;
+    const auto many = parameterize_consistently(models, options);
+    ASSERT_EQ(many.size(), 2u);
+    for (std::size_t m = 0; m < 2; ++m) {
+      SCOPED_TRACE("threads " + std::to_string(threads) + ", model " + std::to_string(m));
+      ASSERT_EQ(many[m].features.size(), one[m].features.size());
+      for (std::size_t k = 0; k < one[m].features.size(); ++k) {
+        EXPECT_EQ(many[m].features[k].vertex, one[m].features[k].vertex) << "feature " << k;
+        EXPECT_EQ(many[m].features[k].patch, one[m].features[k].patch) << "feature " << k;
+        EXPECT_EQ(many[m].features[k].uv.x(), one[m].features[k].uv.x()) << "feature " << k;
+        EXPECT_EQ(many[m].features[k].uv.y(), one[m].features[k].uv.y()) << "feature " << k;
+      }
+      EXPECT_EQ(many[m].seam_mismatches, one[m].seam_mismatches);
+      EXPECT_EQ(many[m].warp_events, one[m].warp_events);
+      ASSERT_EQ(many[m].patches.size(), one[m].patches.size());
+      for (std::size_t p = 0; p < one[m].patches.size(); ++p) {
+        const PatchParameterization &a = one[m].patches[p], &b = many[m].patches[p];
+        EXPECT_EQ(a.uv, b.uv) << "patch " << p;
+        EXPECT_EQ(a.mvc_stretch.l2, b.mvc_stretch.l2) << "patch " << p;
+        EXPECT_EQ(a.mvc_stretch.linf, b.mvc_stretch.linf) << "patch " << p;
+        EXPECT_EQ(a.mvc_fallback, b.mvc_fallback) << "patch " << p;
+        EXPECT_EQ(a.boundary_off_chord, b.boundary_off_chord) << "patch " << p;
+        EXPECT_EQ(a.base_vertices, b.base_vertices) << "patch " << p;
+      }
+    }
+  }
+}
+
+// Both patches of the sphere fail (the features lie on the cut, which every patch touches): the error is the
+// lowest patch's, as in a sequential run, whichever thread fails first.
 TEST(ConsistentParameterization, ThreadCountDoesNotChangeTheError) {
   ParameterizationInput bad = test::automatic_input(test::sphere(3), "s");
   bad.features = {bad.partition_points[2], bad.partition_points[0]};  // on the cut, in every patch
@@ -203,7 +248,7 @@ TEST(ConsistentParameterization, ThreadCountDoesNotChangeTheError) {
   } catch (const InvalidInput& e) {
     parallel = e.what();
   }
-  EXPECT_NE(sequential.find("lies on the partition cut"), std::string::npos) << sequential;
+  EXPECT_NE(sequential.find("lies on the partition cut (patch 0)"), std::string::npos) << sequential;
   EXPECT_EQ(parallel, sequential);
 }
 

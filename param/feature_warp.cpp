@@ -631,7 +631,7 @@ void check_inputs(const std::vector<Tri>& triangles, const std::vector<Vec2>& uv
   auto fail = [](const std::string& what) { throw InvalidInput("warp_features: " + what); };
   if (targets.size() != features.size()) fail("one target per feature is required");
   if (!(options.collision_distance > 0) || !(options.event_tolerance > 0) ||
-      !(options.repair_stop_fraction > 0 && options.repair_stop_fraction < 1)) {
+      !(options.repair_stop_fraction > 0 && options.repair_stop_fraction < 1) || options.reorder_passes < 0) {
     fail("invalid options");
   }
   for (const Vec2& p : uv) {
@@ -685,7 +685,7 @@ namespace {
 
 /// One pass of `warp_features`: the features move in the order given. Sets `proved` to the number of
 /// unreached features whose reason is a proof (no order can reach them) and lists in `failed` the others that
-/// it gave up, in the order it gave them up. Stops early (`aborted`) once `limit` features are unreached: such
+/// it gave up, in the order they moved. Stops early (`aborted`) once `limit` features are unreached: such
 /// a pass cannot beat one that left `limit` unreached.
 FeatureWarpResult warp_pass(const std::vector<Tri>& triangles, std::vector<Vec2>& uv, const std::vector<int>& features,
                             const std::vector<Vec2>& targets, const FeatureWarpOptions& options, std::size_t limit,
@@ -918,7 +918,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
   // Passes: each starts again from the input uv and moves first the features the previous pass left unreached
   // (in the order they moved), then the others in the previous pass's order; only the last pass steps aside.
   const int n = int(features.size());
-  const int passes = 1 + std::max(0, options.reorder_passes);
+  const int passes = 1 + options.reorder_passes;
   std::vector<int> order(n);
   for (int k = 0; k < n; ++k) order[k] = k;
   FeatureWarpResult best, effort;

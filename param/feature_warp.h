@@ -68,7 +68,7 @@ struct FeatureWarpOptions {
   /// that stall are the ones whose way leads through the stars that earlier moves dragged and squeezed. Only
   /// the last pass steps aside (`sidesteps`); the earlier ones give a stalled feature up at once. A pass stops
   /// as soon as it has left as many features unreached as the best one so far; the pass with the fewest
-  /// unreached features is kept. 0: one pass in the given order, with steps aside.
+  /// unreached features is kept. 0: one pass in the given order, with steps aside. Negative: InvalidInput.
   int reorder_passes = 3;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after
@@ -102,7 +102,8 @@ struct FeatureWarpResult {
   /// boundary vertices would be flipped or flat with every feature at its target; the features of it that have
   /// to move are reported and not moved), or where and why the warp gave up on it.
   std::vector<std::string> unreached_reasons;
-  /// Passes run (see `FeatureWarpOptions::reorder_passes`): 1 when the first pass reached every target. The
+  /// Passes run (see `FeatureWarpOptions::reorder_passes`): 1 when the first pass reached every target or
+  /// every target it left unreached is provably unreachable (no order can help). The
   /// result is the best pass's; `events`, `repaired_vertices`, `steps`, `detours` and
   /// `min_warp_triangle_area` are over all passes.
   int passes = 0;

@@ -403,6 +403,11 @@ TEST(WarpFeatures, RejectsInvalidInputWithoutTouchingUv) {
   Tris out_of_range = e.triangles;
   out_of_range[0][0] = int(e.uv.size());
   rejects(out_of_range, {f}, {Vec2(0.5, 0.5)});
+  FeatureWarpOptions negative_passes;
+  negative_passes.reorder_passes = -1;
+  std::vector<Vec2> uv = e.uv;
+  EXPECT_THROW(warp_features(e.triangles, uv, {f}, {Vec2(0.5, 0.5)}, negative_passes), InvalidInput);
+  EXPECT_EQ(uv, e.uv);
 }
 
 }  // namespace

@@ -69,13 +69,13 @@ struct ConvertResult {
   double param_seconds = 0, resample_seconds = 0, encode_seconds = 0;
 };
 
-/// \throw InvalidInput / SolverFailure from the parameterization; std::invalid_argument never escapes (the
-/// images come from resample_geometry()).
 /// The mesh the viewer's frame (ConvertOptions::up, front) is guessed from: the first model as read when it
 /// was repaired (a filled hole — the camel head's neck cut faired into a dome — would hide the cut that tells
 /// a neck from a crown), else the first model. Requires !models.inputs.empty().
 const TriMesh& view_frame_mesh(const PreparedModels& models);
 
+/// \throw InvalidInput / SolverFailure from the parameterization; std::invalid_argument never escapes (the
+/// images come from resample_geometry()).
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options);
 
 }  // namespace geomip::tools

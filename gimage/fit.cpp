@@ -26,12 +26,25 @@ constexpr const char* kFunction = "fit_geometry_images";
 constexpr std::size_t kChunk = 4096;
 /// Rounds of the flip guard (each halves the offsets of the flipped triangles' vertices) before they are reset.
 constexpr int kFlipRounds = 8;
-/// Barycentric points per remesh triangle for the remesh→original direction: the centroid and the three
-/// points halfway between it and the corners (a degree-2-exact-ish symmetric rule; equal weights).
-constexpr std::array<std::array<double, 3>, 4> kTrianglePoints{{{1.0 / 3, 1.0 / 3, 1.0 / 3},
-                                                                {2.0 / 3, 1.0 / 6, 1.0 / 6},
-                                                                {1.0 / 6, 2.0 / 3, 1.0 / 6},
-                                                                {1.0 / 6, 1.0 / 6, 2.0 / 3}}};
+/// Points on each remesh triangle for the remesh→original direction: Dunavant's 6-point rule (exact for degree 4,
+/// i.e. for the square of a quadratic deviation from the plane); barycentric coordinates and weights.
+constexpr double kA = 0.445948490915965, kB = 0.091576213509771;
+constexpr std::array<std::array<double, 4>, 6> kTriangleRule{{{kA, kA, 1 - 2 * kA, 0.223381589678011},
+                                                             {kA, 1 - 2 * kA, kA, 0.223381589678011},
+                                                             {1 - 2 * kA, kA, kA, 0.223381589678011},
+                                                             {kB, kB, 1 - 2 * kB, 0.109951743655322},
+                                                             {kB, 1 - 2 * kB, kB, 0.109951743655322},
+                                                             {1 - 2 * kB, kB, kB, 0.109951743655322}}};
+/// Metro (and measure_surface_distance()) samples a surface's vertices besides its faces (10 per face by
+/// default), each vertex with the weight of a face sample: the vertices' share of the remesh→original average.
+constexpr double kMetroFaceSamplesPerTriangle = 10;
+
+/// A point of the remesh, fixed in barycentric coordinates of one triangle, with its weight in the average.
+struct RemeshPoint {
+  std::size_t triangle = 0;
+  std::array<double, 3> b{};
+  double weight = 0;
+};
 
 [[noreturn]] void fail(const std::string& what) { throw InvalidInput(std::string(kFunction) + ": " + what); }
 
@@ -175,14 +188,34 @@ FitResult fit_geometry_images(const TriMesh& original, const GeometryImages& ima
   std::vector<double> delta(nv, 0);
   std::vector<Eigen::Vector3d> x = p0;
   std::vector<Equation> to_remesh(original_points.size());
-  std::vector<Equation> to_original(triangles.size() * kTrianglePoints.size());
-  std::vector<double> to_original_weight(to_original.size());
-  for (std::size_t f = 0; f < triangles.size(); ++f) {
-    for (std::size_t s = 0; s < kTrianglePoints.size(); ++s) {
-      to_original_weight[f * kTrianglePoints.size() + s] =
-          0.5 * unfitted_normals[f].norm() / (remesh_area * kTrianglePoints.size());
+  std::vector<RemeshPoint> remesh_points;
+  {
+    std::vector<std::pair<std::size_t, int>> corner_of(nv, {0, -1});  // a triangle and slot per vertex
+    std::size_t active_vertices = 0;
+    for (std::size_t f = 0; f < triangles.size(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        if (corner_of[triangles[f][k]].second < 0) {
+          corner_of[triangles[f][k]] = {f, k};
+          ++active_vertices;
+        }
+      }
+    }
+    const double face_share = kMetroFaceSamplesPerTriangle * static_cast<double>(triangles.size());
+    const double total = face_share + static_cast<double>(active_vertices);
+    for (std::size_t f = 0; f < triangles.size(); ++f) {
+      const double area_share = 0.5 * unfitted_normals[f].norm() / remesh_area;
+      for (const auto& r : kTriangleRule) {
+        remesh_points.push_back({f, {r[0], r[1], r[2]}, r[3] * area_share * face_share / total});
+      }
+    }
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (corner_of[v].second < 0) continue;
+      RemeshPoint point{corner_of[v].first, {0, 0, 0}, 1 / total};
+      point.b[corner_of[v].second] = 1;
+      remesh_points.push_back(point);
     }
   }
+  std::vector<Equation> to_original(remesh_points.size());
 
   // Linearizes both directions at the current positions x; returns the two sampled RMS distances.
   auto linearize = [&]() -> std::pair<double, double> {
@@ -207,8 +240,8 @@ FitResult fit_geometry_images(const TriMesh& original, const GeometryImages& ima
       e.distance2 = (hit.point - q).squaredNorm();
     });
     parallel_for(to_original.size(), threads, [&](std::size_t i) {
-      const auto& t = triangles[i / kTrianglePoints.size()];
-      const auto& b = kTrianglePoints[i % kTrianglePoints.size()];
+      const auto& t = triangles[remesh_points[i].triangle];
+      const auto& b = remesh_points[i].b;
       Eigen::Vector3d y = Eigen::Vector3d::Zero(), base = Eigen::Vector3d::Zero();
       for (int k = 0; k < 3; ++k) {
         y += b[k] * x[t[k]];
@@ -217,14 +250,14 @@ FitResult fit_geometry_images(const TriMesh& original, const GeometryImages& ima
       const SurfaceQuery::Closest hit = original_query.closest(y);
       const Eigen::Vector3d& m = original_normals[hit.triangle];
       Equation& e = to_original[i];
-      e.triangle = i / kTrianglePoints.size();
+      e.triangle = remesh_points[i].triangle;
       for (int k = 0; k < 3; ++k) e.coef[k] = b[k] * m.dot(normals[t[k]]);
       e.rhs = m.dot(hit.point - base);
       e.distance2 = (hit.point - y).squaredNorm();
     });
     double sum1 = 0, sum2 = 0;
     for (const Equation& e : to_remesh) sum1 += e.distance2;
-    for (std::size_t i = 0; i < to_original.size(); ++i) sum2 += to_original_weight[i] * to_original[i].distance2;
+    for (std::size_t i = 0; i < to_original.size(); ++i) sum2 += remesh_points[i].weight * to_original[i].distance2;
     return {std::sqrt(sum1 / static_cast<double>(to_remesh.size())), std::sqrt(sum2)};
   };
 
@@ -248,7 +281,7 @@ FitResult fit_geometry_images(const TriMesh& original, const GeometryImages& ima
     };
     const double w1 = 1.0 / static_cast<double>(to_remesh.size());
     for (const Equation& e : to_remesh) add(e, w1);
-    for (std::size_t i = 0; i < to_original.size(); ++i) add(to_original[i], to_original_weight[i]);
+    for (std::size_t i = 0; i < to_original.size(); ++i) add(to_original[i], remesh_points[i].weight);
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(9 * triangles.size() + 4 * edges.size() + static_cast<std::size_t>(unknowns));
     for (std::size_t f = 0; f < triangles.size(); ++f) {

@@ -48,6 +48,7 @@ int run_remesh(const RemeshArgs& args) {
                                         : "--level " + std::to_string(args.level) + " is outside [0, " +
                                               std::to_string(kMaxGeometryImageLevel) + "]");
   }
+  if (args.fit && !uniform) throw InvalidInput("--fit moves the uniform remesh's samples: give --level K too");
   if (args.draco != 0 && !args.glb) throw InvalidInput("--draco compresses the GLB: give --glb too");
   if (args.draco < 0 || args.draco > 30)
     throw InvalidInput("--draco=" + std::to_string(args.draco) + ": position bits must be in 1..30");

@@ -1,6 +1,7 @@
 // End-to-end tests of the geomip program: exit codes, one-line errors, JSON keys, atomic outputs.
 #include "codec/pack.h"
 #include "gimage/exr_io.h"
+#include "gimage/surface_distance.h"
 #include "mesh/mesh_io.h"
 #include "mesh/mesh_topology.h"
 #include "tests/param/test_meshes.h"
@@ -525,6 +526,39 @@ TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
   EXPECT_EQ(ga.parts.size(), 2u);
   EXPECT_EQ(gb.parts.size(), 2u);
   EXPECT_TRUE(fs::exists(out + "/b.normals.exr"));
+}
+
+// remesh --fit (gimage/fit.h): the same face list as without it and for both models of the set, closed, genus 0,
+// and closer to each original (symmetric RMS; the ratios measured: docs/measurements.md, "Fitted geometry
+// images"). --fit without a uniform remesh exits 2 with one line.
+TEST_F(CliGimage, FitKeepsTheConsistentFaceListAndGetsCloser) {
+  const std::string corr = sphere_pair();
+  const std::string out = dir_ + "/out";
+  for (const char* fit : {"--fit", "--no-fit"}) {
+    const Outcome r = geomip("remesh --quiet --points '" + corr + "' --level 4 " + fit + " -o '" + out + "/" +
+                             (fit + 2) + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  std::vector<std::array<int, 3>> faces;
+  for (const char* name : {"a", "b"}) {
+    SCOPED_TRACE(name);
+    const TriMesh original = read_mesh(dir_ + "/" + name + ".obj");
+    const TriMesh fitted = read_mesh(out + "/fit/" + name + ".M4.obj");
+    const TriMesh plain = read_mesh(out + "/no-fit/" + name + ".M4.obj");
+    if (faces.empty()) faces = plain.triangles;
+    EXPECT_EQ(fitted.triangles, faces);
+    EXPECT_EQ(plain.triangles, faces);
+    const TopologyReport t = analyze_topology(fitted);
+    EXPECT_EQ(t.boundary_edges, 0u);
+    EXPECT_TRUE(t.manifold);
+    EXPECT_EQ(t.genus, 0);
+    const double ratio =
+        measure_surface_distance(original, fitted).rms / measure_surface_distance(original, plain).rms;
+    RecordProperty(std::string(name) + "_rms_ratio", std::to_string(ratio));
+    EXPECT_LT(ratio, 0.6);
+  }
+  expect_bad_input("remesh --points '" + corr + "' --adaptive 0.01 --fit -o '" + out + "/x'", "--fit");
+  EXPECT_FALSE(fs::exists(out + "/x"));
 }
 
 // A user layout in CORR.json: the cube's 6 faces over test::sphere()'s corners 0..7 (kept by write_mesh), one

@@ -930,6 +930,30 @@ TEST_F(CliPack, CodecSwitchesForAblations) {
                    "--tangential-shift");
 }
 
+// convert --fit: the whole pack decodes to the same faces as without it and closer to the mesh (symmetric RMS;
+// the ratio measured: docs/measurements.md, "Fitted geometry images"); --fit=x exits 2 with one line.
+TEST_F(CliPack, FitDecodesCloserToTheMesh) {
+  const TriMesh original = read_mesh(spot_);
+  std::vector<TriMesh> decoded;
+  for (const char* fit : {"--fit", "--no-fit"}) {
+    const std::string pack = dir_ + "/fit.gip", obj = dir_ + "/fit.obj";
+    const Outcome c = geomip("convert -q '" + spot_ + "' --level 5 --no-normals " + fit + " -o '" + pack + "'");
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    const Outcome d = geomip("decode -q '" + pack + "' -o '" + obj + "'");
+    ASSERT_EQ(d.exit_code, 0) << d.err;
+    decoded.push_back(read_mesh(obj));
+  }
+  EXPECT_EQ(decoded[0].triangles, decoded[1].triangles);
+  const double ratio =
+      measure_surface_distance(original, decoded[0]).rms / measure_surface_distance(original, decoded[1]).rms;
+  RecordProperty("spot_rms_ratio", std::to_string(ratio));
+  EXPECT_LT(ratio, 0.85);
+  const Outcome bad = geomip("convert -q '" + spot_ + "' --level 3 --fit=x -o '" + dir_ + "/bad.gip'");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/bad.gip"));
+}
+
 // --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch
 // count): watertight, genus 0, K·2·4^L faces, V = K·4^L + 2; bad K exit 2 with one line and nothing written.
 TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {

@@ -323,12 +323,16 @@ FitResult fit_geometry_images(const TriMesh& original, const GeometryImages& ima
       delta[v] = d;
     }
     result.flip_guarded = 0;
-    for (int round = 0; round <= kFlipRounds; ++round) {
+    // After kFlipRounds halvings the offsets are reset to 0; that ends, since with every offset 0 the remesh is
+    // the unfitted one (its zero-area triangles are not checked: they have no normal to turn).
+    for (int round = 0;; ++round) {
       for (std::size_t v = 0; v < nv; ++v) x[v] = p0[v] + delta[v] * normals[v];
       std::vector<int> flipped;
       for (std::size_t f = 0; f < triangles.size(); ++f) {
-        if (!(face_normal(x, triangles[f]).dot(unfitted_normals[f]) > 0)) {
-          flipped.insert(flipped.end(), triangles[f].begin(), triangles[f].end());
+        if (unfitted_normals[f].squaredNorm() > 0 && !(face_normal(x, triangles[f]).dot(unfitted_normals[f]) > 0)) {
+          for (int v : triangles[f]) {
+            if (delta[v] != 0) flipped.push_back(v);
+          }
         }
       }
       if (flipped.empty()) break;

@@ -6,13 +6,14 @@
 // regions every remesh triangle lies on one side of the surface (its sag) and the symmetric RMS distance
 // (surface_distance.h, the paper's PSNR, §5 of ../shared/seed/consistent-mesh-parameterizations.txt) pays all
 // of it. Shifting the samples by about half the sag cuts the RMS (in 1D, a parabola's chordal interpolant
-// shifted by the best constant has about 0.45× its RMS error).
+// shifted by the best constant has √(1/180 ÷ 1/30) ≈ 0.41× its RMS error).
 //
 // Method (Gauss–Newton on point-to-plane residuals, as ICP): dense points on the original (its vertices and
 // area-uniform random points on its faces) are projected onto the remesh; each projection gives one linear
 // equation in the offsets of the 3 vertices of the triangle it lands in (barycentric weights · normals, along
-// the hit triangle's normal). Points on the remesh (fixed barycentric points of every triangle, weighted by
-// area) are projected onto the original likewise (along the original triangle's normal). Both directions are
+// the hit triangle's normal). Points on the remesh (Dunavant's 6-point rule on every triangle, exact for the
+// square of a quadratic sag, weighted by area, plus its vertices with the weight Metro's sampling gives them)
+// are projected onto the original likewise (along the normal of the original triangle hit). Both directions are
 // averages over their samples and are added; a small Laplacian (offset differences across remesh edges) and
 // Tikhonov term keep the system positive definite. The normal equations are solved exactly (sparse LDLT),
 // the samples re-projected, and this repeated `iterations` times.
@@ -23,7 +24,8 @@
 //   same face list.
 // - |offset| ≤ FitOptions::max_offset × the vertex's mean incident edge length in the level's remesh.
 // - No triangle of the fitted remesh has its normal turned by 90° or more from the same triangle of the
-//   unfitted remesh (offsets of the vertices of such triangles are halved until none is, else reset to 0).
+//   unfitted remesh (offsets of the vertices of such triangles are halved up to 8 times, then reset to 0;
+//   checked in double before the positions are rounded to float).
 // - Deterministic: the same inputs and options give bit-identical results, whatever `threads` is.
 // - Correspondence: a sample moves only along the normal, by at most a fraction of an edge, so it stays over the
 //   same surface point; the (u,v) of every sample and the face list are unchanged, and a consistent set keeps
@@ -34,9 +36,10 @@
 // Coarser remeshes of a fitted level-n image (every 2^(n−k)-th sample) are not refitted: the offsets are fitted
 // for the level-n triangles.
 //
-// Cost: a CGAL AABB tree of the remesh per iteration and one closest-point query per sample per iteration
-// (face samples: samples_per_triangle × remesh triangles on each side), a sparse LDLT of the
-// vertices × vertices system (2D-grid-like fill). Memory: O(samples + vertices).
+// Cost: iterations + 1 passes, each an AABB tree of the remesh (SurfaceQuery) and one closest-point query per
+// point (original side: its vertices + samples_per_triangle × remesh triangles; remesh side: 6 per triangle +
+// its vertices), and per iteration a sparse LDLT of the vertices × vertices system (2D-grid-like fill). Memory:
+// O(points + vertices), all points' linearizations held at once (timings and peak memory: docs/measurements.md).
 #pragma once
 
 #include "gimage/resample.h"

@@ -337,6 +337,20 @@ std::vector<double> distances_to_surface(const TriMesh& surface, const std::vect
   return distances;
 }
 
+std::vector<Eigen::Vector3d> sample_surface_points(const TriMesh& mesh, std::size_t face_samples,
+                                                   std::uint64_t seed) {
+  validate(mesh, "surface");
+  if (face_samples == 0) throw InvalidInput("sample_surface_points: face_samples must be > 0");
+  SurfaceDistanceOptions options;
+  options.face_samples = face_samples;
+  options.seed = seed;
+  const Samples s = sample_surface(mesh, options, 0);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(s.points.size());
+  for (const Point& q : s.points) points.emplace_back(q.x(), q.y(), q.z());
+  return points;
+}
+
 struct SurfaceQuery::Impl {
   explicit Impl(const TriMesh& m) : mesh(m), surface(mesh), normals(vertex_normals(mesh)) {}
   TriMesh mesh;  // a copy: the query does not depend on the caller's mesh staying alive
@@ -407,5 +421,9 @@ Eigen::Vector3d SurfaceQuery::normal_near(const Eigen::Vector3d& p) const {
   return sum.norm() > 0 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d(n.normalized());
 }
 
-}  // namespace geomip
+SurfaceQuery::Closest SurfaceQuery::closest(const Eigen::Vector3d& p) const {
+  const auto [point, primitive] = impl_->surface.tree().closest_point_and_primitive(to_point(p));
+  return {Eigen::Vector3d(point.x(), point.y(), point.z()), impl_->surface.triangle_of(primitive)};
+}
 
+}  // namespace geomip

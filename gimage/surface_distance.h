@@ -97,6 +97,12 @@ SurfaceDistance measure_surface_distance(const TriMesh& original, const TriMesh&
 /// \throw InvalidInput as measure_surface_distance() for a bad `surface`.
 std::vector<double> distances_to_surface(const TriMesh& surface, const std::vector<Eigen::Vector3d>& points);
 
+/// The samples measure_surface_distance() takes on a surface (first stream): every referenced vertex, then
+/// `face_samples` area-uniform random points on the faces (face by face), no edge samples. The same seed gives
+/// the same points. \pre face_samples > 0. \throw InvalidInput as measure_surface_distance() for a bad mesh.
+std::vector<Eigen::Vector3d> sample_surface_points(const TriMesh& mesh, std::size_t face_samples,
+                                                   std::uint64_t seed);
+
 /// Line and closest-point queries against one surface: its nonzero-area triangles in the same kind of AABB
 /// tree as measure_surface_distance(), built once. Queries are const and may run concurrently. Used by the
 /// encoder's normal-mesh resampling (codec/normal_mesh.h), which asks where a line along a predicted normal
@@ -119,6 +125,14 @@ class SurfaceQuery {
   /// interpolated barycentrically in the closest triangle and renormalized (as resample_geometry()'s normal
   /// maps); the triangle's own normal where that sum vanishes.
   Eigen::Vector3d normal_near(const Eigen::Vector3d& p) const;
+
+  /// A closest point of the surface to `p` (exact point–triangle distance) and the triangle that holds it, as
+  /// an index into the constructor's mesh (never a zero-area triangle). `p` must be finite.
+  struct Closest {
+    Eigen::Vector3d point;
+    std::size_t triangle = 0;
+  };
+  Closest closest(const Eigen::Vector3d& p) const;
 
  private:
   struct Impl;

@@ -33,6 +33,7 @@ struct ConvertArgs {
   int frame_steps = ConvertOptions{}.frame_steps;
   int tangential_shift = ConvertOptions{}.tangential_shift;
   bool no_orientation_weights = false;
+  bool fit = false;
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
   std::string front;  ///< +x, -x, +y, -y, +z, -z; empty: from the shape
 };
@@ -102,6 +103,7 @@ int run_convert(const ConvertArgs& args) {
   options.frame_steps = args.frame_steps;
   options.tangential_shift = args.tangential_shift;
   options.orientation_weights = !args.no_orientation_weights;
+  options.fit = args.fit;
   options.up = up;
   options.front = front;
   options.progress = bar.callback();
@@ -172,6 +174,10 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_option("--normal-mesh-reach", args->normal_mesh_reach,
                   "Largest move of a normal-mesh sample, in sample spacings of its level")
       ->check(CLI::Range(0.0, 4.0));
+  cmd->add_flag("--fit,!--no-fit", args->fit,
+                "Move every level-N sample along its normal so that the level-N remesh is a least-squares fit of "
+                "the surface, not its interpolant (gimage/fit.h, after the normal-mesh resampling; hole-mask "
+                "quads left out); --no-fit: samples on the surface (default)");
   // Codec tools, for ablations (docs/codec-v3.md); the defaults are the codec's best measured.
   cmd->add_option("--frame-steps", args->frame_steps,
                   "Code the details of the finest STEPS wavelet steps in local (normal, tangent) frames "

@@ -4,6 +4,7 @@
 // DIR/<stem>.adaptive.obj (gimage/adaptive_remesh.h): watertight, consistently oriented, one face list for
 // all models of a consistent set.
 #include "gimage/adaptive_remesh.h"
+#include "gimage/fit.h"
 #include "gimage/resample.h"
 #include "gimage/uniform_remesh.h"
 #include "param/consistent_parameterization.h"
@@ -36,6 +37,7 @@ struct RemeshArgs {
   bool ply = false;
   bool glb = false;
   int draco = 0;  ///< the GLB's Draco position bits, 0 = no Draco
+  bool fit = false;  ///< least-squares fitted samples (gimage/fit.h) for the uniform remesh
 };
 
 int run_remesh(const RemeshArgs& args) {
@@ -46,6 +48,7 @@ int run_remesh(const RemeshArgs& args) {
                                         : "--level " + std::to_string(args.level) + " is outside [0, " +
                                               std::to_string(kMaxGeometryImageLevel) + "]");
   }
+  if (args.fit && !uniform) throw InvalidInput("--fit moves the uniform remesh's samples: give --level K too");
   if (args.draco != 0 && !args.glb) throw InvalidInput("--draco compresses the GLB: give --glb too");
   if (args.draco < 0 || args.draco > 30)
     throw InvalidInput("--draco=" + std::to_string(args.draco) + ": position bits must be in 1..30");
@@ -75,10 +78,18 @@ int run_remesh(const RemeshArgs& args) {
     t0 = std::chrono::steady_clock::now();
     ResampleOptions resample;
     resample.normals = args.glb;  // the GLB's normals come from the normal maps
-    const GeometryImages images = resample_geometry(result[i], args.level, resample);
+    GeometryImages images = resample_geometry(result[i], args.level, resample);
+    const double resample_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    double fit_seconds = 0;
+    if (args.fit) {
+      t0 = std::chrono::steady_clock::now();
+      images = fit_geometry_images(result[i].mesh, images).images;
+      fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    t0 = std::chrono::steady_clock::now();
     const UniformRemeshResult remesh = uniform_remesh(images, args.level);
     const double remesh_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        resample_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() +
                              ".M" + std::to_string(args.level);
     write_file_atomically(stem + ".obj",
@@ -99,14 +110,18 @@ int run_remesh(const RemeshArgs& args) {
                        {"level", args.level},
                        {"vertices", remesh.mesh.positions.size()},
                        {"faces", remesh.mesh.triangles.size()},
-                       {"remesh_seconds", remesh_seconds}};
+                       {"remesh_seconds", remesh_seconds},
+                       {"fit", args.fit}};
+      if (args.fit) j["fit_seconds"] = fit_seconds;
       if (args.ply) j["ply"] = stem + ".ply";
       if (args.glb) j["glb"] = stem + ".glb";
       summary.push_back(j);
     } else if (!args.common.quiet) {
-      std::printf("remesh %s → %s.obj: %zu vertices, %zu faces (resampled and remeshed in %.3f s)\n",
+      std::printf("remesh %s → %s.obj: %zu vertices, %zu faces (resampled and remeshed in %.3f s",
                   models.paths[i].c_str(), stem.c_str(), remesh.mesh.positions.size(),
                   remesh.mesh.triangles.size(), remesh_seconds);
+      if (args.fit) std::printf(", fitted in %.3f s", fit_seconds);
+      std::printf(")\n");
     }
   }
   double adaptive_tree_seconds = 0;  // resampling, quad errors and the shared tree, all models
@@ -187,6 +202,10 @@ CommandRunner add_remesh_command(CLI::App& app) {
   cmd->add_flag("--measure-samples", args->measure_samples,
                 "Adaptive: measure each quad's geometry image samples too, not only the mesh vertices in it "
                 "(stricter than the paper's eq. 4-5)");
+  cmd->add_flag("--fit,!--no-fit", args->fit,
+                "Uniform remesh: move every sample along its normal so that the remesh is a least-squares fit of "
+                "the surface, not its interpolant (gimage/fit.h; same faces, seams welded); --no-fit: samples on "
+                "the surface (default)");
   cmd->add_flag("--ply", args->ply, "Also write DIR/<stem>.M<K>.ply (binary)");
   cmd->add_flag("--glb", args->glb,
                 "Also write DIR/<stem>.M<K>.glb: glTF with each patch's (u,v) as TEXCOORD_0 and the normal "

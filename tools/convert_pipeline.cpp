@@ -2,6 +2,7 @@
 
 #include "codec/normal_mesh.h"
 #include "codec/parallel.h"
+#include "gimage/fit.h"
 #include "gimage/hole_mask.h"
 #include "gimage/resample.h"
 #include "gimage/surface_distance.h"
@@ -75,6 +76,24 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
   }
 }
 
+/// fit_geometry_images() against `surface`, the quads of `mask` (at `mask_level` ≤ the images' level) left out.
+GeometryImages fit_images(const GeometryImages& images, const TriMesh& surface, const HoleMaskResult& mask,
+                          int mask_level) {
+  FitOptions fit;
+  if (!mask.quads.empty()) {
+    const int level = images.geometry.front().level, shift = level - mask_level;
+    const int n = 1 << level, coarse = 1 << mask_level;
+    fit.hole_quads.assign(mask.quads.size(), std::vector<std::uint8_t>(static_cast<std::size_t>(n) * n, 0));
+    for (std::size_t p = 0; p < mask.quads.size(); ++p) {
+      for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i)
+          fit.hole_quads[p][j * n + i] = mask.quads[p][(j >> shift) * coarse + (i >> shift)];
+      }
+    }
+  }
+  return fit_geometry_images(surface, images, fit).images;
+}
+
 }  // namespace
 
 const TriMesh& view_frame_mesh(const PreparedModels& models) {
@@ -119,8 +138,9 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
     GeometryImages images = resample_geometry(params[m], options.level, resample);
     if (normal_mesh_steps > 0) normal_mesh(images, params[m].mesh, normal_mesh_steps, options, result);
     HoleMaskResult mask;
-    if (m < models.originals.size() && !models.originals[m].triangles.empty())
-      mask = hole_mask(params[m], models.originals[m], mask_level);
+    const bool repaired = m < models.originals.size() && !models.originals[m].triangles.empty();
+    if (repaired) mask = hole_mask(params[m], models.originals[m], mask_level);
+    if (options.fit) images = fit_images(images, repaired ? models.originals[m] : params[m].mesh, mask, mask_level);
     result.masked_quads.push_back(mask.masked_quads);
     inputs.push_back(pack_model_input(models.inputs[m].name, images, &mask, options.normals));
     inputs.back().hole_mask_level = mask_level;

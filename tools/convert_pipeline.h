@@ -42,6 +42,10 @@ struct ConvertOptions {
   int normal_mesh_steps = -1;
   /// Largest move of a normal-mesh sample, in local sample spacings (NormalMeshOptions::max_shift).
   double normal_mesh_max_shift = 0.5;
+  /// Least-squares fitted samples (gimage/fit.h), after the normal-mesh resampling: the level-N remesh fits the
+  /// surface (the mesh before repair, the hole mask's quads left out) instead of interpolating it. Any number of
+  /// models (offsets along the normals keep the correspondences).
+  bool fit = false;
   /// The viewer's frame stored as each model's normalization (codec::PackModelInfo::normalization): the up
   /// axis (kAuto: from the first model's shape) and front of the first model (upright_rotation()), one
   /// rotation for every model of the pack alike (a consistent set keeps one pose), then each model's rotated

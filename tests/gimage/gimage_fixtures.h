@@ -81,9 +81,8 @@ inline bool same_bits(const float* a, const float* b) {
   return std::memcmp(a, b, 3 * sizeof(float)) == 0;
 }
 
-// Shared sides and corners: bit-identical floats in every patch that holds them, in geometry and normals; and
-// the copied side is the right one (close to what its own patch's triangles give).
-inline void expect_seams_bit_identical(const ModelParameterization& m, const GeometryImages& g) {
+// Shared sides (corners included): bit-identical floats in every patch that holds them, in geometry and normals.
+inline void expect_shared_sides_bit_identical(const GeometryImages& g) {
   for (const auto* images : {&g.geometry, &g.normals}) {
     for (const SideLink& link : g.adjacency) {
       const GeometryImage& a = (*images)[link.patch];
@@ -107,6 +106,12 @@ inline void expect_seams_bit_identical(const ModelParameterization& m, const Geo
       }
     }
   }
+}
+
+// Shared sides and corners: bit-identical floats in every patch that holds them, in geometry and normals; and
+// the corners are the corner vertices' exact positions.
+inline void expect_seams_bit_identical(const ModelParameterization& m, const GeometryImages& g) {
+  expect_shared_sides_bit_identical(g);
   for (std::size_t p = 0; p < m.patches.size(); ++p) {
     const int last = g.geometry[p].size() - 1;
     const int ij[4][2] = {{0, 0}, {last, 0}, {last, last}, {0, last}};

@@ -1,6 +1,7 @@
 // End-to-end tests of the geomip program: exit codes, one-line errors, JSON keys, atomic outputs.
 #include "codec/pack.h"
 #include "gimage/exr_io.h"
+#include "gimage/surface_distance.h"
 #include "mesh/mesh_io.h"
 #include "mesh/mesh_topology.h"
 #include "tests/param/test_meshes.h"
@@ -527,6 +528,39 @@ TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
   EXPECT_TRUE(fs::exists(out + "/b.normals.exr"));
 }
 
+// remesh --fit (gimage/fit.h): the same face list as without it and for both models of the set, closed, genus 0,
+// and closer to each original (symmetric RMS; the ratios measured: docs/measurements.md, "Fitted geometry
+// images"). --fit without a uniform remesh exits 2 with one line.
+TEST_F(CliGimage, FitKeepsTheConsistentFaceListAndGetsCloser) {
+  const std::string corr = sphere_pair();
+  const std::string out = dir_ + "/out";
+  for (const char* fit : {"--fit", "--no-fit"}) {
+    const Outcome r = geomip("remesh --quiet --points '" + corr + "' --level 4 " + fit + " -o '" + out + "/" +
+                             (fit + 2) + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  std::vector<std::array<int, 3>> faces;
+  for (const char* name : {"a", "b"}) {
+    SCOPED_TRACE(name);
+    const TriMesh original = read_mesh(dir_ + "/" + name + ".obj");
+    const TriMesh fitted = read_mesh(out + "/fit/" + name + ".M4.obj");
+    const TriMesh plain = read_mesh(out + "/no-fit/" + name + ".M4.obj");
+    if (faces.empty()) faces = plain.triangles;
+    EXPECT_EQ(fitted.triangles, faces);
+    EXPECT_EQ(plain.triangles, faces);
+    const TopologyReport t = analyze_topology(fitted);
+    EXPECT_EQ(t.boundary_edges, 0u);
+    EXPECT_TRUE(t.manifold);
+    EXPECT_EQ(t.genus, 0);
+    const double ratio =
+        measure_surface_distance(original, fitted).rms / measure_surface_distance(original, plain).rms;
+    RecordProperty(std::string(name) + "_rms_ratio", std::to_string(ratio));
+    EXPECT_LT(ratio, 0.6);
+  }
+  expect_bad_input("remesh --points '" + corr + "' --adaptive 0.01 --fit -o '" + out + "/x'", "--fit");
+  EXPECT_FALSE(fs::exists(out + "/x"));
+}
+
 // A user layout in CORR.json: the cube's 6 faces over test::sphere()'s corners 0..7 (kept by write_mesh), one
 // face list for both models; a bad layout exits 2 with one line and writes nothing.
 TEST_F(CliGimage, CorrespondenceLayoutGivesSixPatchesAndOneFaceList) {
@@ -894,6 +928,30 @@ TEST_F(CliPack, CodecSwitchesForAblations) {
   expect_bad_input("convert -q '" + spot_ + "' --level 4 --frame-steps 5 -o '" + pack + "'", "--frame-steps");
   expect_bad_input("convert -q '" + spot_ + "' --level 4 --tangential-shift 9 -o '" + pack + "'",
                    "--tangential-shift");
+}
+
+// convert --fit: the whole pack decodes to the same faces as without it and closer to the mesh (symmetric RMS;
+// the ratio measured: docs/measurements.md, "Fitted geometry images"); --fit=x exits 2 with one line.
+TEST_F(CliPack, FitDecodesCloserToTheMesh) {
+  const TriMesh original = read_mesh(spot_);
+  std::vector<TriMesh> decoded;
+  for (const char* fit : {"--fit", "--no-fit"}) {
+    const std::string pack = dir_ + "/fit.gip", obj = dir_ + "/fit.obj";
+    const Outcome c = geomip("convert -q '" + spot_ + "' --level 5 --no-normals " + fit + " -o '" + pack + "'");
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    const Outcome d = geomip("decode -q '" + pack + "' -o '" + obj + "'");
+    ASSERT_EQ(d.exit_code, 0) << d.err;
+    decoded.push_back(read_mesh(obj));
+  }
+  EXPECT_EQ(decoded[0].triangles, decoded[1].triangles);
+  const double ratio =
+      measure_surface_distance(original, decoded[0]).rms / measure_surface_distance(original, decoded[1]).rms;
+  RecordProperty("spot_rms_ratio", std::to_string(ratio));
+  EXPECT_LT(ratio, 0.85);
+  const Outcome bad = geomip("convert -q '" + spot_ + "' --level 3 --fit=x -o '" + dir_ + "/bad.gip'");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/bad.gip"));
 }
 
 // --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch

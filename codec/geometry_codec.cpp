@@ -227,9 +227,11 @@ std::int64_t round_shift(std::int64_t v, int s) {
 /// The frame whose normal is N (any length; identity rows for N = 0).
 Frame make_frame(std::int64_t n0, std::int64_t n1, std::int64_t n2) {
   constexpr std::int32_t one = 1 << kFrameBits;
-  const int bits = static_cast<int>(
-      std::bit_width(static_cast<std::uint64_t>(std::max({std::abs(n0), std::abs(n1), std::abs(n2)}))));
-  if (bits > 20) n0 >>= bits - 20, n1 >>= bits - 20, n2 >>= bits - 20;  // floor halvings: < 2^20
+  const auto largest = static_cast<std::uint64_t>(std::max({std::abs(n0), std::abs(n1), std::abs(n2)}));
+  if (largest >> 20) {  // more than 20 bits: floor halvings to < 2^20
+    const int bits = static_cast<int>(std::bit_width(largest));
+    n0 >>= bits - 20, n1 >>= bits - 20, n2 >>= bits - 20;
+  }
   const std::uint64_t len = isqrt(static_cast<std::uint64_t>(n0 * n0 + n1 * n1 + n2 * n2));
   if (len == 0) return {one, 0, 0, 0, one, 0, 0, 0, one};
   const std::int64_t n[3] = {round_div(n0 * one, static_cast<std::int64_t>(len)),
@@ -384,9 +386,12 @@ struct FrameField {
           // Differences of garbage (a corrupt stream) can reach 2^33: keep the cross product below 2^63.
           // Never active for streams of this encoder (quantized values < 2^25).
           for (std::int64_t* v : {a, b}) {
-            const int bits = static_cast<int>(std::bit_width(
-                static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}))));
-            if (bits > 30) v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
+            const auto largest =
+                static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}));
+            if (largest >> 30) {  // more than 30 bits
+              const int bits = static_cast<int>(std::bit_width(largest));
+              v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
+            }
           }
           normals[p][static_cast<std::size_t>(idx)] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
                                                        a[0] * b[1] - a[1] * b[0]};

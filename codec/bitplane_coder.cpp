@@ -17,6 +17,9 @@ namespace {
 
 constexpr std::uint8_t kSig = 1;     // node state: known significant
 constexpr std::uint8_t kActive = 2;  // node state: covers at least one coded sample
+// Decoder: bits 2–4 of a node's state count its significant neighbours at its level (left, right, up,
+// down), kept by mark_significant(); the encoder's nodes leave them 0 (it counts in node_context()).
+constexpr int kNbrShift = 2;
 constexpr int kMaxQuadLevels = 16;
 
 /// A sample of the significant-sample list. flags: bit c = channel c significant, bit 3 + c = its sign.
@@ -36,6 +39,7 @@ struct Band {
   int lw[kMaxQuadLevels] = {}, lh[kMaxQuadLevels] = {};
   std::size_t lbase[kMaxQuadLevels] = {};
   std::vector<std::uint8_t> state;
+  std::vector<std::uint8_t> kids;  // per node of level ≥ 1: bit q set when child q (2x + (q & 1), 2y + (q >> 1)) is active
   std::vector<std::int8_t> msb;  // encoder: highest set bit of the node's max magnitude, −1 if zero
   int parent = -1;
   std::vector<std::uint32_t> lis, lis_next;
@@ -43,6 +47,17 @@ struct Band {
   std::size_t refine_count = 0;
 
   std::size_t node(int l, int x, int y) const { return lbase[l] + static_cast<std::size_t>(y) * lw[l] + x; }
+  /// Decoder: sets kSig at node (l, x, y) (not significant before) and counts it at its neighbours.
+  void mark_significant(int l, int x, int y) {
+    std::uint8_t* const at = state.data() + node(l, x, y);
+    *at |= kSig;
+    const int row = lw[l];
+    constexpr std::uint8_t one = 1u << kNbrShift;
+    if (x > 0) at[-1] = static_cast<std::uint8_t>(at[-1] + one);
+    if (x + 1 < row) at[1] = static_cast<std::uint8_t>(at[1] + one);
+    if (y > 0) *(at - row) = static_cast<std::uint8_t>(*(at - row) + one);
+    if (y + 1 < lh[l]) at[row] = static_cast<std::uint8_t>(at[row] + one);
+  }
   std::uint32_t grid_index(int x, int y, int size) const {
     return static_cast<std::uint32_t>((y0 + dy * y) * size + x0 + dx * x);
   }
@@ -160,14 +175,21 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
     b.state.assign(total, 0);
     const auto& mask = coded[b.patch];
     for (int y = 0; y < b.h; ++y) {
-      for (int x = 0; x < b.w; ++x) {
-        if (mask[b.grid_index(x, y, size)]) b.state[b.node(0, x, y)] = kActive;
-      }
+      const std::uint8_t* const row = mask.data() + b.grid_index(0, y, size);
+      std::uint8_t* const out = b.state.data() + b.node(0, 0, y);
+      for (int x = 0; x < b.w; ++x) out[x] = row[static_cast<std::size_t>(b.dx) * x] ? kActive : 0;
     }
+    b.kids.assign(total, 0);
     for (int l = 1; l < b.levels; ++l) {
       for (int y = 0; y < b.lh[l - 1]; ++y) {
-        for (int x = 0; x < b.lw[l - 1]; ++x)
-          b.state[b.node(l, x >> 1, y >> 1)] |= b.state[b.node(l - 1, x, y)];
+        const std::uint8_t* const child = b.state.data() + b.node(l - 1, 0, y);
+        std::uint8_t* const parent = b.state.data() + b.node(l, 0, y >> 1);
+        std::uint8_t* const kids = b.kids.data() + b.node(l, 0, y >> 1);
+        for (int x = 0; x < b.lw[l - 1]; ++x) {
+          // child & kActive is 0 or 2: shifted to bit (x & 1) + 2·(y & 1) of its parent's kids.
+          parent[x >> 1] |= child[x];
+          kids[x >> 1] |= static_cast<std::uint8_t>((child[x] & kActive) << ((x & 1) + 2 * (y & 1)) >> 1);
+        }
       }
     }
     const int top = b.levels - 1;
@@ -476,7 +498,7 @@ class PlaneCoder {
               }
               if (p > kMaxCoefficientPlane) throw Corrupt{};
             }
-            band.state[band.node(k.l, k.x, k.y)] |= kSig;
+            band.mark_significant(k.l, k.x, k.y);
             if (k.l == 0) {
               band.lsp.push_back(Sample{band.grid_index(k.x, k.y, size_), {0, 0, 0}, {0, 0, 0}, 0});
               k.c = 0;
@@ -587,9 +609,9 @@ class PlaneCoder {
     Context* const chan = &chan_ctx_[band.cls * 3 * 2];
     // The band's and its parent's quadtree shapes in locals, and node_context() over them.
     const int levels = band.levels;
-    int lw[kMaxQuadLevels], lh[kMaxQuadLevels];
+    int lw[kMaxQuadLevels];
     std::size_t lbase[kMaxQuadLevels];
-    for (int i = 0; i < levels; ++i) lw[i] = band.lw[i], lh[i] = band.lh[i], lbase[i] = band.lbase[i];
+    for (int i = 0; i < levels; ++i) lw[i] = band.lw[i], lbase[i] = band.lbase[i];
     // Per level nl of this band: the parent band's node covering (x, y) is (x, y) >> pshift[nl] at level
     // nl − 1 (level 0 for nl = 0), inside pw[nl] × ph[nl] (0 × 0 when the parent has no such level).
     const Band* const pb = band.parent >= 0 ? &bands_[static_cast<std::size_t>(band.parent)] : nullptr;
@@ -608,15 +630,9 @@ class PlaneCoder {
       return lbase[nl] + static_cast<std::size_t>(ny) * static_cast<std::size_t>(lw[nl]) +
              static_cast<std::size_t>(nx);
     };
-    const auto context = [&](int nl, int nx, int ny) {  // = node_context(band, nl, nx, ny)
-      const std::uint8_t* const at = st + node(nl, nx, ny);
-      const int w = lw[nl], h = lh[nl];
-      int nbr = 0;
-      if (nx > 0) nbr += at[-1] & kSig;
-      if (nx + 1 < w) nbr += at[1] & kSig;
-      if (ny > 0) nbr += *(at - w) & kSig;
-      if (ny + 1 < h) nbr += at[w] & kSig;
-      nbr = std::min(nbr, 2);
+    // = node_context(band, nl, nx, ny) for the node at st[at]: its neighbour count is in its state byte.
+    const auto context = [&](std::size_t at, int nl, int nx, int ny) {
+      const int nbr = std::min(st[at] >> kNbrShift, 2);
       const int px = nx >> pshift[nl], py = ny >> pshift[nl];
       const int par = px < pw[nl] && py < ph[nl]
                           ? pbase[nl][static_cast<std::size_t>(py) * static_cast<std::size_t>(pw[nl]) +
@@ -625,7 +641,14 @@ class PlaneCoder {
                           : 0;
       return lctx[nl] + nbr * 2 + par;
     };
-    Frame stack[kMaxQuadLevels];
+    const std::uint8_t* const kids = band.kids.data();
+    // A split node: its active children not processed yet (bit q: child q), and whether one was significant.
+    struct Split {
+      std::uint16_t x, y;
+      std::uint8_t l, left;
+      bool any;
+    };
+    Split stack[kMaxQuadLevels];
     for (std::size_t n = 0; n < lis_size; ++n) {
       const std::uint32_t packed = lis[n];
       int l = static_cast<int>(packed >> 28), x = static_cast<int>((packed >> 14) & 0x3FFF),
@@ -634,11 +657,13 @@ class PlaneCoder {
       int depth = 0;
       while (true) {
         // Test node (l, x, y); split it (or read its sample) when significant.
-        if (!inferred && !d.decode(node_ctx_[context(l, x, y)])) {
+        const std::size_t at = node(l, x, y);
+        if (!inferred && !d.decode(node_ctx_[context(at, l, x, y)])) {
           band.lis_next.push_back(pack(l, x, y));
         } else {
           if (!inferred && p > kMaxCoefficientPlane) throw Corrupt{};
-          st[node(l, x, y)] |= kSig;
+          band.mark_significant(l, x, y);
+          if (depth > 0) stack[depth - 1].any = true;  // (l, x, y) is a child of the innermost split node
           if (l == 0) {
             Sample sm{band.grid_index(x, y, size_), {0, 0, 0}, {0, 0, 0}, 0};
             bool any = false;
@@ -652,48 +677,25 @@ class PlaneCoder {
             }
             band.lsp.push_back(sm);
           } else {
-            Frame& f = stack[depth++];
+            Split& f = stack[depth++];
             f.x = static_cast<std::uint16_t>(x);
             f.y = static_cast<std::uint16_t>(y);
             f.l = static_cast<std::uint8_t>(l);
-            f.last = -1;
+            f.left = kids[at];
             f.any = false;
-            f.remaining = 0;
-            const int cl = l - 1;
-            for (int q = 0; q < 4; ++q) {
-              const int cx = 2 * x + (q & 1), cy = 2 * y + (q >> 1);
-              if (cx < lw[cl] && cy < lh[cl] && (st[node(cl, cx, cy)] & kActive)) ++f.remaining;
-            }
           }
         }
         // The next node: the next active child of the innermost split node with children left.
-        bool found = false;
-        while (depth > 0) {
-          Frame& f = stack[depth - 1];
-          const int cl = f.l - 1;
-          if (f.last >= 0) {
-            const int lx = 2 * f.x + (f.last & 1), ly = 2 * f.y + (f.last >> 1);
-            f.any = f.any || (st[node(cl, lx, ly)] & kSig);
-          }
-          if (f.remaining == 0) {
-            --depth;
-            continue;
-          }
-          int q = f.last + 1;
-          for (;; ++q) {
-            const int cx = 2 * f.x + (q & 1), cy = 2 * f.y + (q >> 1);
-            if (cx < lw[cl] && cy < lh[cl] && (st[node(cl, cx, cy)] & kActive)) break;
-          }
-          f.last = static_cast<std::int8_t>(q);
-          --f.remaining;
-          l = cl;
-          x = 2 * f.x + (q & 1);
-          y = 2 * f.y + (q >> 1);
-          inferred = f.remaining == 0 && !f.any;
-          found = true;
-          break;
-        }
-        if (!found) break;
+        while (depth > 0 && stack[depth - 1].left == 0) --depth;
+        if (depth == 0) break;
+        Split& f = stack[depth - 1];
+        const int q = std::countr_zero(static_cast<unsigned>(f.left));
+        f.left = static_cast<std::uint8_t>(f.left & (f.left - 1));
+        l = f.l - 1;
+        x = 2 * f.x + (q & 1);
+        y = 2 * f.y + (q >> 1);
+        // The last active child is significant for sure when no sibling was.
+        inferred = f.left == 0 && !f.any;
       }
     }
     std::swap(band.lis, band.lis_next);

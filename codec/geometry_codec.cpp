@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
+#include <utility>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -211,7 +213,10 @@ std::uint64_t isqrt(std::uint64_t v) {
 /// round(num / den) for den > 0, halves up (floor((2·num + den) / (2·den))).
 std::int64_t round_div(std::int64_t num, std::int64_t den) {
   const std::int64_t a = 2 * num + den, b = 2 * den;
-  return a >= 0 ? a / b : -((-a + b - 1) / b);
+  // Floor division without a branch on the sign (random for frame components): the truncated quotient,
+  // one less when the remainder is negative (a < 0, inexact).
+  const std::int64_t q = a / b, r = a % b;
+  return q - (r < 0);
 }
 
 /// round(v / 2^s), halves up (s ≥ 0).
@@ -222,9 +227,11 @@ std::int64_t round_shift(std::int64_t v, int s) {
 /// The frame whose normal is N (any length; identity rows for N = 0).
 Frame make_frame(std::int64_t n0, std::int64_t n1, std::int64_t n2) {
   constexpr std::int32_t one = 1 << kFrameBits;
-  const int bits = static_cast<int>(
-      std::bit_width(static_cast<std::uint64_t>(std::max({std::abs(n0), std::abs(n1), std::abs(n2)}))));
-  if (bits > 20) n0 >>= bits - 20, n1 >>= bits - 20, n2 >>= bits - 20;  // floor halvings: < 2^20
+  const auto largest = static_cast<std::uint64_t>(std::max({std::abs(n0), std::abs(n1), std::abs(n2)}));
+  if (largest >> 20) {  // more than 20 bits: floor halvings to < 2^20
+    const int bits = static_cast<int>(std::bit_width(largest));
+    n0 >>= bits - 20, n1 >>= bits - 20, n2 >>= bits - 20;
+  }
   const std::uint64_t len = isqrt(static_cast<std::uint64_t>(n0 * n0 + n1 * n1 + n2 * n2));
   if (len == 0) return {one, 0, 0, 0, one, 0, 0, 0, one};
   const std::int64_t n[3] = {round_div(n0 * one, static_cast<std::int64_t>(len)),
@@ -258,10 +265,15 @@ struct FrameField {
   WaveletFilter filter = WaveletFilter::kCubic;
   const Ownership* own = nullptr;
   std::vector<int> start;                                         // start plane of step k at [k − 1]
-  std::vector<std::vector<std::array<std::int64_t, 3>>> normals;  // [patch][grid index]
-  std::vector<std::uint8_t> ready;                                // [k − 1]: normals of step k computed
-  // Frames built so far (an incremental decoder reconstructs many times from the same normals).
-  mutable std::vector<std::vector<Frame>> frames;        // [patch][grid index]
+  std::size_t samples = 0;  // grid positions per patch
+  int max_threads = 1;      // compute() and to_xyz() run their patches on up to this many threads
+  // [patch][grid index]; left uninitialized (no zero-fill of 24 B per position): only the coded framed
+  // positions of computed steps are written (compute()), and only those are read (frame()).
+  std::vector<std::unique_ptr<std::array<std::int64_t, 3>[]>> normals;
+  std::vector<std::uint8_t> ready;  // [k − 1]: normals of step k computed
+  // Frames built so far (an incremental decoder reconstructs many times from the same normals); an entry is
+  // valid where built[p][i] is set (the rest stays uninitialized).
+  mutable std::vector<std::unique_ptr<Frame[]>> frames;  // [patch][grid index]
   mutable std::vector<std::vector<std::uint8_t>> built;  // [patch][grid index]: frames[...] is valid
 
   /// The frame at a framed position (built when first needed: only non-zero coefficients need one; the
@@ -269,8 +281,8 @@ struct FrameField {
   const Frame& frame(std::size_t p, int idx) const {
     const auto i = static_cast<std::size_t>(idx);
     if (built[p].empty()) {  // first frame of this patch
-      frames[p].resize(normals[p].size());
-      built[p].assign(normals[p].size(), 0);
+      frames[p] = std::make_unique_for_overwrite<Frame[]>(samples);
+      built[p].assign(samples, 0);
     }
     if (!built[p][i]) {
       const auto& n = normals[p][i];
@@ -292,7 +304,8 @@ struct FrameField {
 
   /// Framed coefficients (n, t1, t2) of the ready steps, at coded positions, back to xyz (steps ≥ min_k).
   void to_xyz(std::vector<PatchCoefficients>& coefs, int min_k = 1) const {
-    for (std::size_t p = 0; p < coefs.size(); ++p) {
+    parallel_for(static_cast<int>(coefs.size()), max_threads, [&](int pi) {
+      const auto p = static_cast<std::size_t>(pi);
       for (int k = std::max(min_k, 1); k <= frame_steps; ++k) {
         if (!ready[static_cast<std::size_t>(k - 1)]) continue;
         for_step(k, [&](int, int, int idx) {
@@ -313,7 +326,7 @@ struct FrameField {
           }
         });
       }
-    }
+    });
   }
 
   /// The frames of the steps that start at `plane`, from `view` (the decoder's coefficients before that
@@ -329,7 +342,7 @@ struct FrameField {
     if (min_k == 0) return;
     std::vector<PatchCoefficients>& w = view;  // scratch: changed in place
     to_xyz(w, min_k);
-    const std::size_t size = (std::size_t{1} << level) + 1, samples = size * size;
+    const std::size_t size = (std::size_t{1} << level) + 1;  // samples: the member (size²)
     for (const auto& [copy, owner] : own->copies) {
       for (int c = 0; c < 3; ++c)
         w[copy / samples][c][copy % samples] = w[owner / samples][c][owner % samples];
@@ -337,12 +350,20 @@ struct FrameField {
     const int s = 1 << (min_k - 1), sub_level = level - (min_k - 1), sub_steps = steps - (min_k - 1);
     const std::size_t sub = (std::size_t{1} << sub_level) + 1;
     const int m = 1 << level;
-    for (std::size_t p = 0; p < w.size(); ++p) {
-      std::array<std::vector<std::int32_t>, 3> g;
+    parallel_for(static_cast<int>(w.size()), max_threads, [&](int pi) {
+      const auto p = static_cast<std::size_t>(pi);
+      // The grid at spacing s: w's own channels at s = 1 (w is scratch), else a gathered sub-grid.
+      std::array<std::vector<std::int32_t>, 3> gathered;
+      std::array<std::span<std::int32_t>, 3> g;
       for (int c = 0; c < 3; ++c) {
-        g[c].resize(sub * sub);
-        for (std::size_t y = 0; y < sub; ++y) {
-          for (std::size_t x = 0; x < sub; ++x) g[c][y * sub + x] = w[p][c][(y * s) * size + x * s];
+        if (s == 1) {
+          g[c] = w[p][c];
+        } else {
+          gathered[c].resize(sub * sub);
+          for (std::size_t y = 0; y < sub; ++y) {
+            for (std::size_t x = 0; x < sub; ++x) gathered[c][y * sub + x] = w[p][c][(y * s) * size + x * s];
+          }
+          g[c] = gathered[c];
         }
         wavelet_inverse(g[c], sub_level, sub_steps, filter);
       }
@@ -365,15 +386,18 @@ struct FrameField {
           // Differences of garbage (a corrupt stream) can reach 2^33: keep the cross product below 2^63.
           // Never active for streams of this encoder (quantized values < 2^25).
           for (std::int64_t* v : {a, b}) {
-            const int bits = static_cast<int>(std::bit_width(
-                static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}))));
-            if (bits > 30) v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
+            const auto largest =
+                static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}));
+            if (largest >> 30) {  // more than 30 bits
+              const int bits = static_cast<int>(std::bit_width(largest));
+              v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
+            }
           }
           normals[p][static_cast<std::size_t>(idx)] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
                                                        a[0] * b[1] - a[1] * b[0]};
         });
       }
-    }
+    });
     for (int k = min_k; k <= frame_steps; ++k) {
       if (start[static_cast<std::size_t>(k - 1)] == plane) ready[static_cast<std::size_t>(k - 1)] = 1;
     }
@@ -417,8 +441,9 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
   ff.ready.assign(static_cast<std::size_t>(h.frame_steps), 0);
   if (h.frame_steps > 0) {
     const std::size_t size = static_cast<std::size_t>(grid_size(h.level));
-    ff.normals.assign(static_cast<std::size_t>(h.num_patches),
-                      std::vector<std::array<std::int64_t, 3>>(size * size));
+    ff.samples = size * size;
+    ff.normals.resize(static_cast<std::size_t>(h.num_patches));
+    for (auto& n : ff.normals) n = std::make_unique_for_overwrite<std::array<std::int64_t, 3>[]>(ff.samples);
     ff.frames.resize(static_cast<std::size_t>(h.num_patches));
     ff.built.resize(static_cast<std::size_t>(h.num_patches));
   }
@@ -660,6 +685,7 @@ Status GeometryDecoder::reset(const GeometryCodecHeader& header, const GeometryD
   st->options = options;
   st->own = seam_ownership(header.level, header.num_patches, header.seams);
   st->ff = make_frame_field(header, st->own);
+  st->ff.max_threads = options.max_threads;
   State* raw = st.get();
   const DecodeHook hook = [raw](int plane, std::vector<PatchCoefficients>& view) {
     raw->ff.compute(plane, view);
@@ -680,16 +706,27 @@ Status GeometryDecoder::update(std::span<const std::span<const std::uint8_t>> se
 void GeometryDecoder::result(DecodedGeometry& out, int drop_finest_steps) {
   out = DecodedGeometry{};
   if (!s_) return;
+  build_result(drop_finest_steps);
+  out = s_->cached;
+}
+
+void GeometryDecoder::take_result(DecodedGeometry& out, int drop_finest_steps) {
+  out = DecodedGeometry{};
+  if (!s_) return;
+  build_result(drop_finest_steps);
+  out = std::move(s_->cached);
+  s_->cached = DecodedGeometry{};
+  s_->cached_drop = -1;  // the cache is gone: the next result() reconstructs
+}
+
+void GeometryDecoder::build_result(int drop_finest_steps) {
   State& st = *s_;
   const GeometryCodecHeader& header = st.header;
   const int level = header.level, np = header.num_patches, steps = header.steps;
   const std::size_t size = static_cast<std::size_t>(grid_size(level)), samples = size * size;
   const int drop = std::min(drop_finest_steps < 0 ? st.options.drop_finest_steps : drop_finest_steps, steps);
   std::vector<std::uint64_t> versions = st.bits.patch_versions();
-  if (versions == st.versions && drop == st.cached_drop) {
-    out = st.cached;
-    return;
-  }
+  if (versions == st.versions && drop == st.cached_drop) return;
   std::vector<PatchCoefficients>& coefs = st.scratch;  // reused: no allocation per call
   st.bits.reconstruct(coefs);
   const Ownership& own = st.own;
@@ -757,7 +794,6 @@ void GeometryDecoder::result(DecodedGeometry& out, int drop_finest_steps) {
   res.detail_level = finest_step > steps ? level - steps : level - finest_step + 1;
   st.versions = std::move(versions);
   st.cached_drop = drop;
-  out = st.cached;
 }
 
 Status decode_geometry(const GeometryCodecHeader& header,
@@ -768,7 +804,7 @@ Status decode_geometry(const GeometryCodecHeader& header,
   GeometryDecoder decoder;
   if (decoder.reset(header, options) != Status::kOk) return Status::kInvalidArgument;
   const Status status = decoder.update(segments, partial_tail);
-  decoder.result(out);
+  decoder.take_result(out);
   return status;
 }
 

@@ -170,8 +170,12 @@ class GeometryDecoder {
   /// value). Cost: the inverse transforms (about a tenth of a full decode; the same grids are returned from
   /// a cache while nothing new was decoded).
   void result(DecodedGeometry& out, int drop_finest_steps = -1);
+  /// As result(), but the grids are moved out of the cache instead of copied (for a decoder whose result is
+  /// taken once, as decode_geometry() does); the next result() reconstructs them again.
+  void take_result(DecodedGeometry& out, int drop_finest_steps = -1);
 
  private:
+  void build_result(int drop_finest_steps);  // the grids of result() into the cache
   struct State;
   std::unique_ptr<State> s_;
 };

@@ -825,6 +825,14 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
 }
 
 PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
+  return make_result(drop_finest_steps, normals, false);
+}
+
+PackDecodeResult PackDecoder::take_result(int drop_finest_steps, bool normals) {
+  return make_result(drop_finest_steps, normals, true);
+}
+
+PackDecodeResult PackDecoder::make_result(int drop_finest_steps, bool normals, bool take) {
   State& st = *s_;
   PackDecodeResult result;
   result.status = st.status;
@@ -849,7 +857,11 @@ PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
       }
       model.geometry_passes = sm.geometry_chunks.size() + sm.tentative_geometry_passes;
       DecodedGeometry decoded;
-      sm.geometry.result(decoded, drop_finest_steps);
+      if (take) {
+        sm.geometry.take_result(decoded, drop_finest_steps);
+      } else {
+        sm.geometry.result(decoded, drop_finest_steps);
+      }
       if (sm.geometry_status != Status::kOk) result.status = Status::kCorrupt;
       model.geometry = std::move(decoded.patches);
       model.detail_level = decoded.detail_level;
@@ -858,7 +870,11 @@ PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
         if (sm.normals_status != Status::kOk) result.status = Status::kCorrupt;
         if (normals) {
           DecodedGeometry decoded_normals;
-          sm.normals.result(decoded_normals);
+          if (take) {
+            sm.normals.take_result(decoded_normals);
+          } else {
+            sm.normals.result(decoded_normals);
+          }
           model.normals = std::move(decoded_normals.patches);
           for (Grid3& grid : model.normals) {
             for (std::size_t k = 0; k + 2 < grid.values.size(); k += 3) {
@@ -881,7 +897,7 @@ PackDecodeResult PackDecoder::result(int drop_finest_steps, bool normals) {
 PackDecodeResult decode_pack(std::span<const std::uint8_t> bytes, const PackDecodeOptions& options) {
   PackDecoder decoder(options);
   decoder.update(bytes);
-  return decoder.result();
+  return decoder.take_result();
 }
 
 }  // namespace geomip::codec

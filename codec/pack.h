@@ -218,8 +218,12 @@ class PackDecoder {
   /// the normal maps out. Cost: the inverse transforms (no symbol is decoded again); cached per model while
   /// nothing new arrived and the drop is the same.
   PackDecodeResult result(int drop_finest_steps = -1, bool normals = true);
+  /// As result(), but the grids are moved out of the per-model caches instead of copied (for a decoder whose
+  /// result is taken once, as decode_pack() does); the next result() reconstructs them again.
+  PackDecodeResult take_result(int drop_finest_steps = -1, bool normals = true);
 
  private:
+  PackDecodeResult make_result(int drop_finest_steps, bool normals, bool take);
   struct State;
   std::unique_ptr<State> s_;
 };

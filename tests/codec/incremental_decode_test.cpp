@@ -183,6 +183,25 @@ TEST(IncrementalDecode, BandsFromOneDecodeEqualSeparateDecodes) {
   }
 }
 
+TEST(IncrementalDecode, TakenResultEqualsCopiedResult) {
+  // take_result() moves the grids out of the caches (decode_pack's way); result() copies them. Both, and a
+  // result() after a take (the cache rebuilt), with the same and with other drops, give the same bits.
+  const std::vector<std::uint8_t> pack = test_pack();
+  for (std::size_t end : {pack.size() / 4, pack.size()}) {
+    const std::span<const std::uint8_t> prefix(pack.data(), end);
+    PackDecoder copied, taken;
+    copied.update(prefix);
+    taken.update(prefix);
+    const std::string at = std::to_string(end) + " bytes";
+    expect_same(taken.take_result(), copied.result(), at + ", taken");
+    expect_same(taken.result(), copied.result(), at + ", result after a take");
+    for (int drop = 0; drop < 3; ++drop) {
+      expect_same(taken.take_result(drop), copied.result(drop), at + ", taken, drop " + std::to_string(drop));
+      expect_same(taken.result(drop), copied.result(drop), at + ", after a take, drop " + std::to_string(drop));
+    }
+  }
+}
+
 TEST(IncrementalDecode, GoldenPacksOfEveryVersion) {
   for (const char* file :
        {"golden-pillow.gip", "golden-pillow-v2.gip", "golden-pillow-v3.gip", "golden-pillow-v4.gip"}) {

@@ -3,7 +3,7 @@
 //   partition (mesh_partition.h) → per patch progressive mesh (progressive_mesh.h) → mean-value embedding of
 //   the base mesh (mean_value_embedding.h) → stretch optimization (stretch_optimization.h) → feature
 //   alignment across models (feature_warp.h) → coarse-to-fine vertex insertion with local stretch
-//   optimization (coarse_to_fine.h) → a few global stretch sweeps.
+//   optimization (coarse_to_fine.h) → a few global stretch sweeps → optionally an L∞ pass.
 #pragma once
 
 #include "mesh/mesh.h"
@@ -76,6 +76,15 @@ struct ParameterizationOptions {
   double level_growth = 2.0;
   /// Global sweeps over each full patch after coarse-to-fine (boundary and features locked); 0 = none.
   std::size_t final_sweeps = 10;
+  /// L∞ pass: after the final sweeps (and the MVC fallback), this many StretchNorm::kLinf sweeps over each
+  /// patch (boundary and features locked) that move only the vertices whose ring holds a triangle with
+  /// normalized L∞ stretch >= `linf_floor` (StretchOptimizationOptions::min_local_stretch). Each move lowers
+  /// the largest Γ of its ring, so the pass never raises a patch's L∞ stretch and never folds a triangle;
+  /// it raises the L2 stretch of the patches it works on. 0 = off (the default: it costs remesh PSNR;
+  /// docs/measurements.md, "L∞ stretch per patch").
+  std::size_t linf_sweeps = 0;
+  /// See `linf_sweeps`: normalized L∞ stretch (stretch.h) below which a vertex's ring is left alone. >= 0.
+  double linf_floor = 2.0;
   /// Also compute the mean-value embedding of each full patch, the baseline the stretch figures are
   /// reported against (one sparse solve per patch).
   bool measure_mvc_baseline = true;

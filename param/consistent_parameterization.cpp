@@ -515,10 +515,11 @@ CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<
   return c2f.result();
 }
 
-// The L∞ pass (ParameterizationOptions::linf_sweeps): StretchNorm::kLinf sweeps over the vertices whose
-// ring holds a triangle with normalized L∞ stretch at least options.linf_floor. The boundary is locked, so
-// Σ A2 (the unit square) and the normalization N = sqrt(Σ A2 / Σ A3) are constant, and the floor is
-// linf_floor / N in the optimizer's un-normalized units.
+// The L∞ pass (ParameterizationOptions::linf_sweeps): StretchNorm::kLinf sweeps, each over the vertices
+// whose ring holds a triangle with normalized L∞ stretch at least max(linf_floor, linf_relative_floor · the
+// patch's L∞ before the sweep); stops early after a sweep that moved nothing. The boundary is locked, so
+// Σ A2 (the unit square) and the normalization N = sqrt(Σ A2 / Σ A3) are constant, and a floor f is f / N in
+// the optimizer's un-normalized units.
 void linf_pass(const std::vector<Eigen::Vector3d>& positions, const std::vector<std::array<int, 3>>& triangles,
                std::vector<Eigen::Vector2d>& uv, const std::vector<char>& locked,
                const ParameterizationOptions& options, std::size_t p) {
@@ -534,8 +535,14 @@ void linf_pass(const std::vector<Eigen::Vector3d>& positions, const std::vector<
   o.seed = options.seed + 313u * static_cast<unsigned>(p + 1);
   o.vertex.norm = StretchNorm::kLinf;
   o.vertex.vertex_weights = nullptr;  // the L∞ term is not weighted
-  o.min_local_stretch = options.linf_floor / std::sqrt(area2 / area3);
-  optimize_stretch(positions, triangles, uv, locked, o);
+  const double n = std::sqrt(area2 / area3);
+  o.max_sweeps = 1;
+  for (std::size_t sweep = 0; sweep < options.linf_sweeps; ++sweep) {
+    const double linf = mesh_stretch(positions, triangles, uv).linf;
+    o.min_local_stretch = std::max(options.linf_floor, options.linf_relative_floor * linf) / n;
+    o.seed = options.seed + 313u * static_cast<unsigned>(p + 1) + 7919u * static_cast<unsigned>(sweep);
+    if (optimize_stretch(positions, triangles, uv, locked, o).vertex_moves == 0) break;
+  }
 }
 
 // Phase C for patch p of model `name`: coarse-to-fine, final sweeps, the MVC baseline and fallback; returns
@@ -628,8 +635,9 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
 std::vector<ModelParameterization> parameterize_consistently(const std::vector<ParameterizationInput>& models,
                                                              const ParameterizationOptions& options) {
   if (models.empty()) throw InvalidInput("parameterize_consistently: no model");
-  if (!(options.linf_floor >= 0) || !std::isfinite(options.linf_floor))
-    throw InvalidInput("parameterize_consistently: linf_floor must be finite and >= 0");
+  if (!(options.linf_floor >= 0) || !std::isfinite(options.linf_floor) || !(options.linf_relative_floor >= 0) ||
+      !(options.linf_relative_floor <= 1))
+    throw InvalidInput("parameterize_consistently: linf_floor must be finite and >= 0, linf_relative_floor in [0, 1]");
   check_feature_counts(models);
   const std::size_t num_features = models[0].features.size();
   const double n = static_cast<double>(models.size());

@@ -76,15 +76,20 @@ struct ParameterizationOptions {
   double level_growth = 2.0;
   /// Global sweeps over each full patch after coarse-to-fine (boundary and features locked); 0 = none.
   std::size_t final_sweeps = 10;
-  /// L∞ pass: after the final sweeps (and the MVC fallback), this many StretchNorm::kLinf sweeps over each
-  /// patch (boundary and features locked) that move only the vertices whose ring holds a triangle with
-  /// normalized L∞ stretch >= `linf_floor` (StretchOptimizationOptions::min_local_stretch). Each move lowers
-  /// the largest Γ of its ring, so the pass never raises a patch's L∞ stretch and never folds a triangle;
-  /// it raises the L2 stretch of the patches it works on. 0 = off (the default: it costs remesh PSNR;
+  /// L∞ pass: after the final sweeps (and the MVC fallback), up to this many StretchNorm::kLinf sweeps over
+  /// each patch (boundary and features locked). Each sweep moves only the vertices whose ring holds a
+  /// triangle with normalized L∞ stretch (stretch.h) >= max(`linf_floor`, `linf_relative_floor` · the
+  /// patch's L∞ stretch before the sweep) (StretchOptimizationOptions::min_local_stretch), so the pass works
+  /// on the worst regions and leaves the rest as it is; it stops after a sweep that moved nothing. Each move
+  /// lowers the largest Γ of its ring, so the pass never raises a patch's L∞ stretch and never folds a
+  /// triangle; it raises the L2 stretch of the patches it works on. Deterministic (seeds per patch and
+  /// sweep), hence bit-identical for any thread count. 0 = off (the default: it costs remesh PSNR;
   /// docs/measurements.md, "L∞ stretch per patch").
   std::size_t linf_sweeps = 0;
-  /// See `linf_sweeps`: normalized L∞ stretch (stretch.h) below which a vertex's ring is left alone. >= 0.
+  /// See `linf_sweeps`: normalized L∞ stretch below which a ring is never moved. Finite, >= 0.
   double linf_floor = 2.0;
+  /// See `linf_sweeps`: fraction of the patch's current L∞ stretch below which a ring is not moved. In [0, 1].
+  double linf_relative_floor = 0.85;
   /// Also compute the mean-value embedding of each full patch, the baseline the stretch figures are
   /// reported against (one sparse solve per patch).
   bool measure_mvc_baseline = true;

@@ -352,9 +352,12 @@ TEST(ConsistentParameterization, LinfPassNeverRaisesLinfNorFolds) {
   }
 }
 
-TEST(ConsistentParameterization, RejectsANegativeLinfFloor) {
+TEST(ConsistentParameterization, RejectsLinfFloorsOutOfRange) {
   ParameterizationOptions options;
   options.linf_floor = -1;
+  EXPECT_THROW(parameterize_consistently(deformed_sphere_pair(), options), InvalidInput);
+  options.linf_floor = 2;
+  options.linf_relative_floor = 1.5;
   EXPECT_THROW(parameterize_consistently(deformed_sphere_pair(), options), InvalidInput);
 }
 

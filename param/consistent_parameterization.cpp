@@ -680,6 +680,15 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
     });
     for (const StageSeconds& s : seconds) add_seconds(o.seconds, s);
     o.seam_mismatches = reconcile_seams(o);
+    // reconcile_seams may have moved seam vertices of a patch after its figures were taken (to a neighbour's
+    // off-chord position): measure every patch again, so that `stretch` and `flipped` describe the output.
+    for (PatchParameterization& patch : o.patches) {
+      std::vector<Eigen::Vector3d> positions;
+      positions.reserve(patch.vertices.size());
+      for (int v : patch.vertices) positions.push_back(o.mesh.positions[v]);
+      patch.stretch = mesh_stretch(positions, patch.triangles, patch.uv);
+      patch.flipped = count_flipped(patch.triangles, patch.uv);
+    }
   }
   report(options, "done", 1.0);
   return out;

@@ -119,7 +119,7 @@ struct PatchParameterization {
   std::array<std::vector<int>, 4> sides;      ///< mesh vertex ids, side k from corner k to corner k+1
   std::size_t base_vertices = 0;              ///< vertices of the progressive mesh's base mesh
   StretchValues mvc_stretch;                  ///< of the full patch's MVC embedding (if measured)
-  StretchValues stretch;                      ///< of the final parameterization
+  StretchValues stretch;                      ///< of the final parameterization (after the seams are reconciled)
   std::size_t flipped = 0;                    ///< triangles with uv area <= 0 in the final result (0)
   std::size_t boundary_off_chord = 0;         ///< boundary vertices not at their chord-length position
   /// True when coarse-to-fine ended above the MVC embedding's stretch and the stretch-optimized MVC

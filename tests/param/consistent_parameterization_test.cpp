@@ -324,6 +324,12 @@ TEST(ConsistentParameterization, LinfPassNeverRaisesLinfNorFolds) {
         EXPECT_EQ(a.flipped, 0u);
         EXPECT_EQ(count_flipped(a.triangles, a.uv), 0u);
         ASSERT_EQ(a.triangles, b.triangles);
+        // The figures describe the output (taken after the seams are reconciled).
+        std::vector<Eigen::Vector3d> positions;
+        for (int v : a.vertices) positions.push_back(after[m].mesh.positions[v]);
+        const StretchValues measured = mesh_stretch(positions, a.triangles, a.uv);
+        EXPECT_EQ(a.stretch.linf, measured.linf);
+        EXPECT_EQ(a.stretch.l2, measured.l2);
         const std::vector<char> boundary = boundary_vertex_mask(a.uv.size(), a.triangles);
         for (std::size_t v = 0; v < a.uv.size(); ++v) {
           if (!boundary[v] && !feature[a.vertices[v]]) continue;

@@ -515,6 +515,36 @@ CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<
   return c2f.result();
 }
 
+// The L∞ pass (ParameterizationOptions::linf_sweeps): StretchNorm::kLinf sweeps, each over the vertices
+// whose ring holds a triangle with normalized L∞ stretch at least max(linf_floor, linf_relative_floor · the
+// patch's L∞ before the sweep); stops early after a sweep that moved nothing. The boundary is locked, so
+// Σ A2 (the unit square) and the normalization N = sqrt(Σ A2 / Σ A3) are constant, and a floor f is f / N in
+// the optimizer's un-normalized units.
+void linf_pass(const std::vector<Eigen::Vector3d>& positions, const std::vector<std::array<int, 3>>& triangles,
+               std::vector<Eigen::Vector2d>& uv, const std::vector<char>& locked,
+               const ParameterizationOptions& options, std::size_t p) {
+  double area2 = 0, area3 = 0;
+  for (const auto& t : triangles) {
+    area3 += 0.5 * (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]).norm();
+    area2 += 0.5 * signed_double_area(uv[t[0]], uv[t[1]], uv[t[2]]);
+  }
+  if (!(area2 > 0) || !(area3 > 0)) return;
+  StretchOptimizationOptions o = options.base_optimization;
+  o.max_sweeps = options.linf_sweeps;
+  o.threshold = 0;  // the max term is not smooth: the sweep count bounds the pass (stretch_optimization.h)
+  o.seed = options.seed + 313u * static_cast<unsigned>(p + 1);
+  o.vertex.norm = StretchNorm::kLinf;
+  o.vertex.vertex_weights = nullptr;  // the L∞ term is not weighted
+  const double n = std::sqrt(area2 / area3);
+  o.max_sweeps = 1;
+  for (std::size_t sweep = 0; sweep < options.linf_sweeps; ++sweep) {
+    const double linf = mesh_stretch(positions, triangles, uv).linf;
+    o.min_local_stretch = std::max(options.linf_floor, options.linf_relative_floor * linf) / n;
+    o.seed = options.seed + 313u * static_cast<unsigned>(p + 1) + 7919u * static_cast<unsigned>(sweep);
+    if (optimize_stretch(positions, triangles, uv, locked, o).vertex_moves == 0) break;
+  }
+}
+
 // Phase C for patch p of model `name`: coarse-to-fine, final sweeps, the MVC baseline and fallback; returns
 // the patch's parameterization in mesh ids. \throw SolverFailure when a triangle ends flipped.
 PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std::string& name,
@@ -580,6 +610,17 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
       seconds.final_optimization += seconds_since(t0);
     }
   }
+  if (options.linf_sweeps > 0) {
+    t0 = Clock::now();
+    linf_pass(pw.local.positions, pp.triangles, pp.uv, locked, options, p);
+    pp.stretch = mesh_stretch(pw.local.positions, pp.triangles, pp.uv);
+    pp.flipped = count_flipped(pp.triangles, pp.uv);
+    if (pp.flipped != 0) {  // optimize_stretch never folds: a bug if it happens
+      throw SolverFailure("parameterize_consistently: the L-infinity pass left " + std::to_string(pp.flipped) +
+                          " flipped triangles in patch " + std::to_string(p) + " of model '" + name + "'");
+    }
+    seconds.final_optimization += seconds_since(t0);
+  }
   for (std::size_t j = 0; j < pw.features.size(); ++j) {
     FeatureLocation& f = features[pw.feature_index[j]];
     f.vertex = pw.to_mesh[pw.features[j]];
@@ -594,6 +635,9 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
 std::vector<ModelParameterization> parameterize_consistently(const std::vector<ParameterizationInput>& models,
                                                              const ParameterizationOptions& options) {
   if (models.empty()) throw InvalidInput("parameterize_consistently: no model");
+  if (!(options.linf_floor >= 0) || !std::isfinite(options.linf_floor) || !(options.linf_relative_floor >= 0) ||
+      !(options.linf_relative_floor <= 1))
+    throw InvalidInput("parameterize_consistently: linf_floor must be finite and >= 0, linf_relative_floor in [0, 1]");
   check_feature_counts(models);
   const std::size_t num_features = models[0].features.size();
   const double n = static_cast<double>(models.size());
@@ -636,6 +680,15 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
     });
     for (const StageSeconds& s : seconds) add_seconds(o.seconds, s);
     o.seam_mismatches = reconcile_seams(o);
+    // reconcile_seams may have moved seam vertices of a patch after its figures were taken (to a neighbour's
+    // off-chord position): measure every patch again, so that `stretch` and `flipped` describe the output.
+    for (PatchParameterization& patch : o.patches) {
+      std::vector<Eigen::Vector3d> positions;
+      positions.reserve(patch.vertices.size());
+      for (int v : patch.vertices) positions.push_back(o.mesh.positions[v]);
+      patch.stretch = mesh_stretch(positions, patch.triangles, patch.uv);
+      patch.flipped = count_flipped(patch.triangles, patch.uv);
+    }
   }
   report(options, "done", 1.0);
   return out;

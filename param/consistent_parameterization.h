@@ -3,7 +3,7 @@
 //   partition (mesh_partition.h) → per patch progressive mesh (progressive_mesh.h) → mean-value embedding of
 //   the base mesh (mean_value_embedding.h) → stretch optimization (stretch_optimization.h) → feature
 //   alignment across models (feature_warp.h) → coarse-to-fine vertex insertion with local stretch
-//   optimization (coarse_to_fine.h) → a few global stretch sweeps.
+//   optimization (coarse_to_fine.h) → a few global stretch sweeps → optionally an L∞ pass.
 #pragma once
 
 #include "mesh/mesh.h"
@@ -76,6 +76,20 @@ struct ParameterizationOptions {
   double level_growth = 2.0;
   /// Global sweeps over each full patch after coarse-to-fine (boundary and features locked); 0 = none.
   std::size_t final_sweeps = 10;
+  /// L∞ pass: after the final sweeps (and the MVC fallback), up to this many StretchNorm::kLinf sweeps over
+  /// each patch (boundary and features locked). Each sweep moves only the vertices whose ring holds a
+  /// triangle with normalized L∞ stretch (stretch.h) >= max(`linf_floor`, `linf_relative_floor` · the
+  /// patch's L∞ stretch before the sweep) (StretchOptimizationOptions::min_local_stretch), so the pass works
+  /// on the worst regions and leaves the rest as it is; it stops after a sweep that moved nothing. Each move
+  /// lowers the largest Γ of its ring, so the pass never raises a patch's L∞ stretch and never folds a
+  /// triangle; it raises the L2 stretch of the patches it works on. Deterministic (seeds per patch and
+  /// sweep), hence bit-identical for any thread count. 0 = off (the default: it costs remesh PSNR;
+  /// docs/measurements.md, "L∞ stretch per patch").
+  std::size_t linf_sweeps = 0;
+  /// See `linf_sweeps`: normalized L∞ stretch below which a ring is never moved. Finite, >= 0.
+  double linf_floor = 2.0;
+  /// See `linf_sweeps`: fraction of the patch's current L∞ stretch below which a ring is not moved. In [0, 1].
+  double linf_relative_floor = 0.85;
   /// Also compute the mean-value embedding of each full patch, the baseline the stretch figures are
   /// reported against (one sparse solve per patch).
   bool measure_mvc_baseline = true;
@@ -105,7 +119,7 @@ struct PatchParameterization {
   std::array<std::vector<int>, 4> sides;      ///< mesh vertex ids, side k from corner k to corner k+1
   std::size_t base_vertices = 0;              ///< vertices of the progressive mesh's base mesh
   StretchValues mvc_stretch;                  ///< of the full patch's MVC embedding (if measured)
-  StretchValues stretch;                      ///< of the final parameterization
+  StretchValues stretch;                      ///< of the final parameterization (after the seams are reconciled)
   std::size_t flipped = 0;                    ///< triangles with uv area <= 0 in the final result (0)
   std::size_t boundary_off_chord = 0;         ///< boundary vertices not at their chord-length position
   /// True when coarse-to-fine ended above the MVC embedding's stretch and the stretch-optimized MVC

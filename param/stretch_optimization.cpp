@@ -312,6 +312,8 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
                        std::to_string(nv) + " vertices");
   }
   if (!(options.threshold >= 0)) throw InvalidInput("optimize_stretch: threshold must be >= 0");
+  if (!(options.min_local_stretch >= 0) || !std::isfinite(options.min_local_stretch))
+    throw InvalidInput("optimize_stretch: min_local_stretch must be finite and >= 0");
   check_vertex_options("optimize_stretch", options.vertex);
   if (uv.size() != nv) {
     throw InvalidInput("optimize_stretch: " + std::to_string(uv.size()) + " uv coordinates for " +
@@ -396,9 +398,11 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
   for (std::size_t sweep = 0; sweep < options.max_sweeps && !movable.empty(); ++sweep) {
     // Priority queue by local stretch, largest first (ties by index, so the order is deterministic).
     queue.clear();
+    const double min_energy = options.min_local_stretch * options.min_local_stretch;
     for (int v : movable) {
       const std::size_t n = gather(v);
-      queue.emplace_back(ring_energy(uv[v], ring.data(), n, ring_weights(ring.data(), n, w)), v);
+      const double energy = ring_energy(uv[v], ring.data(), n, ring_weights(ring.data(), n, w));
+      if (!(energy < min_energy)) queue.emplace_back(energy, v);
     }
     std::sort(queue.begin(), queue.end(), [](const auto& a, const auto& b) {
       return a.first > b.first || (a.first == b.first && a.second < b.second);

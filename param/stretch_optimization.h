@@ -106,6 +106,11 @@ struct StretchOptimizationOptions {
   std::size_t max_sweeps = 50;
   /// Seed of the random search directions (the result is deterministic for a given seed).
   unsigned seed = 1;
+  /// Vertices whose local stretch sqrt(E(v)) (local_stretch(), in 3D units per uv unit, not normalized) is
+  /// below this at the start of a sweep are not moved in that sweep; 0 = all unlocked vertices. With
+  /// StretchNorm::kLinf this confines the sweeps to the rings of the triangles that set the L∞ stretch, and
+  /// leaves the rest of the parameterization (and its L2 stretch) as it is.
+  double min_local_stretch = 0;
   /// Record the mesh L2/L∞ stretch after every sweep in StretchOptimizationResult::per_sweep (one O(#F) pass
   /// per sweep).
   bool record_sweeps = false;
@@ -128,7 +133,9 @@ struct StretchOptimizationResult {
 /// is below `options.threshold`, or after `options.max_sweeps`.
 ///
 /// Guarantees: locked vertices are never written (bit-identical); no triangle becomes flipped or degenerate;
-/// every move lowers its vertex's E. With StretchNorm::kL2 and a fixed boundary (all boundary vertices
+/// every move lowers its vertex's E. With StretchNorm::kLinf a move lowers the largest Γ of the vertex's ring,
+/// and every triangle it changes is in that ring, so the largest Γ over the mesh never increases; with a
+/// fixed boundary (Σ A2 constant) neither does the normalized mesh L∞ stretch. With StretchNorm::kL2 and a fixed boundary (all boundary vertices
 /// locked, so the total uv area Σ A2 is constant) the normalized mesh L2 stretch therefore never increases
 /// from sweep to sweep. Unlocked boundary vertices drift outward (the un-normalized energy falls as the uv
 /// area grows; each step is bounded by VertexOptimizationOptions::max_step): lock the boundary for a fixed

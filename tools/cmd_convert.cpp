@@ -98,6 +98,7 @@ int run_convert(const ConvertArgs& args) {
   options.quantization_bits = args.quantization_bits;
   options.hole_mask_level = args.hole_mask_level;
   options.sampling_exponent = args.common.sampling_exponent;
+  options.linf_sweeps = static_cast<std::size_t>(args.common.linf_sweeps);
   options.normal_mesh_steps = args.normal_mesh_steps;
   options.normal_mesh_max_shift = args.normal_mesh_reach;
   options.frame_steps = args.frame_steps;

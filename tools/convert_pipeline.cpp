@@ -118,6 +118,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   param.measure_mvc_baseline = false;
   param.curvature_sampling = options.sampling_exponent > 0;
   param.sampling_weights.exponent = options.sampling_exponent;
+  param.linf_sweeps = options.linf_sweeps;
   param.progress = [&](const char* stage, double fraction) { progress(stage, 0.8 * fraction); };
   auto t0 = std::chrono::steady_clock::now();
   const std::vector<ModelParameterization> params = parameterize_consistently(models.inputs, param);

@@ -35,6 +35,8 @@ struct ConvertOptions {
   /// default here because it costs the codec at low rates; the remeshing commands default to 1/3; README,
   /// "Curvature sampling").
   double sampling_exponent = 0;
+  /// Sweeps of the parameterization's L∞ pass (ParameterizationOptions::linf_sweeps; 0 = off).
+  std::size_t linf_sweeps = 0;
   /// Normal-mesh resampling of the finest `normal_mesh_steps` wavelet steps' samples before coding
   /// (codec/normal_mesh.h; 0 = off). One model only: it moves samples off the parameterization, which the
   /// morphs of a consistent set rely on (InvalidInput when asked for with several models). -1 (default) =

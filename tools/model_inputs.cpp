@@ -213,6 +213,10 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
                   "Curvature sampling exponent g: stretch weights ((eps + |II|^2)/eps)^g give bent regions more "
                   "samples; 0 = plain geometric stretch (default: 1/3 for param, gimage, remesh; 0 for convert)")
       ->check(CLI::Range(0.0, 2.0));
+  cmd->add_option("--linf-sweeps", args.linf_sweeps,
+                  "Sweeps of the L-infinity pass after the stretch optimization: lowers each patch's worst "
+                  "stretch (never raises it), raises the L2 stretch (default 0: off)")
+      ->check(CLI::Range(0, 10000));
   add_patches_option(cmd, args.patches);
 }
 
@@ -226,6 +230,7 @@ void add_patches_option(CLI::App* cmd, int& patches) {
 void apply_sampling(const ModelArgs& args, ParameterizationOptions& options) {
   options.curvature_sampling = args.sampling_exponent > 0;
   options.sampling_weights.exponent = args.sampling_exponent;
+  options.linf_sweeps = static_cast<std::size_t>(args.linf_sweeps);
 }
 
 }  // namespace geomip::tools

@@ -29,6 +29,8 @@ struct ModelArgs {
   bool quiet = false;
   /// Curvature sampling exponent γ (SamplingWeightOptions::exponent); 0 = uniform geometric stretch.
   double sampling_exponent = SamplingWeightOptions{}.exponent;
+  /// --linf-sweeps N: ParameterizationOptions::linf_sweeps (0 = no L∞ pass).
+  int linf_sweeps = 0;
   /// --patches K: patches of the automatic layout. 2 = the two-square partition (choose_partition_points();
   /// genus 1: the 2×2 periodic grid; genus ≥ 2, which has neither: the first K-quad layout, K = 2g+2, 4g, 6g,
   /// 8g, 12g, … that partitions the mesh); another K = a K-quad layout (choose_quad_layout()). Only without
@@ -36,7 +38,8 @@ struct ModelArgs {
   int patches = 2;
 };
 
-/// Sets the parameterization's curvature sampling from `--sampling-exponent`.
+/// Sets the parameterization's curvature sampling from `--sampling-exponent` and its L∞ pass from
+/// `--linf-sweeps`.
 void apply_sampling(const ModelArgs& args, ParameterizationOptions& options);
 
 /// Registers ModelArgs' options on `cmd` (same names and help in every command).

@@ -6,6 +6,7 @@
 #include "mesh/mesh_repair.h"
 #include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
+#include "param/quad_layout.h"
 #include "tests/param/test_meshes.h"
 
 #include <gtest/gtest.h>
@@ -282,6 +283,88 @@ TEST(ConsistentParameterizationReal, StretchOptimizationBeatsMvcOnTheBunny) {
   for (const auto& p : result[0].patches) {
     EXPECT_LE(p.stretch.l2, 0.8 * p.mvc_stretch.l2) << "MVC " << p.mvc_stretch.l2 << " → " << p.stretch.l2;
   }
+}
+
+// The L∞ pass (ParameterizationOptions::linf_sweeps) runs after everything else, so a run without it is the
+// "before": with it no patch's L∞ stretch rises, none folds, the locked vertices (boundary, features) keep
+// their uv bit for bit, and some patch's L∞ drops. Two models with features over two squares, and an
+// automatic 8-quad layout of one of them.
+TEST(ConsistentParameterization, LinfPassNeverRaisesLinfNorFolds) {
+  std::vector<std::vector<ParameterizationInput>> cases = {deformed_sphere_pair()};
+  {
+    ParameterizationInput in;
+    in.mesh = deformed_sphere_pair()[1].mesh;
+    in.name = "b, 8 quads";
+    QuadLayoutOptions layout_options;
+    layout_options.patches = 8;
+    const QuadLayoutChoice layout = choose_quad_layout(in.mesh, layout_options);
+    in.partition_points = layout.layout.corners;
+    in.layout_quads = layout.layout.quads;
+    cases.push_back({in});
+  }
+  for (const auto& models : cases) {
+    SCOPED_TRACE(models[0].name);
+    ParameterizationOptions options;
+    options.measure_mvc_baseline = false;
+    const auto before = parameterize_consistently(models, options);
+    options.linf_sweeps = 30;
+    options.linf_floor = 0;
+    const auto after = parameterize_consistently(models, options);
+    ASSERT_EQ(after.size(), before.size());
+    bool lowered = false;
+    for (std::size_t m = 0; m < after.size(); ++m) {
+      ASSERT_EQ(after[m].patches.size(), before[m].patches.size());
+      std::vector<char> feature(after[m].mesh.positions.size(), 0);
+      for (const FeatureLocation& f : after[m].features) feature[f.vertex] = 1;
+      for (std::size_t p = 0; p < after[m].patches.size(); ++p) {
+        const PatchParameterization &a = after[m].patches[p], &b = before[m].patches[p];
+        SCOPED_TRACE("model " + std::to_string(m) + " patch " + std::to_string(p));
+        EXPECT_LE(a.stretch.linf, b.stretch.linf);
+        lowered = lowered || a.stretch.linf < b.stretch.linf;
+        EXPECT_EQ(a.flipped, 0u);
+        EXPECT_EQ(count_flipped(a.triangles, a.uv), 0u);
+        ASSERT_EQ(a.triangles, b.triangles);
+        // The figures describe the output (taken after the seams are reconciled).
+        std::vector<Eigen::Vector3d> positions;
+        for (int v : a.vertices) positions.push_back(after[m].mesh.positions[v]);
+        const StretchValues measured = mesh_stretch(positions, a.triangles, a.uv);
+        EXPECT_EQ(a.stretch.linf, measured.linf);
+        EXPECT_EQ(a.stretch.l2, measured.l2);
+        const std::vector<char> boundary = boundary_vertex_mask(a.uv.size(), a.triangles);
+        for (std::size_t v = 0; v < a.uv.size(); ++v) {
+          if (!boundary[v] && !feature[a.vertices[v]]) continue;
+          ASSERT_EQ(a.uv[v].x(), b.uv[v].x()) << "locked vertex " << v;
+          ASSERT_EQ(a.uv[v].y(), b.uv[v].y()) << "locked vertex " << v;
+        }
+      }
+      EXPECT_EQ(after[m].seam_mismatches, 0u);
+    }
+    EXPECT_TRUE(lowered);
+    // Bit-identical for any thread count with the pass on, too.
+    options.threads = 1;
+    const auto one = parameterize_consistently(models, options);
+    options.threads = 3;
+    const auto three = parameterize_consistently(models, options);
+    for (std::size_t m = 0; m < one.size(); ++m) {
+      for (std::size_t p = 0; p < one[m].patches.size(); ++p) {
+        const auto &x = one[m].patches[p].uv, &y = three[m].patches[p].uv;
+        ASSERT_EQ(x.size(), y.size());
+        for (std::size_t v = 0; v < x.size(); ++v) {
+          ASSERT_EQ(x[v].x(), y[v].x()) << "model " << m << " patch " << p << " vertex " << v;
+          ASSERT_EQ(x[v].y(), y[v].y()) << "model " << m << " patch " << p << " vertex " << v;
+        }
+      }
+    }
+  }
+}
+
+TEST(ConsistentParameterization, RejectsLinfFloorsOutOfRange) {
+  ParameterizationOptions options;
+  options.linf_floor = -1;
+  EXPECT_THROW(parameterize_consistently(deformed_sphere_pair(), options), InvalidInput);
+  options.linf_floor = 2;
+  options.linf_relative_floor = 1.5;
+  EXPECT_THROW(parameterize_consistently(deformed_sphere_pair(), options), InvalidInput);
 }
 
 }  // namespace

@@ -162,6 +162,45 @@ TEST(OptimizeStretch, LinfModeLowersMaxStretch) {
   }
 }
 
+// min_local_stretch: a sweep leaves the vertices whose local stretch is below it where they are; above the
+// largest local stretch nothing moves at all; in L∞ mode the mesh's max never rises.
+TEST(OptimizeStretch, MinLocalStretchLeavesLowVerticesAlone) {
+  const TriMesh m = paraboloid(10, 1.5);
+  const std::vector<Eigen::Vector2d> start = pushed_to_corner(xy(m), 0.6);
+  const std::vector<char> locked = boundary_vertex_mask(m.positions.size(), m.triangles);
+  const auto rings = vertex_rings(m);
+  StretchOptimizationOptions options;
+  options.vertex.norm = StretchNorm::kLinf;
+  std::vector<double> local(m.positions.size(), 0);
+  double largest = 0;
+  for (std::size_t v = 0; v < local.size(); ++v) {
+    if (locked[v]) continue;
+    local[v] = local_stretch(static_cast<int>(v), rings[v], m.positions, m.triangles, start, options.vertex);
+    largest = std::max(largest, local[v]);
+  }
+  std::vector<double> sorted = local;
+  std::sort(sorted.begin(), sorted.end());
+  options.min_local_stretch = sorted[sorted.size() / 2];  // about half the vertices below
+  options.max_sweeps = 1;
+  std::vector<Eigen::Vector2d> uv = start;
+  const StretchOptimizationResult r = optimize_stretch(m.positions, m.triangles, uv, locked, options);
+  EXPECT_GT(r.vertex_moves, 0u);
+  EXPECT_LE(r.after.linf, r.before.linf);
+  EXPECT_EQ(count_flipped(m.triangles, uv), 0u);
+  for (std::size_t v = 0; v < uv.size(); ++v) {
+    if (locked[v] || local[v] < options.min_local_stretch) {
+      EXPECT_TRUE(bit_identical(uv[v], start[v])) << v;
+    }
+  }
+  options.min_local_stretch = 2 * largest;
+  options.max_sweeps = 20;
+  uv = start;
+  EXPECT_EQ(optimize_stretch(m.positions, m.triangles, uv, locked, options).vertex_moves, 0u);
+  for (std::size_t v = 0; v < uv.size(); ++v) EXPECT_TRUE(bit_identical(uv[v], start[v])) << v;
+  options.min_local_stretch = -1;
+  EXPECT_THROW(optimize_stretch(m.positions, m.triangles, uv, locked, options), InvalidInput);
+}
+
 TEST(OptimizeStretch, LockedInteriorVerticesStayAndResultIsDeterministic) {
   const TriMesh m = paraboloid(8, 1.0);
   const std::vector<Eigen::Vector2d> start = pushed_to_corner(xy(m), 0.5);

@@ -28,6 +28,13 @@ constexpr int kMaxLevel = 12;
 constexpr int kMaxTopBitplane = 48;
 constexpr std::uint64_t kMaxTotalSamples = std::uint64_t{1} << 26;  // patches · (2^level+1)²
 
+/// An array of n default-initialized (for these trivial types: not zero-filled) elements; what
+/// std::make_unique_for_overwrite does, which Emscripten's libc++ lacks.
+template <class T>
+std::unique_ptr<T[]> uninitialized_array(std::size_t n) {
+  return std::unique_ptr<T[]>(new T[n]);
+}
+
 int grid_size(int level) {
   return (1 << level) + 1;
 }
@@ -281,7 +288,7 @@ struct FrameField {
   const Frame& frame(std::size_t p, int idx) const {
     const auto i = static_cast<std::size_t>(idx);
     if (built[p].empty()) {  // first frame of this patch
-      frames[p] = std::make_unique_for_overwrite<Frame[]>(samples);
+      frames[p] = uninitialized_array<Frame>(samples);
       built[p].assign(samples, 0);
     }
     if (!built[p][i]) {
@@ -443,7 +450,7 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
     const std::size_t size = static_cast<std::size_t>(grid_size(h.level));
     ff.samples = size * size;
     ff.normals.resize(static_cast<std::size_t>(h.num_patches));
-    for (auto& n : ff.normals) n = std::make_unique_for_overwrite<std::array<std::int64_t, 3>[]>(ff.samples);
+    for (auto& n : ff.normals) n = uninitialized_array<std::array<std::int64_t, 3>>(ff.samples);
     ff.frames.resize(static_cast<std::size_t>(h.num_patches));
     ff.built.resize(static_cast<std::size_t>(h.num_patches));
   }

@@ -12,8 +12,11 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <exception>
 #include <cmath>
+#include <mutex>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <utility>
 
@@ -56,22 +59,38 @@ struct Equation {
   double distance2 = 0;  // squared distance of the sample (for the reported RMS)
 };
 
-/// Runs `fn(i)` for i in [0, n) over `threads` threads in fixed chunks.
+/// Runs `fn(i)` for i in [0, n) over `threads` threads in fixed chunks. The threads are joined on every
+/// way out (if a thread cannot be started, fewer do the work); an exception from `fn` stops the remaining
+/// chunks and is rethrown here, so none leaves a worker thread.
 template <class Fn>
 void parallel_for(std::size_t n, unsigned threads, const Fn& fn) {
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::atomic<std::size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
   auto work = [&] {
-    for (std::size_t c = next++; c < chunks; c = next++) {
-      const std::size_t end = std::min(n, (c + 1) * kChunk);
-      for (std::size_t i = c * kChunk; i < end; ++i) fn(i);
+    try {
+      for (std::size_t c = next++; c < chunks; c = next++) {
+        const std::size_t end = std::min(n, (c + 1) * kChunk);
+        for (std::size_t i = c * kChunk; i < end; ++i) fn(i);
+      }
+    } catch (...) {
+      next = chunks;
+      const std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
     }
   };
   const unsigned pool = static_cast<unsigned>(std::min<std::size_t>(std::max(1u, threads), chunks));
   std::vector<std::thread> workers;
-  for (unsigned t = 1; t < pool; ++t) workers.emplace_back(work);
+  workers.reserve(pool);  // before any thread runs: emplace_back below cannot throw bad_alloc
+  try {
+    for (unsigned t = 1; t < pool; ++t) workers.emplace_back(work);
+  } catch (const std::system_error&) {
+    // No more threads to be had: the ones started and this one share the chunks.
+  }
   work();
   for (auto& w : workers) w.join();
+  if (error) std::rethrow_exception(error);
 }
 
 Eigen::Vector3d face_normal(const std::vector<Eigen::Vector3d>& x, const std::array<int, 3>& t) {

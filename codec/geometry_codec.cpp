@@ -21,8 +21,9 @@ namespace geomip::codec {
 namespace {
 
 // Version 1: one joint bit-plane stream for all patches; version 2: a stream per patch (parallel decoding);
-// version 3: version 2 plus local frames and orientation weights.
-constexpr std::uint8_t kHeaderVersion = 3;
+// version 3: version 2 plus local frames and orientation weights; version 4: version 3 plus the lifting
+// update flag (bit 1 of the flags byte).
+constexpr std::uint8_t kHeaderVersion = 4;
 constexpr int kMaxTangentialShift = 8;
 constexpr int kMaxLevel = 12;
 constexpr int kMaxTopBitplane = 48;
@@ -143,6 +144,7 @@ bool header_ok(const GeometryCodecHeader& h) {
       (h.version < 2 && h.joint_segments != 0))
     return false;
   if (h.version < 3 && (h.orientation_weights || h.frame_steps != 0 || h.tangential_shift != 0)) return false;
+  if (h.version < 4 && h.lifting_update) return false;
   if (h.frame_steps < 0 || h.frame_steps > h.steps || h.tangential_shift < 0 ||
       h.tangential_shift > kMaxTangentialShift ||
       h.frame_start.size() != static_cast<std::size_t>(h.frame_steps))
@@ -270,6 +272,7 @@ Frame make_frame(std::int64_t n0, std::int64_t n1, std::int64_t n2) {
 struct FrameField {
   int level = 0, steps = 0, frame_steps = 0, tangential_shift = 0;
   WaveletFilter filter = WaveletFilter::kCubic;
+  bool update = false;  // the wavelet's update step (header version 4)
   const Ownership* own = nullptr;
   std::vector<int> start;                                         // start plane of step k at [k − 1]
   std::size_t samples = 0;  // grid positions per patch
@@ -372,7 +375,7 @@ struct FrameField {
           }
           g[c] = gathered[c];
         }
-        wavelet_inverse(g[c], sub_level, sub_steps, filter);
+        wavelet_inverse(g[c], sub_level, sub_steps, filter, update);
       }
       const auto at = [&](int c, int i, int j) {
         return static_cast<std::int64_t>(  // i, j ≥ 0 multiples of s = 2^(min_k − 1)
@@ -443,6 +446,7 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
   ff.frame_steps = h.frame_steps;
   ff.tangential_shift = h.tangential_shift;
   ff.filter = h.filter;
+  ff.update = h.lifting_update;
   ff.own = &own;
   ff.start = h.frame_start;
   ff.ready.assign(static_cast<std::size_t>(h.frame_steps), 0);
@@ -480,7 +484,7 @@ std::vector<std::uint8_t> GeometryCodecHeader::serialize() const {
   put_varint(out, static_cast<std::uint64_t>(top_bitplane));
   if (version >= 2) put_varint(out, static_cast<std::uint64_t>(joint_segments));
   if (version >= 3) {
-    out.push_back(orientation_weights ? 1 : 0);
+    out.push_back(static_cast<std::uint8_t>((orientation_weights ? 1 : 0) | (lifting_update ? 2 : 0)));
     put_varint(out, static_cast<std::uint64_t>(frame_steps));
     put_varint(out, static_cast<std::uint64_t>(tangential_shift));
     for (int v : frame_start) put_varint(out, static_cast<std::uint64_t>(v));
@@ -515,11 +519,12 @@ Status GeometryCodecHeader::parse(std::span<const std::uint8_t> bytes, GeometryC
   }
   if (h.version >= 3) {
     std::uint8_t flags;
-    if (!r.byte(flags) || flags > 1 || !r.small_int(h.frame_steps, kMaxLevel) ||
+    if (!r.byte(flags) || flags > (h.version >= 4 ? 3 : 1) || !r.small_int(h.frame_steps, kMaxLevel) ||
         !r.small_int(h.tangential_shift, kMaxTangentialShift)) {
       return Status::kCorrupt;
     }
-    h.orientation_weights = flags == 1;
+    h.orientation_weights = (flags & 1) != 0;
+    h.lifting_update = (flags & 2) != 0;
     h.frame_start.resize(static_cast<std::size_t>(h.frame_steps));
     for (int& v : h.frame_start) {
       if (!r.small_int(v, kMaxTopBitplane)) return Status::kCorrupt;
@@ -618,10 +623,11 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
       coefs[copy / samples][c][copy % samples] = coefs[owner / samples][c][owner % samples];
   }
   for (auto& pc : coefs) {
-    for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter);
+    for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter, options.lifting_update);
   }
   h.version = kHeaderVersion;
   h.orientation_weights = options.orientation_weights;
+  h.lifting_update = options.lifting_update;
   h.frame_steps = std::min(options.frame_steps, h.steps);
   h.tangential_shift = h.frame_steps > 0 ? options.tangential_shift : 0;
   // Start plane of the framed details of step k: one plane above the top of their xyz magnitudes (a frame
@@ -791,7 +797,7 @@ void GeometryDecoder::build_result(int drop_finest_steps) {
           }
         }
       }
-      wavelet_inverse(ch, level, steps, header.filter);
+      wavelet_inverse(ch, level, steps, header.filter, header.lifting_update);
       for (std::size_t i = 0; i < samples; ++i) {
         g.values[3 * i + c] = to_float(header.origin[c] + header.step * static_cast<double>(ch[i]));
       }

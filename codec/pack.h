@@ -3,7 +3,7 @@
 //
 // Layout (all integers little-endian; varint = unsigned LEB128):
 //   [fixed header]
-//     version 4: magic "GEOMIPK\x1a" (8) | format version u16 | manifest size varint (1–4 bytes) |
+//     versions 4–5: magic "GEOMIPK\x1a" (8) | format version u16 | manifest size varint (1–4 bytes) |
 //                manifest CRC32 u32   (15–18 bytes)
 //     versions 1–3: magic (8) | format version u16 | flags u16 (0) | manifest size u32 | manifest CRC32 u32
 //                (kPackHeaderSize = 20 bytes)
@@ -46,13 +46,15 @@ namespace geomip::codec {
 /// this many bytes of a pack (or all of a shorter source) can always read the fixed header, and the
 /// manifest always ends at or after it.
 inline constexpr std::size_t kPackHeaderSize = 20;
-/// Format version written. Version 4 (this one): the header diet — CRC32 trailers per chunk group instead
-/// of a CRC per chunk in the up-front table, a varint manifest size, compact doubles and codec headers
-/// (above); codec headers of version 3 or later. Version 3: codec header version 3 (local frames,
+/// Format version written. Version 5 (this one): version 4's container, codec headers of version 3 or later
+/// (the encoder writes 4: the wavelet's lifting update, docs/codec-v3.md "Lifting update"); an older reader
+/// says "unsupported version" instead of failing on the codec header. Version 4: the header diet — CRC32
+/// trailers per chunk group instead of a CRC per chunk in the up-front table, a varint manifest size,
+/// compact doubles and codec headers (above); codec headers of version 3. Version 3: codec header version 3 (local frames,
 /// orientation weights; docs/codec-v3.md). Version 2: bit-plane segments hold one stream per patch (codec
-/// header version 2), decoded in parallel. Version 1: one joint stream per segment. Versions 1–3 are still
-/// read.
-inline constexpr std::uint16_t kPackVersion = 4;
+/// header version 2), decoded in parallel. Version 1: one joint stream per segment. Versions 1–4 are still
+/// read. "Version 4" in the layout notes means versions 4 and later.
+inline constexpr std::uint16_t kPackVersion = 5;
 inline constexpr std::uint16_t kOldestPackVersion = 1;
 
 enum class ChunkKind : std::uint8_t {
@@ -132,7 +134,8 @@ struct PackWriteOptions {
                                     .steps = -1,
                                     .frame_steps = 0,
                                     .tangential_shift = 0,
-                                    .orientation_weights = false};
+                                    .orientation_weights = false,
+                                    .lifting_update = false};
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// CRC groups (format version 4, see the layout above): chunks with smaller payloads share one CRC32
   /// trailer until their payloads reach this many bytes; ≥ 1. Larger values save 4 bytes per merged chunk;

@@ -35,7 +35,7 @@ inline std::int32_t wrap(I64 v) {
 /// One pass of one step. `rows` = true: the row pass (lines along i); false: the column pass.
 /// sign = −1: forward (subtract the prediction), +1: inverse (add it). The taps of each odd position are
 /// chosen once per pass, so the inner loops have no branches.
-void pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int sign) {
+void predict_pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int sign) {
   const int intervals = (size - 1) / s;  // of the current grid along a line
   const int num_evens = intervals / 2 + 1;
   const int num_odds = intervals / 2;
@@ -90,6 +90,43 @@ void pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int sign) {
   }
 }
 
+/// The update step of one line: every even sample strictly inside the line gets (d_left + d_right + 2) >> 2
+/// of its two neighbouring details added (sign +1, forward) or subtracted (−1, inverse).
+void update_row(std::int32_t* row, int size, int s, int sign) {
+  const int num_evens = (size - 1) / s / 2 + 1;
+  for (int t = 1; t + 1 < num_evens; ++t) {
+    const I64 u = (static_cast<I64>(row[(2 * t - 1) * s]) + row[(2 * t + 1) * s] + 2) >> 2;
+    std::int32_t& e = row[2 * t * s];
+    e = wrap(e + sign * u);
+  }
+}
+
+/// The update step of the column pass, row-major friendly: for each even row strictly inside, all interior
+/// columns of the current grid at once.
+void update_columns(std::int32_t* g, int size, int s, int sign) {
+  const int num_evens = (size - 1) / s / 2 + 1;
+  const std::ptrdiff_t line = static_cast<std::ptrdiff_t>(size) * s;
+  for (int t = 1; t + 1 < num_evens; ++t) {
+    std::int32_t* e = g + 2 * t * line;
+    const std::int32_t* a = e - line;
+    const std::int32_t* b = e + line;
+    for (int i = s; i + 1 < size; i += s) e[i] = wrap(e[i] + sign * ((static_cast<I64>(a[i]) + b[i] + 2) >> 2));
+  }
+}
+
+/// One pass of one step with the optional update on interior lines (border rows and columns are left to the
+/// prediction alone, so a border line's coefficients still depend only on that line). Forward (sign −1):
+/// predict, then update; inverse (+1): undo the update, then the prediction.
+void pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int sign, bool update) {
+  const auto update_all = [&](int u) {
+    if (!rows) return update_columns(g, size, s, u);
+    for (int j = s; j + 1 < size; j += s) update_row(g + static_cast<std::ptrdiff_t>(j) * size, size, s, u);
+  };
+  if (update && sign > 0) update_all(-1);
+  predict_pass(g, size, s, rows, cubic, sign);
+  if (update && sign < 0) update_all(+1);
+}
+
 void check(std::span<std::int32_t> grid, int level, int steps, const char* who) {
   if (level < 0 || level > 15 || steps < 0 || steps > level) {
     throw std::invalid_argument(std::string(who) + ": level " + std::to_string(level) + " / steps " +
@@ -104,25 +141,25 @@ void check(std::span<std::int32_t> grid, int level, int steps, const char* who) 
 
 }  // namespace
 
-void wavelet_forward(std::span<std::int32_t> grid, int level, int steps, WaveletFilter filter) {
+void wavelet_forward(std::span<std::int32_t> grid, int level, int steps, WaveletFilter filter, bool update) {
   check(grid, level, steps, "wavelet_forward");
   const int size = (1 << level) + 1;
   const bool cubic = filter == WaveletFilter::kCubic;
   for (int k = 1; k <= steps; ++k) {
     const int s = 1 << (k - 1);
-    pass(grid.data(), size, s, true, cubic, -1);
-    pass(grid.data(), size, s, false, cubic, -1);
+    pass(grid.data(), size, s, true, cubic, -1, update);
+    pass(grid.data(), size, s, false, cubic, -1, update);
   }
 }
 
-void wavelet_inverse(std::span<std::int32_t> grid, int level, int steps, WaveletFilter filter) {
+void wavelet_inverse(std::span<std::int32_t> grid, int level, int steps, WaveletFilter filter, bool update) {
   check(grid, level, steps, "wavelet_inverse");
   const int size = (1 << level) + 1;
   const bool cubic = filter == WaveletFilter::kCubic;
   for (int k = steps; k >= 1; --k) {
     const int s = 1 << (k - 1);
-    pass(grid.data(), size, s, false, cubic, +1);
-    pass(grid.data(), size, s, true, cubic, +1);
+    pass(grid.data(), size, s, false, cubic, +1, update);
+    pass(grid.data(), size, s, true, cubic, +1, update);
   }
 }
 

@@ -33,6 +33,7 @@ struct ConvertArgs {
   int frame_steps = ConvertOptions{}.frame_steps;
   int tangential_shift = ConvertOptions{}.tangential_shift;
   bool no_orientation_weights = false;
+  bool no_lifting_update = false;
   bool fit = false;
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
   std::string front;  ///< +x, -x, +y, -y, +z, -z; empty: from the shape
@@ -104,6 +105,7 @@ int run_convert(const ConvertArgs& args) {
   options.frame_steps = args.frame_steps;
   options.tangential_shift = args.tangential_shift;
   options.orientation_weights = !args.no_orientation_weights;
+  options.lifting_update = !args.no_lifting_update;
   options.fit = args.fit;
   options.up = up;
   options.front = front;
@@ -188,6 +190,9 @@ CommandRunner add_convert_command(CLI::App& app) {
                       std::to_string(ConvertOptions{}.tangential_shift) + ")");
   cmd->add_flag("--no-orientation-weights", args->no_orientation_weights,
                 "Weigh row/column and diagonal detail bands alike (ablations)");
+  cmd->add_flag("--no-lifting-update", args->no_lifting_update,
+                "Code the geometry with the plain interpolating wavelet, without the update step (ablations; "
+                "the pack is still format 5)");
   cmd->add_option(
          "--up", args->up,
          "The models' up axis, stored with the front in each model's normalization (the viewer's frame; "

@@ -158,6 +158,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   write.geometry.frame_steps = options.frame_steps;
   write.geometry.tangential_shift = options.tangential_shift;
   write.geometry.orientation_weights = options.orientation_weights;
+  write.geometry.lifting_update = options.lifting_update;
   result.pack = codec::write_pack(inputs, write);
   result.encode_seconds = seconds_since(t0);
   if (options.keep_inputs) result.inputs = std::move(inputs);

@@ -25,10 +25,12 @@ struct ConvertOptions {
   int quantization_bits = 14; ///< position quantization over the largest bounding-box extent
   /// Codec tools of the geometry stream (codec::GeometryCodecOptions: local frames of the finest
   /// frame_steps wavelet steps, their tangential components 2^tangential_shift coarser, orientation
-  /// weights). The defaults are the codec's; the switches exist for ablations (docs/codec-v3.md).
+  /// weights, the wavelet's lifting update). The defaults are the codec's; the switches exist for ablations
+  /// (docs/codec-v3.md).
   int frame_steps = codec::GeometryCodecOptions{}.frame_steps;
   int tangential_shift = codec::GeometryCodecOptions{}.tangential_shift;
   bool orientation_weights = codec::GeometryCodecOptions{}.orientation_weights;
+  bool lifting_update = codec::GeometryCodecOptions{}.lifting_update;
   /// Level of the hole-mask grid (repaired meshes); -1 = the geometry's level.
   int hole_mask_level = -1;
   /// Curvature sampling exponent of the parameterization (SamplingWeightOptions::exponent; 0 = off, the

@@ -153,26 +153,41 @@ TEST(GeometryCodec, EveryBytePrefixDecodesWatertight) {
 TEST(GeometryCodec, DroppingFinestStepsStaysWatertightAndLowersDetailLevel) {
   std::vector<PatchSeam> seams;
   const auto patches = two_patch_surface(5, seams);
-  GeometryCodecOptions o;
-  o.frame_steps = 0;  // exact coarse samples need exact (xyz) coefficients
-  const auto enc = encode_geometry(patches, seams, o);
-  const auto segs = first_segments(enc, enc.segments.size());
-  for (int drop = 0; drop <= 6; ++drop) {
-    DecodedGeometry dec;
-    ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec, {drop}), Status::kOk);
-    EXPECT_EQ(dec.detail_level, std::max(5 - drop, 0));
-    expect_watertight(dec.patches, seams);
-    // The kept coarse grid is still exact (interpolating wavelet): samples at multiples of 2^drop.
-    const int n = 33, s = 1 << std::min(drop, 5);
-    for (int j = 0; j < n; j += s) {
-      for (int i = 0; i < n; i += s) {
-        for (int c = 0; c < 3; ++c) {
-          EXPECT_NEAR(dec.patches[0].values[3 * (j * n + i) + c], patches[0].values[3 * (j * n + i) + c],
-                      enc.header.step * 0.5 + 1e-6);
+  std::vector<double> rms[2];  // [update]: RMS error of the dropped reconstruction against the input
+  for (bool update : {false, true}) {
+    GeometryCodecOptions o;
+    o.frame_steps = 0;  // exact coarse samples need exact (xyz) coefficients
+    o.lifting_update = update;
+    const auto enc = encode_geometry(patches, seams, o);
+    const auto segs = first_segments(enc, enc.segments.size());
+    for (int drop = 0; drop <= 6; ++drop) {
+      DecodedGeometry dec;
+      ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec, {drop}), Status::kOk);
+      EXPECT_EQ(dec.detail_level, std::max(5 - drop, 0));
+      expect_watertight(dec.patches, seams);
+      double sum = 0;
+      for (std::size_t v = 0; v < patches[0].values.size(); ++v) {
+        const double e = dec.patches[0].values[v] - patches[0].values[v];
+        sum += e * e;
+      }
+      rms[update].push_back(std::sqrt(sum / static_cast<double>(patches[0].values.size())));
+      if (update) continue;
+      // Without the update the kept coarse grid is exact (interpolating wavelet): samples at multiples of
+      // 2^drop.
+      const int n = 33, s = 1 << std::min(drop, 5);
+      for (int j = 0; j < n; j += s) {
+        for (int i = 0; i < n; i += s) {
+          for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(dec.patches[0].values[3 * (j * n + i) + c], patches[0].values[3 * (j * n + i) + c],
+                        enc.header.step * 0.5 + 1e-6);
+          }
         }
       }
     }
   }
+  // With the update the coarse levels are averages, not subsamples: dropping the finest steps leaves a
+  // reconstruction closer to the full grid (what makes short prefixes better).
+  for (std::size_t drop = 1; drop <= 3; ++drop) EXPECT_LT(rms[1][drop], rms[0][drop]) << "drop " << drop;
 }
 
 TEST(GeometryCodec, HeaderRoundTripsAndIsCompact) {
@@ -371,35 +386,44 @@ TEST(GeometryCodec, GoldenStreamIsStable) {
       }
     }
   }
-  // xyz coding (no frames, no orientation weights: the version-2 bit stream in a version-3 header), then the
-  // version-3 tools (3 framed steps, tangential shift 1, orientation weights), whose decoded values are
-  // pinned too (the frames' integer arithmetic must give the same bits everywhere, WASM included).
-  for (bool v3_tools : {false, true}) {
-    GeometryCodecOptions o;
-    o.quantization_bits = 6;  // extent 64: step 1
-    o.frame_steps = v3_tools ? 3 : 0;
-    o.tangential_shift = v3_tools ? 1 : 0;
-    o.orientation_weights = v3_tools;
-    const auto enc = encode_geometry(patches, {}, o);
-    ASSERT_EQ(enc.header.step, 1.0);
-    EXPECT_EQ(stream_hash(enc), v3_tools ? 0xa3aa021d93df34fcull : 0x382710ca3802b988ull)
-        << std::hex << "0x" << stream_hash(enc);
-    std::vector<std::span<const std::uint8_t>> segs(enc.segments.begin(), enc.segments.end());
-    DecodedGeometry dec;
-    ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec), Status::kOk);
-    if (!v3_tools) {
-      EXPECT_EQ(dec.patches[0].values, patches[0].values);
-      EXPECT_EQ(dec.patches[1].values, patches[1].values);
-    } else {
-      std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the decoded floats' bits
-      for (const auto& g : dec.patches) {
-        for (float f : g.values) {
-          std::uint32_t bits;
-          std::memcpy(&bits, &f, 4);
-          for (int b = 0; b < 4; ++b) h = (h ^ ((bits >> (8 * b)) & 0xFF)) * 1099511628211ull;
+  // xyz coding (no frames, no orientation weights: the version-2 bit stream), then the version-3 tools (3
+  // framed steps, tangential shift 1, orientation weights), whose decoded values are pinned too (the frames'
+  // integer arithmetic must give the same bits everywhere, WASM included); each without and with the
+  // version-4 lifting update. Without it the segments are the version-3 encoder's, byte for byte: hashed
+  // with the header's version set back to 3, they give version 3's hashes.
+  for (bool update : {false, true}) {
+    for (bool v3_tools : {false, true}) {
+      GeometryCodecOptions o;
+      o.quantization_bits = 6;  // extent 64: step 1
+      o.frame_steps = v3_tools ? 3 : 0;
+      o.tangential_shift = v3_tools ? 1 : 0;
+      o.orientation_weights = v3_tools;
+      o.lifting_update = update;
+      const auto enc = encode_geometry(patches, {}, o);
+      ASSERT_EQ(enc.header.step, 1.0);
+      ASSERT_EQ(enc.header.version, 4);
+      EncodedGeometry as_v3 = enc;
+      if (!update) as_v3.header.version = 3;
+      const std::uint64_t expected = update ? (v3_tools ? 0x753b1c4f79dba598ull : 0x84e2bd6c59662047ull)
+                                            : (v3_tools ? 0xa3aa021d93df34fcull : 0x382710ca3802b988ull);
+      EXPECT_EQ(stream_hash(as_v3), expected) << std::hex << "0x" << stream_hash(as_v3);
+      std::vector<std::span<const std::uint8_t>> segs(enc.segments.begin(), enc.segments.end());
+      DecodedGeometry dec;
+      ASSERT_EQ(decode_geometry(enc.header, segs, {}, dec), Status::kOk);
+      if (!v3_tools) {  // lossless, with or without the update
+        EXPECT_EQ(dec.patches[0].values, patches[0].values);
+        EXPECT_EQ(dec.patches[1].values, patches[1].values);
+      } else {
+        std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the decoded floats' bits
+        for (const auto& g : dec.patches) {
+          for (float f : g.values) {
+            std::uint32_t bits;
+            std::memcpy(&bits, &f, 4);
+            for (int b = 0; b < 4; ++b) h = (h ^ ((bits >> (8 * b)) & 0xFF)) * 1099511628211ull;
+          }
         }
+        EXPECT_EQ(h, update ? 0x89a9c7ab6e577f75ull : 0x8cf4e5dd7b017e01ull) << std::hex << "decoded 0x" << h;
       }
-      EXPECT_EQ(h, 0x8cf4e5dd7b017e01ull) << std::hex << "decoded 0x" << h;
     }
   }
 }

@@ -204,7 +204,8 @@ TEST(IncrementalDecode, TakenResultEqualsCopiedResult) {
 
 TEST(IncrementalDecode, GoldenPacksOfEveryVersion) {
   for (const char* file :
-       {"golden-pillow.gip", "golden-pillow-v2.gip", "golden-pillow-v3.gip", "golden-pillow-v4.gip"}) {
+       {"golden-pillow.gip", "golden-pillow-v2.gip", "golden-pillow-v3.gip", "golden-pillow-v4.gip",
+        "golden-pillow-v5.gip"}) {
     std::ifstream in(std::string(GEOMIP_SOURCE_DIR) + "/tests/data/" + file, std::ios::binary);
     ASSERT_TRUE(in) << file;
     const std::vector<std::uint8_t> pack((std::istreambuf_iterator<char>(in)),

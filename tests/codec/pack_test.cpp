@@ -301,7 +301,7 @@ TEST(Pack, CrcGroupsGatherSmallChunksAndTileTheFile) {
   const std::vector<std::uint8_t> pack = write_pack({pillow_model(5, "a", 1.0, true)});
   PackInfo info;
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
-  EXPECT_EQ(info.version, 4);
+  EXPECT_EQ(info.version, kPackVersion);
   EXPECT_EQ(info.file_size(), pack.size());
   const std::uint32_t group_bytes = PackWriteOptions{}.crc_group_bytes;
   std::uint64_t offset = info.manifest_end, gathered = 0;
@@ -526,7 +526,8 @@ TEST(PackPerPatch, EverySingleBitFlipIsRefusedOrACoarserModel) {
 }
 
 // The committed golden packs (tests/data/golden-pillow.gip written by format version 1, golden-pillow-v2.gip
-// by version 2, golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4) must keep decoding to
+// by version 2, golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by
+// version 5: codec header version 4, the lifting update) must keep decoding to
 // the pillow they were made from: decoders of old streams do not silently change.
 class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
 
@@ -539,7 +540,8 @@ TEST_P(GoldenPack, Decodes) {
   PackInfo info;
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   EXPECT_EQ(info.version, version);
-  EXPECT_EQ(info.models.at(0).geometry.version, std::min(version, 3));
+  EXPECT_EQ(info.models.at(0).geometry.version, version >= 5 ? 4 : std::min(version, 3));
+  EXPECT_EQ(info.models.at(0).geometry.lifting_update, version >= 5);
   const PackDecodeResult r = decode_pack(pack);
   ASSERT_EQ(r.status, Status::kOk);
   ASSERT_EQ(r.models.size(), 2u);
@@ -566,7 +568,8 @@ INSTANTIATE_TEST_SUITE_P(Versions, GoldenPack,
                          ::testing::Values(std::pair<const char*, int>{"golden-pillow.gip", 1},
                                            std::pair<const char*, int>{"golden-pillow-v2.gip", 2},
                                            std::pair<const char*, int>{"golden-pillow-v3.gip", 3},
-                                           std::pair<const char*, int>{"golden-pillow-v4.gip", 4}));
+                                           std::pair<const char*, int>{"golden-pillow-v4.gip", 4},
+                                           std::pair<const char*, int>{"golden-pillow-v5.gip", 5}));
 
 }  // namespace
 }  // namespace geomip::codec

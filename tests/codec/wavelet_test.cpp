@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -21,17 +22,19 @@ std::vector<std::int32_t> random_grid(int level, std::uint32_t seed, int range =
 }
 
 TEST(Wavelet, PerfectReconstructionOnRandomIntegers) {
-  for (auto filter : kFilters) {
-    for (int level = 0; level <= 8; ++level) {
-      for (int steps = 0; steps <= level; ++steps) {
-        auto g = random_grid(level, static_cast<std::uint32_t>(level * 31 + steps));
-        const auto original = g;
-        wavelet_forward(g, level, steps, filter);
-        if (steps > 0 && level >= 2) {
-          EXPECT_NE(g, original);
+  for (bool update : {false, true}) {  // the interpolating transform, then with the update step
+    for (auto filter : kFilters) {
+      for (int level = 0; level <= 8; ++level) {
+        for (int steps = 0; steps <= level; ++steps) {
+          auto g = random_grid(level, static_cast<std::uint32_t>(level * 31 + steps));
+          const auto original = g;
+          wavelet_forward(g, level, steps, filter, update);
+          if (steps > 0 && level >= 2) {
+            EXPECT_NE(g, original);
+          }
+          wavelet_inverse(g, level, steps, filter, update);
+          ASSERT_EQ(g, original) << "level " << level << " steps " << steps;
         }
-        wavelet_inverse(g, level, steps, filter);
-        ASSERT_EQ(g, original) << "level " << level << " steps " << steps;
       }
     }
   }
@@ -52,98 +55,146 @@ TEST(Wavelet, CoarseBandIsTheNestedSubsample) {
   }
 }
 
-TEST(Wavelet, BoundaryCoefficientsDependOnlyOnTheBoundaryLineAndReverse) {
-  // Two grids with the same boundary row j = 0 reversed as column i = n−1 (as on a reversed seam), different
-  // interiors: the coefficients along those lines agree (reversed), for every side pairing used by seams.
+TEST(Wavelet, TheUpdateAveragesTheCoarseBandButLeavesTheBorderToItself) {
+  // With the update the coarse band is no longer the subsample inside the grid (it still is on the border
+  // lines, which are never updated).
   for (auto filter : kFilters) {
-    const int level = 7, n = 129;
-    auto a = random_grid(level, 11), b = random_grid(level, 12);
-    for (int k = 0; k < n; ++k) b[(n - 1 - k) * n + (n - 1)] = a[k];  // side 0 of a == side 1 of b reversed
-    wavelet_forward(a, level, level, filter);
-    wavelet_forward(b, level, level, filter);
-    for (int k = 0; k < n; ++k) ASSERT_EQ(b[(n - 1 - k) * n + (n - 1)], a[k]) << "k = " << k;
-    // And a changed interior leaves the boundary coefficients alone.
-    auto c = random_grid(level, 13);
-    auto d = c;
-    for (int j = 1; j < n - 1; ++j) {
-      for (int i = 1; i < n - 1; ++i) d[j * n + i] += 17 * i - 5 * j;
+    const int level = 6, n = 65, steps = 3, s = 1 << steps;
+    auto g = random_grid(level, 7, 1000);
+    const auto original = g;
+    wavelet_forward(g, level, steps, filter, true);
+    int inner_changed = 0;
+    for (int j = 0; j < n; j += s) {
+      for (int i = 0; i < n; i += s) {
+        const bool border = i == 0 || j == 0 || i == n - 1 || j == n - 1;
+        if (border) {
+          ASSERT_EQ(g[j * n + i], original[j * n + i]) << i << ", " << j;
+        } else {
+          inner_changed += g[j * n + i] != original[j * n + i];
+        }
+      }
     }
-    wavelet_forward(c, level, 5, filter);
-    wavelet_forward(d, level, 5, filter);
-    for (int k = 0; k < n; ++k) {
-      ASSERT_EQ(c[k], d[k]);
-      ASSERT_EQ(c[(n - 1) * n + k], d[(n - 1) * n + k]);
-      ASSERT_EQ(c[k * n], d[k * n]);
-      ASSERT_EQ(c[k * n + n - 1], d[k * n + n - 1]);
+    EXPECT_GT(inner_changed, 0);
+    // A spike on a constant field at a sample that is not in the coarse band: the subsample misses it, the
+    // updated band keeps its mass (the update preserves the mean: each coarse sample stands for 4 finer ones).
+    for (bool update : {false, true}) {
+      std::vector<std::int32_t> f(static_cast<std::size_t>(n) * n, 500);
+      const int spike = 4096;
+      f[33 * n + 31] += spike;  // odd row and column: not a coarse sample after one step
+      wavelet_forward(f, level, 1, filter, update);
+      std::int64_t mass = 0;
+      for (int j = 0; j < n; j += 2) {
+        for (int i = 0; i < n; i += 2) mass += f[j * n + i] - 500;
+      }
+      if (update) {
+        EXPECT_NEAR(4.0 * static_cast<double>(mass), spike, 16.0) << static_cast<int>(filter);
+      } else {
+        EXPECT_EQ(mass, 0);
+      }
+    }
+  }
+}
+
+TEST(Wavelet, BoundaryCoefficientsDependOnlyOnTheBoundaryLineAndReverse) {
+  for (bool update : {false, true}) {  // the interpolating transform, then with the update step
+    // Two grids with the same boundary row j = 0 reversed as column i = n−1 (as on a reversed seam), different
+    // interiors: the coefficients along those lines agree (reversed), for every side pairing used by seams.
+    for (auto filter : kFilters) {
+      const int level = 7, n = 129;
+      auto a = random_grid(level, 11), b = random_grid(level, 12);
+      for (int k = 0; k < n; ++k) b[(n - 1 - k) * n + (n - 1)] = a[k];  // side 0 of a == side 1 of b reversed
+      wavelet_forward(a, level, level, filter, update);
+      wavelet_forward(b, level, level, filter, update);
+      for (int k = 0; k < n; ++k) ASSERT_EQ(b[(n - 1 - k) * n + (n - 1)], a[k]) << "k = " << k;
+      // And a changed interior leaves the boundary coefficients alone.
+      auto c = random_grid(level, 13);
+      auto d = c;
+      for (int j = 1; j < n - 1; ++j) {
+        for (int i = 1; i < n - 1; ++i) d[j * n + i] += 17 * i - 5 * j;
+      }
+      wavelet_forward(c, level, 5, filter, update);
+      wavelet_forward(d, level, 5, filter, update);
+      for (int k = 0; k < n; ++k) {
+        ASSERT_EQ(c[k], d[k]);
+        ASSERT_EQ(c[(n - 1) * n + k], d[(n - 1) * n + k]);
+        ASSERT_EQ(c[k * n], d[k * n]);
+        ASSERT_EQ(c[k * n + n - 1], d[k * n + n - 1]);
+      }
     }
   }
 }
 
 TEST(Wavelet, OneDimensionalReversalEquivariance) {
-  // A grid and its mirror image (i → n−1−i) transform to mirrored coefficients.
-  for (auto filter : kFilters) {
-    for (int level = 1; level <= 6; ++level) {
-      const int n = (1 << level) + 1;
-      auto a = random_grid(level, 40 + level);
-      auto b = a;
-      for (int j = 0; j < n; ++j) {
-        for (int i = 0; i < n; ++i) b[j * n + i] = a[j * n + (n - 1 - i)];
-      }
-      wavelet_forward(a, level, level, filter);
-      wavelet_forward(b, level, level, filter);
-      for (int j = 0; j < n; ++j) {
-        for (int i = 0; i < n; ++i) ASSERT_EQ(b[j * n + i], a[j * n + (n - 1 - i)]);
+  for (bool update : {false, true}) {  // the interpolating transform, then with the update step
+    // A grid and its mirror image (i → n−1−i) transform to mirrored coefficients.
+    for (auto filter : kFilters) {
+      for (int level = 1; level <= 6; ++level) {
+        const int n = (1 << level) + 1;
+        auto a = random_grid(level, 40 + level);
+        auto b = a;
+        for (int j = 0; j < n; ++j) {
+          for (int i = 0; i < n; ++i) b[j * n + i] = a[j * n + (n - 1 - i)];
+        }
+        wavelet_forward(a, level, level, filter, update);
+        wavelet_forward(b, level, level, filter, update);
+        for (int j = 0; j < n; ++j) {
+          for (int i = 0; i < n; ++i) ASSERT_EQ(b[j * n + i], a[j * n + (n - 1 - i)]);
+        }
       }
     }
   }
 }
 
 TEST(Wavelet, LinearFieldsHaveZeroDetailsWithTheLinearFilter) {
-  const int level = 7, n = 129;
-  std::vector<std::int32_t> g(n * n);
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) g[j * n + i] = 1234 + 37 * i - 91 * j;
-  }
-  for (auto filter : kFilters) {
-    auto c = g;
-    wavelet_forward(c, level, level, filter);
+  for (bool update : {false, true}) {  // the interpolating transform, then with the update step
+    const int level = 7, n = 129;
+    std::vector<std::int32_t> g(n * n);
     for (int j = 0; j < n; ++j) {
-      for (int i = 0; i < n; ++i) {
-        if (i % (n - 1) == 0 && j % (n - 1) == 0) continue;  // the level-0 corners
-        ASSERT_EQ(c[j * n + i], 0) << "(" << i << ", " << j << ")";
+      for (int i = 0; i < n; ++i) g[j * n + i] = 1234 + 37 * i - 91 * j;
+    }
+    for (auto filter : kFilters) {
+      auto c = g;
+      wavelet_forward(c, level, level, filter, update);
+      for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+          if (i % (n - 1) == 0 && j % (n - 1) == 0) continue;  // the level-0 corners
+          ASSERT_EQ(c[j * n + i], 0) << "(" << i << ", " << j << ")";
+        }
       }
     }
   }
 }
 
 TEST(Wavelet, CubicFieldsHaveZeroDetailsWithTheCubicFilter) {
-  // p(i) + q(j) cubic: exact wherever the line has at least 4 evens (current grid of ≥ 9 samples).
-  const int level = 7, n = 129;
-  std::vector<std::int32_t> g(n * n);
-  auto p = [](std::int64_t x) { return x * x * x - 60 * x * x + 7 * x; };
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      const std::int64_t v = (static_cast<std::int64_t>(i) * i * i - 150 * i * i + 3 * i) + 2 * p(j);
-      g[j * n + i] = static_cast<std::int32_t>(v);
+  for (bool update : {false, true}) {  // the interpolating transform, then with the update step
+    // p(i) + q(j) cubic: exact wherever the line has at least 4 evens (current grid of ≥ 9 samples).
+    const int level = 7, n = 129;
+    std::vector<std::int32_t> g(n * n);
+    auto p = [](std::int64_t x) { return x * x * x - 60 * x * x + 7 * x; };
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const std::int64_t v = (static_cast<std::int64_t>(i) * i * i - 150 * i * i + 3 * i) + 2 * p(j);
+        g[j * n + i] = static_cast<std::int32_t>(v);
+      }
     }
-  }
-  const int steps = level - 2;  // the last step works on a 9-sample grid: 5 evens
-  auto c = g;
-  wavelet_forward(c, level, steps, WaveletFilter::kCubic);
-  const int coarse = 1 << steps;
-  int nonzero = 0;
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      if (i % coarse == 0 && j % coarse == 0) continue;
-      nonzero += c[j * n + i] != 0;
+    const int steps = level - 2;  // the last step works on a 9-sample grid: 5 evens
+    auto c = g;
+    wavelet_forward(c, level, steps, WaveletFilter::kCubic, update);
+    const int coarse = 1 << steps;
+    int nonzero = 0;
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        if (i % coarse == 0 && j % coarse == 0) continue;
+        nonzero += c[j * n + i] != 0;
+      }
     }
+    EXPECT_EQ(nonzero, 0);
+    auto l = g;
+    wavelet_forward(l, level, steps, WaveletFilter::kLinear);
+    int linear_nonzero = 0;
+    for (auto v : l) linear_nonzero += v != 0;
+    EXPECT_GT(linear_nonzero, n * n / 2);  // the linear filter does not reproduce cubics
   }
-  EXPECT_EQ(nonzero, 0);
-  auto l = g;
-  wavelet_forward(l, level, steps, WaveletFilter::kLinear);
-  int linear_nonzero = 0;
-  for (auto v : l) linear_nonzero += v != 0;
-  EXPECT_GT(linear_nonzero, n * n / 2);  // the linear filter does not reproduce cubics
 }
 
 TEST(Wavelet, RejectsWrongSizes) {

@@ -39,8 +39,10 @@ struct QuadLayoutOptions {
   /// length L bounds the patch's L∞ stretch from below by L / sqrt(A) whatever the map (the side lies on a
   /// unit edge of the square), and a corner far above 90° squeezes the surface around it into the square's
   /// wedge; a patch of low flatness (PatchStats::flatness) wraps around a leg or a hoof and cannot be
-  /// mapped to the square without stretch. 0: the objective alone, as before.
-  double shape_weight = 1.0;
+  /// mapped to the square without stretch. 0 (default): the objective alone. Off by default because on the
+  /// horse, bunny, armadillo and cow it moved the L∞ stretch per patch both ways and cost up to 2.8 dB of
+  /// remesh PSNR (docs/measurements.md, "L∞ stretch per patch: layouts").
+  double shape_weight = 0.0;
   double max_corner_angle_deg = 150.0;
   double max_side_ratio = 2.5;
   double min_flatness = 0.5;

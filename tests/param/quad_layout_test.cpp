@@ -151,13 +151,14 @@ std::pair<double, double> measured_shape(const TriMesh& m, const QuadLayout& lay
 // the same up to those moves); with the shape term the layout's longest side over sqrt(area) is lower than
 // without it, and the choice is the same on a second run (deterministic).
 TEST(QuadLayout, ShapeTermShortensLongSides) {
+  ASSERT_EQ(QuadLayoutOptions{}.shape_weight, 0.0);
   TriMesh m = test::sphere(4);
   for (auto& p : m.positions) p = Eigen::Vector3d(5.0 * p.x(), p.y(), p.z());
   for (int k : {8, 12}) {
     SCOPED_TRACE(std::to_string(k) + " patches");
-    QuadLayoutOptions plain, shaped, unmoved;
+    QuadLayoutOptions plain, shaped, unmoved;  // plain: shape_weight 0, the default
     plain.patches = shaped.patches = unmoved.patches = k;
-    plain.shape_weight = 0.0;
+    shaped.shape_weight = unmoved.shape_weight = 1.0;
     unmoved.shape_steps = 0;
     const QuadLayoutChoice a = choose_quad_layout(m, plain), b = choose_quad_layout(m, shaped),
                            c = choose_quad_layout(m, unmoved);

@@ -83,7 +83,8 @@ std::vector<PatchShape> patch_shapes(const PartitionResult& partition) {
     for (int s = 0; s < 4; ++s) {
       const auto& path = patch.sides[s].vertices;
       double length = 0.0;
-      for (std::size_t i = 1; i < path.size(); ++i) length += (pm.positions[path[i]] - pm.positions[path[i - 1]]).norm();
+      for (std::size_t i = 1; i < path.size(); ++i)
+        length += (pm.positions[path[i]] - pm.positions[path[i - 1]]).norm();
       shapes[q].side_ratio[s] = area > 0.0 ? length / std::sqrt(area) : 0.0;
     }
   }
@@ -758,12 +759,13 @@ int relax_corners(const TriMesh& mesh, const Objective& objective,
 }
 
 // Moves the corners whose patches are worst shaped (shape_penalty(): a corner angle above
-// `max_corner_angle_deg`, a side longer than `max_side_ratio` · sqrt(area)) to lower `objective`. Each round
+// `max_corner_angle_deg`, a side longer than `max_side_ratio` · sqrt(area), a flatness below `min_flatness`)
+// to lower `objective`. Each round
 // ranks the corners by their share of the penalty and, for the worst 8 in turn, tries landing it (on the
 // nearest free vertex of its patches) at `step` towards and away from each of its patches' area centroids and
-// `step`/2 of the way towards and away from each corner it shares a side with; the best candidate that lowers the objective
-// is kept. When no corner improves the step is halved. At most `evaluations` partitions are tried. Returns
-// the number of moves kept.
+// `step`/2 of the way towards and away from each corner it shares a side with; the best candidate that
+// lowers the objective is kept. When no corner improves the step is halved. At most `evaluations`
+// partitions are tried. Returns the number of moves kept.
 int reshape_corners(const TriMesh& mesh, const Objective& objective, const QuadLayoutOptions& options,
                     const std::vector<int>& locked, QuadLayout& layout, PartitionResult& partition,
                     PartitionStats& stats, int evaluations) {
@@ -887,8 +889,8 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
       options.objective == LayoutObjective::kSamplingCost ? sampling_cost : area_spread;
   const Objective objective = [&](const PartitionResult& partition, const PartitionStats& stats) {
     const double cost = base(stats);
-    return options.shape_weight > 0.0 ? cost + options.shape_weight * shape_penalty(patch_shapes(partition), stats, options)
-                                      : cost;
+    if (options.shape_weight <= 0.0) return cost;
+    return cost + options.shape_weight * shape_penalty(patch_shapes(partition), stats, options);
   };
   std::string last_error;
   // Two groups of candidates: coarse meshes without and with the protrusion tips pinned (at most half the

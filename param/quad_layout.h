@@ -32,16 +32,17 @@ struct QuadLayoutOptions {
   double tip_persistence = 0.0;
   /// For measurements: only the candidates with the tips pinned (when tips are found).
   bool only_pinned_tips = false;
-  /// Patch shape (issue 15, L∞ stretch per patch): the objective gets `shape_weight` times Σ over the patches
-  /// of Σ_corners (max(0, corner angle − max_corner_angle_deg) / 90°)² + Σ_sides max(0, side length /
-  /// sqrt(patch area) − max_side_ratio)² + (max(0, min_flatness − flatness) / 0.25)², where a corner angle is the 3D angle sum of the patch's triangles
-  /// at that corner (the square has 90° there) and a side length the 3D length of its path. A side of
-  /// length L bounds the patch's L∞ stretch from below by L / sqrt(A) whatever the map (the side lies on a
-  /// unit edge of the square), and a corner far above 90° squeezes the surface around it into the square's
-  /// wedge; a patch of low flatness (PatchStats::flatness) wraps around a leg or a hoof and cannot be
-  /// mapped to the square without stretch. 0 (default): the objective alone. Off by default because on the
-  /// horse, bunny, armadillo and cow it moved the L∞ stretch per patch both ways and cost up to 2.8 dB of
-  /// remesh PSNR (docs/measurements.md, "L∞ stretch per patch: layouts").
+  /// Patch shape (issue 15, L∞ stretch per patch): the objective gets `shape_weight` times Σ over the
+  /// patches of Σ_corners (max(0, corner angle − max_corner_angle_deg) / 90°)² + Σ_sides max(0, side length /
+  /// sqrt(patch area) − max_side_ratio)² + (max(0, min_flatness − flatness) / 0.25)², where a corner angle is
+  /// the 3D angle sum of the patch's triangles at that corner (the square has 90° there) and a side length
+  /// the 3D length of its path. A side of length L bounds the patch's L∞ stretch from below by L / sqrt(A)
+  /// whatever the map (the side lies on a unit edge of the square); a corner far above 90° squeezes the
+  /// surface around it into the square's wedge; a patch of low flatness (PatchStats::flatness) wraps around
+  /// a limb and cannot be mapped to the square without stretch. 0 (default): the objective alone, the
+  /// layouts as without this term. Off by default: on the horse, bunny, armadillo and cow it moved the
+  /// worst patch's L∞ stretch both ways and lowered the remesh PSNR on most of them (docs/measurements.md,
+  /// "L∞ stretch per patch: layouts").
   double shape_weight = 0.0;
   double max_corner_angle_deg = 150.0;
   double max_side_ratio = 2.5;
@@ -98,7 +99,8 @@ struct QuadLayoutChoice {
 /// Deterministic: no randomness, no threads; the same mesh and options give the same layout.
 /// With `tip_persistence` > 0 the steps run twice, without and with the protrusion tips pinned as coarse
 /// vertices (never collapsed, never moved), and the layout with the lower objective is returned.
-/// Cost: O(F log F) for the simplification plus one partition per pairing and per balancing step.
+/// Cost: O(F log F) for the simplification plus one partition per pairing, per balancing step and per shape
+/// move tried.
 ///
 /// \throw InvalidInput with "choose_quad_layout:" when the mesh is not one closed, manifold, oriented
 ///   component, K < 2, K + 2 − 2g < 4 (K too small for the genus), K + 2 − 2g exceeds the mesh's vertices

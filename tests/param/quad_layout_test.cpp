@@ -130,7 +130,8 @@ std::pair<double, double> measured_shape(const TriMesh& m, const QuadLayout& lay
       for (int j = 0; j < 3; ++j) {
         const auto at = std::find(patch.corners.begin(), patch.corners.end(), t[j]);
         if (at == patch.corners.end()) continue;
-        const Eigen::Vector3d u = (p[t[(j + 1) % 3]] - p[t[j]]).normalized(), v = (p[t[(j + 2) % 3]] - p[t[j]]).normalized();
+        const Eigen::Vector3d u = (p[t[(j + 1) % 3]] - p[t[j]]).normalized(),
+                              v = (p[t[(j + 2) % 3]] - p[t[j]]).normalized();
         angle[at - patch.corners.begin()] += std::acos(std::clamp(u.dot(v), -1.0, 1.0)) * 180.0 / M_PI;
       }
     }
@@ -138,7 +139,8 @@ std::pair<double, double> measured_shape(const TriMesh& m, const QuadLayout& lay
       max_angle = std::max(max_angle, angle[s]);
       const auto& path = patch.sides[s].vertices;
       double length = 0.0;
-      for (std::size_t i = 1; i < path.size(); ++i) length += (r.mesh.positions[path[i]] - r.mesh.positions[path[i - 1]]).norm();
+      for (std::size_t i = 1; i < path.size(); ++i)
+        length += (r.mesh.positions[path[i]] - r.mesh.positions[path[i - 1]]).norm();
       max_ratio = std::max(max_ratio, length / std::sqrt(area));
     }
   }

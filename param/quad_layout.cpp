@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <queue>
 #include <string>
 #include <tuple>
@@ -45,6 +46,67 @@ double sampling_cost(const PartitionStats& stats) {
     cost += p.area * p.area / std::max(p.flatness, 0.05);
   }
   return cost * static_cast<double>(stats.patches.size()) / (total * total);
+}
+
+// What a layout is ranked by: the area / sampling term of `stats` plus the shape penalty of `partition`.
+using Objective = std::function<double(const PartitionResult&, const PartitionStats&)>;
+
+// The shape of each patch of `partition`: the 3D angle sum of its triangles at each of its 4 corners and the
+// 3D length of each side over sqrt(its area). Both bound the L∞ stretch of any map of the patch to the
+// square with the corners on the square's corners: side k lies on a unit edge, so some boundary edge is
+// stretched by at least L_k / sqrt(A) (docs/measurements.md, "L∞ stretch per patch"), and a corner whose
+// surface angle is far above 90° is squeezed into the square's 90° wedge.
+struct PatchShape {
+  std::array<double, 4> corner_angle{};  // radians
+  std::array<double, 4> side_ratio{};    // side length / sqrt(area)
+};
+
+std::vector<PatchShape> patch_shapes(const PartitionResult& partition) {
+  const auto& pm = partition.mesh;
+  std::vector<PatchShape> shapes(partition.patches.size());
+  for (std::size_t q = 0; q < partition.patches.size(); ++q) {
+    const Patch& patch = partition.patches[q];
+    double area = 0.0;
+    for (int f : patch.faces) {
+      const auto& t = pm.triangles[f];
+      const Eigen::Vector3d e1 = pm.positions[t[1]] - pm.positions[t[0]], e2 = pm.positions[t[2]] - pm.positions[t[0]];
+      area += 0.5 * e1.cross(e2).norm();
+      for (int j = 0; j < 3; ++j) {
+        for (int c = 0; c < 4; ++c) {
+          if (t[j] != patch.corners[c]) continue;
+          const Eigen::Vector3d u = pm.positions[t[(j + 1) % 3]] - pm.positions[t[j]],
+                                v = pm.positions[t[(j + 2) % 3]] - pm.positions[t[j]];
+          shapes[q].corner_angle[c] += std::atan2(u.cross(v).norm(), u.dot(v));
+        }
+      }
+    }
+    for (int s = 0; s < 4; ++s) {
+      const auto& path = patch.sides[s].vertices;
+      double length = 0.0;
+      for (std::size_t i = 1; i < path.size(); ++i)
+        length += (pm.positions[path[i]] - pm.positions[path[i - 1]]).norm();
+      shapes[q].side_ratio[s] = area > 0.0 ? length / std::sqrt(area) : 0.0;
+    }
+  }
+  return shapes;
+}
+
+// Σ over patches of Σ_corners (max(0, angle − max_angle) / 90°)² + Σ_sides max(0, ratio − max_ratio)² +
+// (max(0, min_flatness − flatness) / 0.25)²: 0 when every corner, side and patch is within the bounds.
+double shape_penalty(const std::vector<PatchShape>& shapes, const PartitionStats& stats, const QuadLayoutOptions& o) {
+  const double max_angle = o.max_corner_angle_deg * M_PI / 180.0;
+  double penalty = 0.0;
+  for (std::size_t q = 0; q < shapes.size(); ++q) {
+    const PatchShape& s = shapes[q];
+    const double f = std::max(0.0, o.min_flatness - stats.patches[q].flatness) / 0.25;
+    penalty += f * f;
+    for (int k = 0; k < 4; ++k) {
+      const double a = std::max(0.0, s.corner_angle[k] - max_angle) / (0.5 * M_PI);
+      const double r = std::max(0.0, s.side_ratio[k] - o.max_side_ratio);
+      penalty += a * a + r * r;
+    }
+  }
+  return penalty;
 }
 
 // Half-edge collapses on a closed manifold triangle mesh, shortest edge first, vertices never moved.
@@ -391,7 +453,7 @@ void even_quads_at_two_quad_corners(QuadLayout& layout) {
 // Pairs `coarse` (closed, 2k triangles over mesh vertices) into k quads by each greedy score completed to a
 // perfect matching; every pairing that partitions `mesh` is measured and kept in `best` if more balanced.
 void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int, 3>>& coarse, long long k,
-                           const std::function<double(const PartitionStats&)>& objective,
+                           const Objective& objective,
                            QuadLayoutChoice& best, double& best_cost, std::string& last_error) {
   const int nf = static_cast<int>(coarse.size());
   // Dual graph: triangles sharing an edge.
@@ -457,10 +519,12 @@ void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int
     }
     even_quads_at_two_quad_corners(layout);
     try {
-      const PartitionStats stats = partition_stats(partition_mesh_layout(mesh, layout));
+      const PartitionResult partition = partition_mesh_layout(mesh, layout);
+      const PartitionStats stats = partition_stats(partition);
+      const double cost = objective(partition, stats);
       ++best.candidates;
-      if (best.candidates == 1 || objective(stats) < best_cost) {
-        best_cost = objective(stats);
+      if (best.candidates == 1 || cost < best_cost) {
+        best_cost = cost;
         best.layout = std::move(layout);
       }
     } catch (const InvalidInput& e) {
@@ -545,32 +609,39 @@ std::vector<int> protrusion_tips(const TriMesh& mesh, double min_persistence, st
   return tips;
 }
 
-// Moves the corners of `layout` over the mesh so that its patches get more equal areas. A move takes a set
-// of corners; each moves towards the area centroids of its larger neighbouring patches and away from its
-// smaller ones (a corner moved into a patch takes area from it and gives it to the patches on its other
-// sides), by `step` times the area-weighted sum of the directions, and lands on the nearest vertex of its
-// neighbouring patches that is not another corner. A move is kept when the new layout partitions the mesh
-// with a lower area_spread(). Each round tries all corners at once, then the corners of one patch at a time,
-// the patch farthest from the mean area first (up to 3 patches); when nothing is kept the step is halved.
-// At most `evaluations` partitions are tried. Returns the number of moves kept.
-int relax_corners(const TriMesh& mesh, const std::function<double(const PartitionStats&)>& objective,
-                  const std::vector<int>& locked, QuadLayout& layout, PartitionResult& partition,
-                  PartitionStats& stats, int evaluations) {
-  const int nc = static_cast<int>(layout.corners.size());
-  const int nq = static_cast<int>(layout.quads.size());
-  std::vector<std::vector<int>> quads_at(nc);
-  for (int q = 0; q < nq; ++q) {
-    for (int c : layout.quads[q]) quads_at[c].push_back(q);
+// A layout with its partition, stats and objective.
+struct EvaluatedLayout {
+  QuadLayout layout;
+  PartitionResult partition;
+  PartitionStats stats;
+  double cost = 0.0;
+};
+
+// Partitions `mesh` by `layout` and measures it; nullopt when the layout cuts the mesh into other regions
+// than its quads (partition_mesh_layout() refuses it).
+std::optional<EvaluatedLayout> evaluate_layout(const TriMesh& mesh, const Objective& objective, QuadLayout layout) {
+  try {
+    EvaluatedLayout e;
+    e.partition = partition_mesh_layout(mesh, layout);
+    e.stats = partition_stats(e.partition);
+    e.cost = objective(e.partition, e.stats);
+    e.layout = std::move(layout);
+    return e;
+  } catch (const InvalidInput&) {
+    return std::nullopt;
   }
-  double spread = objective(stats);
-  double step = 0.5;
-  int kept = 0, tried = 0;
-  while (tried < evaluations && step > 0.03) {
+}
+
+// Area centroid, area and (original mesh) vertices of every patch of `partition`.
+struct PatchGeometry {
+  std::vector<Eigen::Vector3d> centroid;
+  std::vector<double> area;
+  std::vector<std::vector<int>> verts;  // ascending
+  double mean = 0.0;                    // mean patch area
+
+  PatchGeometry(const TriMesh& mesh, const PartitionResult& partition, int nq)
+      : centroid(nq, Eigen::Vector3d::Zero()), area(nq, 0.0), verts(nq) {
     const auto& pm = partition.mesh;
-    // Area centroid of every patch and the vertices of each patch (original mesh vertices only).
-    std::vector<Eigen::Vector3d> centroid(nq, Eigen::Vector3d::Zero());
-    std::vector<double> area(nq, 0.0);
-    std::vector<std::vector<int>> verts(nq);
     for (std::size_t f = 0; f < pm.triangles.size(); ++f) {
       const auto& t = pm.triangles[f];
       const int q = partition.face_patch[f];
@@ -590,7 +661,53 @@ int relax_corners(const TriMesh& mesh, const std::function<double(const Partitio
       std::sort(verts[q].begin(), verts[q].end());
       verts[q].erase(std::unique(verts[q].begin(), verts[q].end()), verts[q].end());
     }
-    const double mean = total / nq;
+    mean = total / nq;
+  }
+
+  // The vertex of the patches `around` nearest `target` that is not `taken` (or is `own`); −1 if none.
+  int snap(const TriMesh& mesh, const std::vector<int>& around, const Eigen::Vector3d& target,
+           const std::vector<char>& taken, int own) const {
+    int best_v = -1;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (int q : around) {
+      for (int v : verts[q]) {
+        if (taken[v] && v != own) continue;
+        const double d = (mesh.positions[v] - target).squaredNorm();
+        if (d < best_d) {
+          best_d = d;
+          best_v = v;
+        }
+      }
+    }
+    return best_v;
+  }
+};
+
+// Moves the corners of `layout` over the mesh so that its patches get more equal areas. A move takes a set
+// of corners; each moves towards the area centroids of its larger neighbouring patches and away from its
+// smaller ones (a corner moved into a patch takes area from it and gives it to the patches on its other
+// sides), by `step` times the area-weighted sum of the directions, and lands on the nearest vertex of its
+// neighbouring patches that is not another corner. A move is kept when the new layout partitions the mesh
+// with a lower area_spread(). Each round tries all corners at once, then the corners of one patch at a time,
+// the patch farthest from the mean area first (up to 3 patches); when nothing is kept the step is halved.
+// At most `evaluations` partitions are tried. Returns the number of moves kept.
+int relax_corners(const TriMesh& mesh, const Objective& objective,
+                  const std::vector<int>& locked, QuadLayout& layout, PartitionResult& partition,
+                  PartitionStats& stats, int evaluations) {
+  const int nc = static_cast<int>(layout.corners.size());
+  const int nq = static_cast<int>(layout.quads.size());
+  std::vector<std::vector<int>> quads_at(nc);
+  for (int q = 0; q < nq; ++q) {
+    for (int c : layout.quads[q]) quads_at[c].push_back(q);
+  }
+  double spread = objective(partition, stats);
+  double step = 0.5;
+  int kept = 0, tried = 0;
+  while (tried < evaluations && step > 0.03) {
+    const PatchGeometry geometry(mesh, partition, nq);
+    const auto& centroid = geometry.centroid;
+    const auto& area = geometry.area;
+    const double mean = geometry.mean;
     // The moves of this round: all corners, then each of the 3 patches farthest from the mean area.
     std::vector<int> order(nq);
     for (int q = 0; q < nq; ++q) order[q] = q;
@@ -618,18 +735,7 @@ int relax_corners(const TriMesh& mesh, const std::function<double(const Partitio
         local /= static_cast<double>(quads_at[c].size());
         Eigen::Vector3d target = pc;
         for (int q : quads_at[c]) target += step * (area[q] - local) / mean * (centroid[q] - pc);
-        int best_v = -1;
-        double best_d = std::numeric_limits<double>::infinity();
-        for (int q : quads_at[c]) {
-          for (int v : verts[q]) {
-            if (taken[v] && v != moved.corners[c]) continue;
-            const double d = (mesh.positions[v] - target).squaredNorm();
-            if (d < best_d) {
-              best_d = d;
-              best_v = v;
-            }
-          }
-        }
+        const int best_v = geometry.snap(mesh, quads_at[c], target, taken, moved.corners[c]);
         if (best_v < 0) continue;
         taken[moved.corners[c]] = 0;
         moved.corners[c] = best_v;
@@ -637,21 +743,116 @@ int relax_corners(const TriMesh& mesh, const std::function<double(const Partitio
       }
       if (moved.corners == layout.corners) continue;
       ++tried;
-      try {
-        PartitionResult candidate = partition_mesh_layout(mesh, moved);
-        PartitionStats candidate_stats = partition_stats(candidate);
-        const double candidate_spread = objective(candidate_stats);
-        if (candidate_spread < spread) {
-          layout = std::move(moved);
-          partition = std::move(candidate);
-          stats = std::move(candidate_stats);
-          spread = candidate_spread;
-          ++kept;
-          improved = true;
-          break;
-        }
-      } catch (const InvalidInput&) {
-        // this move cuts the mesh into other regions than the layout's quads: not kept
+      if (auto candidate = evaluate_layout(mesh, objective, std::move(moved)); candidate && candidate->cost < spread) {
+        spread = candidate->cost;
+        layout = std::move(candidate->layout);
+        partition = std::move(candidate->partition);
+        stats = std::move(candidate->stats);
+        ++kept;
+        improved = true;
+        break;
+      }
+    }
+    step = improved ? std::min(1.0, step * 1.25) : step * 0.5;
+  }
+  return kept;
+}
+
+// Moves the corners whose patches are worst shaped (shape_penalty(): a corner angle above
+// `max_corner_angle_deg`, a side longer than `max_side_ratio` · sqrt(area), a flatness below `min_flatness`)
+// to lower `objective`. Each round
+// ranks the corners by their share of the penalty and, for the worst 8 in turn, tries landing it (on the
+// nearest free vertex of its patches) at `step` towards and away from each of its patches' area centroids and
+// `step`/2 of the way towards and away from each corner it shares a side with; the best candidate that
+// lowers the objective is kept. When no corner improves the step is halved. At most `evaluations`
+// partitions are tried. Returns the number of moves kept.
+int reshape_corners(const TriMesh& mesh, const Objective& objective, const QuadLayoutOptions& options,
+                    const std::vector<int>& locked, QuadLayout& layout, PartitionResult& partition,
+                    PartitionStats& stats, int evaluations) {
+  const int nc = static_cast<int>(layout.corners.size());
+  const int nq = static_cast<int>(layout.quads.size());
+  std::vector<std::vector<int>> quads_at(nc), side_neighbours(nc);
+  for (int q = 0; q < nq; ++q) {
+    for (int i = 0; i < 4; ++i) {
+      const int c = layout.quads[q][i];
+      quads_at[c].push_back(q);
+      side_neighbours[c].push_back(layout.quads[q][(i + 1) % 4]);
+      side_neighbours[c].push_back(layout.quads[q][(i + 3) % 4]);
+    }
+  }
+  for (auto& n : side_neighbours) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  const double max_angle = options.max_corner_angle_deg * M_PI / 180.0;
+  double cost = objective(partition, stats);
+  double step = 0.5;
+  int kept = 0, tried = 0;
+  while (tried < evaluations && step > 0.03) {
+    // Each corner's share of the shape penalty (a side's share goes to both its ends).
+    std::unordered_map<int, int> corner_of;
+    for (int c = 0; c < nc; ++c) corner_of[layout.corners[c]] = c;
+    const std::vector<PatchShape> shapes = patch_shapes(partition);
+    std::vector<double> badness(nc, 0.0);
+    for (std::size_t q = 0; q < shapes.size(); ++q) {
+      const auto& corners = partition.patches[q].corners;
+      const double flat = std::max(0.0, options.min_flatness - stats.patches[q].flatness) / 0.25;
+      for (int k = 0; k < 4; ++k) {
+        if (const auto it = corner_of.find(corners[k]); it != corner_of.end()) badness[it->second] += flat * flat;
+        const double a = std::max(0.0, shapes[q].corner_angle[k] - max_angle) / (0.5 * M_PI);
+        const double r = std::max(0.0, shapes[q].side_ratio[k] - options.max_side_ratio);
+        const auto here = corner_of.find(corners[k]), next = corner_of.find(corners[(k + 1) % 4]);
+        if (here != corner_of.end()) badness[here->second] += a * a + r * r;
+        if (next != corner_of.end()) badness[next->second] += r * r;
+      }
+    }
+    std::vector<int> order;
+    for (int c = 0; c < nc; ++c) {
+      if (badness[c] > 0.0 && std::find(locked.begin(), locked.end(), layout.corners[c]) == locked.end())
+        order.push_back(c);
+    }
+    if (order.empty()) break;
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return badness[a] != badness[b] ? badness[a] > badness[b] : a < b; });
+    if (order.size() > 8) order.resize(8);
+    const PatchGeometry geometry(mesh, partition, nq);
+    std::vector<char> taken(mesh.positions.size(), 0);
+    for (int v : layout.corners) taken[v] = 1;
+    bool improved = false;
+    for (int c : order) {
+      const Eigen::Vector3d pc = mesh.positions[layout.corners[c]];
+      std::vector<Eigen::Vector3d> targets;
+      for (int q : quads_at[c]) {
+        targets.push_back(pc + step * (geometry.centroid[q] - pc));
+        targets.push_back(pc - step * (geometry.centroid[q] - pc));
+      }
+      for (int n : side_neighbours[c]) {
+        targets.push_back(pc + 0.5 * step * (mesh.positions[layout.corners[n]] - pc));
+        targets.push_back(pc - 0.5 * step * (mesh.positions[layout.corners[n]] - pc));
+      }
+      std::vector<int> landed;
+      for (const auto& target : targets) {
+        const int v = geometry.snap(mesh, quads_at[c], target, taken, layout.corners[c]);
+        if (v >= 0 && v != layout.corners[c] && std::find(landed.begin(), landed.end(), v) == landed.end())
+          landed.push_back(v);
+      }
+      std::optional<EvaluatedLayout> best;
+      for (int v : landed) {
+        if (tried >= evaluations) break;
+        QuadLayout moved = layout;
+        moved.corners[c] = v;
+        ++tried;
+        auto candidate = evaluate_layout(mesh, objective, std::move(moved));
+        if (candidate && candidate->cost < (best ? best->cost : cost)) best = std::move(candidate);
+      }
+      if (best) {
+        cost = best->cost;
+        layout = std::move(best->layout);
+        partition = std::move(best->partition);
+        stats = std::move(best->stats);
+        ++kept;
+        improved = true;
+        break;
       }
     }
     step = improved ? std::min(1.0, step * 1.25) : step * 0.5;
@@ -684,8 +885,13 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
     throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches need " + std::to_string(target) +
                        " corners but the mesh has " + std::to_string(vertices) + " vertices");
   }
-  const std::function<double(const PartitionStats&)> objective =
+  const std::function<double(const PartitionStats&)> base =
       options.objective == LayoutObjective::kSamplingCost ? sampling_cost : area_spread;
+  const Objective objective = [&](const PartitionResult& partition, const PartitionStats& stats) {
+    const double cost = base(stats);
+    if (options.shape_weight <= 0.0) return cost;
+    return cost + options.shape_weight * shape_penalty(patch_shapes(partition), stats, options);
+  };
   std::string last_error;
   // Two groups of candidates: coarse meshes without and with the protrusion tips pinned (at most half the
   // corners), by either collapse rule, each paired three ways. The best pairing of each group is balanced
@@ -718,7 +924,14 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
       PartitionStats stats = partition_stats(partition);
       group.balance_steps =
           relax_corners(mesh, objective, tips, group.layout, partition, stats, options.balance_steps);
-      group_cost = objective(stats);
+      group_cost = objective(partition, stats);
+    }
+    if (options.shape_weight > 0.0 && options.shape_steps > 0) {
+      PartitionResult partition = partition_mesh_layout(mesh, group.layout);
+      PartitionStats stats = partition_stats(partition);
+      group.shape_steps =
+          reshape_corners(mesh, objective, options, tips, group.layout, partition, stats, options.shape_steps);
+      group_cost = objective(partition, stats);
     }
     if (best.candidates == 0 || group_cost < best_cost) {
       best = std::move(group);
@@ -733,10 +946,19 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
   best.candidates = candidates;
   best.tips = tips;
   {
-    const PartitionStats stats = partition_stats(partition_mesh_layout(mesh, best.layout));
+    const PartitionResult partition = partition_mesh_layout(mesh, best.layout);
+    const PartitionStats stats = partition_stats(partition);
     best.area_balance = stats.area_balance;
     best.area_spread = area_spread(stats);
     best.sampling_cost = sampling_cost(stats);
+    const std::vector<PatchShape> shapes = patch_shapes(partition);
+    best.shape_penalty = shape_penalty(shapes, stats, options);
+    for (const PatchShape& shape : shapes) {
+      for (int j = 0; j < 4; ++j) {
+        best.max_corner_angle_deg = std::max(best.max_corner_angle_deg, shape.corner_angle[j] * 180.0 / M_PI);
+        best.max_side_ratio = std::max(best.max_side_ratio, shape.side_ratio[j]);
+      }
+    }
   }
   return best;
 }

@@ -32,6 +32,24 @@ struct QuadLayoutOptions {
   double tip_persistence = 0.0;
   /// For measurements: only the candidates with the tips pinned (when tips are found).
   bool only_pinned_tips = false;
+  /// Patch shape (issue 15, L∞ stretch per patch): the objective gets `shape_weight` times Σ over the
+  /// patches of Σ_corners (max(0, corner angle − max_corner_angle_deg) / 90°)² + Σ_sides max(0, side length /
+  /// sqrt(patch area) − max_side_ratio)² + (max(0, min_flatness − flatness) / 0.25)², where a corner angle is
+  /// the 3D angle sum of the patch's triangles at that corner (the square has 90° there) and a side length
+  /// the 3D length of its path. A side of length L bounds the patch's L∞ stretch from below by L / sqrt(A)
+  /// whatever the map (the side lies on a unit edge of the square); a corner far above 90° squeezes the
+  /// surface around it into the square's wedge; a patch of low flatness (PatchStats::flatness) wraps around
+  /// a limb and cannot be mapped to the square without stretch. 0 (default): the objective alone, the
+  /// layouts as without this term. Off by default: on the horse, bunny, armadillo and cow it moved the
+  /// worst patch's L∞ stretch both ways and lowered the remesh PSNR on most of them (docs/measurements.md,
+  /// "L∞ stretch per patch: layouts").
+  double shape_weight = 0.0;
+  double max_corner_angle_deg = 150.0;
+  double max_side_ratio = 2.5;
+  double min_flatness = 0.5;
+  /// At most this many partitions tried by the shape moves after the balancing (each moves one corner of
+  /// the worst-shaped patches; a move is kept only when the objective drops). 0: none.
+  int shape_steps = 120;
 };
 
 /// What choose_quad_layout() measured on the layout it returns.
@@ -45,6 +63,12 @@ struct QuadLayoutChoice {
   /// squares (1), an estimate of the layout's squared resampling error at a fixed sample count.
   double sampling_cost = 0.0;
   int balance_steps = 0;       ///< corner moves kept by the balancing
+  int shape_steps = 0;         ///< corner moves kept by the shape moves
+  /// The largest corner angle (degrees) and side length / sqrt(area) over the patches of its partition, and
+  /// its shape penalty (QuadLayoutOptions::shape_weight's sum, with the options' bounds; 0: all within).
+  double max_corner_angle_deg = 0.0;
+  double max_side_ratio = 0.0;
+  double shape_penalty = 0.0;
   std::vector<int> tips;       ///< protrusion tips found (vertex ids; pinned in some candidates)
   bool tips_pinned = false;    ///< the layout returned is one with the tips pinned
   std::size_t candidates = 0;  ///< pairings tried that partition the mesh
@@ -68,9 +92,15 @@ struct QuadLayoutChoice {
 ///    steps towards the area centroids of its larger neighbouring patches and away from its smaller ones,
 ///    landing on a mesh vertex that is not another corner; a move is kept only when the layout still
 ///    partitions the mesh and the objective drops, so it never makes the layout worse.
+/// 5. with `shape_weight` > 0 the objective includes the shape penalty (see QuadLayoutOptions) in steps 3
+///    and 4, and then the corners with the largest share of it are moved (at most `shape_steps` partitions
+///    tried): each towards or away from one of its patches' area centroids or along one of its sides,
+///    kept only when the objective drops.
+/// Deterministic: no randomness, no threads; the same mesh and options give the same layout.
 /// With `tip_persistence` > 0 the steps run twice, without and with the protrusion tips pinned as coarse
 /// vertices (never collapsed, never moved), and the layout with the lower objective is returned.
-/// Cost: O(F log F) for the simplification plus one partition per pairing and per balancing step.
+/// Cost: O(F log F) for the simplification plus one partition per pairing, per balancing step and per shape
+/// move tried.
 ///
 /// \throw InvalidInput with "choose_quad_layout:" when the mesh is not one closed, manifold, oriented
 ///   component, K < 2, K + 2 − 2g < 4 (K too small for the genus), K + 2 − 2g exceeds the mesh's vertices

@@ -30,14 +30,20 @@ int main(int argc, char** argv) {
       if (const char* steps = std::getenv("GEOMIP_BALANCE_STEPS")) options.balance_steps = std::atoi(steps);
       if (const char* t = std::getenv("GEOMIP_TIP_PERSISTENCE")) options.tip_persistence = std::atof(t);
       options.only_pinned_tips = std::getenv("GEOMIP_ONLY_PINNED_TIPS") != nullptr;
+      if (const char* w = std::getenv("GEOMIP_SHAPE_WEIGHT")) options.shape_weight = std::atof(w);
+      if (const char* a = std::getenv("GEOMIP_MAX_CORNER_ANGLE")) options.max_corner_angle_deg = std::atof(a);
+      if (const char* ratio = std::getenv("GEOMIP_MAX_SIDE_RATIO")) options.max_side_ratio = std::atof(ratio);
+      if (const char* f = std::getenv("GEOMIP_MIN_FLATNESS")) options.min_flatness = std::atof(f);
+      if (const char* n = std::getenv("GEOMIP_SHAPE_STEPS")) options.shape_steps = std::atoi(n);
       if (const char* o = std::getenv("GEOMIP_LAYOUT_OBJECTIVE"); o && std::string(o) == "area")
         options.objective = LayoutObjective::kAreaSpread;
       const auto start = std::chrono::steady_clock::now();
       const QuadLayoutChoice c = choose_quad_layout(mesh, options);
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::printf("%s K=%d balance %.3f spread %.3f cost %.3f moves %d candidates %zu tips %zu%s (%.1f s)\n", argv[1],
-                  options.patches, c.area_balance, c.area_spread, c.sampling_cost, c.balance_steps,
+      std::printf("%s K=%d balance %.3f spread %.3f cost %.3f max angle %.0f max side %.2f penalty %.2f moves %d + %d candidates %zu tips %zu%s (%.1f s)\n", argv[1],
+                  options.patches, c.area_balance, c.area_spread, c.sampling_cost, c.max_corner_angle_deg,
+                  c.max_side_ratio, c.shape_penalty, c.balance_steps, c.shape_steps,
                   c.candidates, c.tips.size(), c.tips_pinned ? " pinned" : "", seconds);
       if (const char* json = std::getenv("GEOMIP_LAYOUT_JSON")) {  // a CORR.json of this layout, corners as xyz
         std::FILE* f = std::fopen(json, "w");

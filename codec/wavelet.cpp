@@ -90,41 +90,61 @@ void predict_pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int s
   }
 }
 
-/// The update step of one line: every even sample strictly inside the line gets (d_left + d_right + 2) >> 2
-/// of its two neighbouring details added (sign +1, forward) or subtracted (−1, inverse).
-void update_row(std::int32_t* row, int size, int s, int sign) {
+/// ⌊(a + b + 2) / 4⌋ for any int32 a, b, exactly, in 32-bit arithmetic (no overflow: each quarter is below
+/// 2^29 in magnitude), so the loops below vectorize.
+inline std::int32_t quarter_sum(std::int32_t a, std::int32_t b) {
+  return (a >> 2) + (b >> 2) + (((a & 3) + (b & 3) + 2) >> 2);
+}
+
+/// e ± u modulo 2^32 (as wrap() of the 64-bit sum).
+template <int kSign>
+inline std::int32_t add_wrapped(std::int32_t e, std::int32_t u) {
+  const auto ue = static_cast<std::uint32_t>(e), uu = static_cast<std::uint32_t>(u);
+  return static_cast<std::int32_t>(kSign > 0 ? ue + uu : ue - uu);
+}
+
+/// The update step of one line: every even sample strictly inside the line gets ⌊(d_left + d_right + 2) / 4⌋
+/// of its two neighbouring details added (kSign +1, forward) or subtracted (−1, inverse).
+template <int kSign>
+void update_row(std::int32_t* row, int size, int s) {
   const int num_evens = (size - 1) / s / 2 + 1;
   for (int t = 1; t + 1 < num_evens; ++t) {
-    const I64 u = (static_cast<I64>(row[(2 * t - 1) * s]) + row[(2 * t + 1) * s] + 2) >> 2;
     std::int32_t& e = row[2 * t * s];
-    e = wrap(e + sign * u);
+    e = add_wrapped<kSign>(e, quarter_sum(row[(2 * t - 1) * s], row[(2 * t + 1) * s]));
   }
 }
 
 /// The update step of the column pass, row-major friendly: for each even row strictly inside, all interior
-/// columns of the current grid at once.
-void update_columns(std::int32_t* g, int size, int s, int sign) {
+/// columns of the current grid at once (contiguous at s = 1, the finest and largest step).
+template <int kSign>
+void update_columns(std::int32_t* g, int size, int s) {
   const int num_evens = (size - 1) / s / 2 + 1;
   const std::ptrdiff_t line = static_cast<std::ptrdiff_t>(size) * s;
   for (int t = 1; t + 1 < num_evens; ++t) {
-    std::int32_t* e = g + 2 * t * line;
-    const std::int32_t* a = e - line;
-    const std::int32_t* b = e + line;
-    for (int i = s; i + 1 < size; i += s) e[i] = wrap(e[i] + sign * ((static_cast<I64>(a[i]) + b[i] + 2) >> 2));
+    std::int32_t* __restrict e = g + 2 * t * line;
+    const std::int32_t* __restrict a = e - line;
+    const std::int32_t* __restrict b = e + line;
+    if (s == 1) {
+      for (int i = 1; i + 1 < size; ++i) e[i] = add_wrapped<kSign>(e[i], quarter_sum(a[i], b[i]));
+    } else {
+      for (int i = s; i + 1 < size; i += s) e[i] = add_wrapped<kSign>(e[i], quarter_sum(a[i], b[i]));
+    }
   }
+}
+
+template <int kSign>
+void update_pass(std::int32_t* g, int size, int s, bool rows) {
+  if (!rows) return update_columns<kSign>(g, size, s);
+  for (int j = s; j + 1 < size; j += s) update_row<kSign>(g + static_cast<std::ptrdiff_t>(j) * size, size, s);
 }
 
 /// One pass of one step with the optional update on interior lines (border rows and columns are left to the
 /// prediction alone, so a border line's coefficients still depend only on that line). Forward (sign −1):
 /// predict, then update; inverse (+1): undo the update, then the prediction.
 void pass(std::int32_t* g, int size, int s, bool rows, bool cubic, int sign, bool update) {
-  const auto update_all = [&](int u) {
-    if (!rows) return update_columns(g, size, s, u);
-    for (int j = s; j + 1 < size; j += s) update_row(g + static_cast<std::ptrdiff_t>(j) * size, size, s, u);
-  };
-  if (update && sign > 0) update_all(-1);
+  if (update && sign > 0) update_pass<-1>(g, size, s, rows);
   predict_pass(g, size, s, rows, cubic, sign);
-  if (update && sign < 0) update_all(+1);
+  if (update && sign < 0) update_pass<+1>(g, size, s, rows);
 }
 
 void check(std::span<std::int32_t> grid, int level, int steps, const char* who) {

@@ -264,9 +264,9 @@ const stateOf = (page) => page.evaluate(() => JSON.parse(JSON.stringify(window.g
 try {
   const nginx = await startNginx();
   const bunnyBytes = readFileSync(path.join(root, bunny)).length;
-  // The first prefix whose scene has a model (WASM decode, complete chunks only; bisection): format 4 verifies
-  // chunks by CRC groups of 256 B, so the coarse levels arrive with the first group's trailer (590 of the
-  // bunny's 8,865 bytes; format 3's per-chunk CRCs gave them within 5 %).
+  // The first prefix whose scene has a model (WASM decode, complete chunks only; bisection): formats 4 and 5
+  // verify chunks by CRC groups of 256 B, so the coarse levels arrive with the first group's trailer (590 of
+  // the format-4 bunny's 8,865 bytes; format 3's per-chunk CRCs gave them within 5 %).
   const firstShown = await (async () => {
     const whole = readFileSync(path.join(root, bunny));
     const shows = async (n) => {

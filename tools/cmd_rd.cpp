@@ -57,6 +57,7 @@ struct RdArgs {
   bool no_geomip = false;   // only the baselines
   int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
   int patches = 2;          // geomip: patches of the automatic layout (--patches)
+  bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -193,13 +194,14 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
 
 /// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only pack),
 /// then one job per prefix size: decode the first N bytes and build the level-N mesh.
-Series geomip_series(const std::string& mesh_path, int level, int patches, int normal_mesh_steps, bool quick,
-                     std::vector<std::uint8_t>& pack_out, ProgressBar& progress) {
+Series geomip_series(const std::string& mesh_path, int level, int patches, int normal_mesh_steps, bool fit,
+                     bool quick, std::vector<std::uint8_t>& pack_out, ProgressBar& progress) {
   const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches);
   ConvertOptions options;
   options.level = level;
   options.normals = false;
   options.normal_mesh_steps = normal_mesh_steps;
+  options.fit = fit;
   options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
   auto pack = std::make_shared<const std::vector<std::uint8_t>>(convert_models(models, options).pack);
   pack_out = *pack;
@@ -286,7 +288,8 @@ int run_rd(const RdArgs& args) {
   std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
   if (!args.no_geomip)
-    plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.normal_mesh_steps, args.quick, pack, progress));
+    plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.normal_mesh_steps, args.fit, args.quick,
+                                 pack, progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -439,6 +442,9 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_option("--normal-mesh", args->normal_mesh_steps,
                   "geomip: normal-mesh resampling of the finest STEPS wavelet steps (as `geomip convert`; 0 = off)")
       ->check(CLI::Range(0, 10));
+  cmd->add_flag("--fit,!--no-fit", args->fit,
+                "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip "
+                "convert --fit`; slower: about 30 s at level 8); --no-fit: samples on the surface (default)");
   add_patches_option(cmd, args->patches);
   return [args] { return run_rd(*args); };
 }

@@ -83,6 +83,39 @@ TEST_F(RdCli, QuickRunWritesCsvAndSvg) {
   EXPECT_EQ(files, 3u);  // rd.csv, rd.svg, sphere.gip
 }
 
+// `rd --fit` codes samples fitted to the surface by least squares (as `convert --fit`): on a sphere the whole
+// pack decodes closer to the mesh than without, and the flag takes no value.
+TEST_F(RdCli, FitRaisesTheWholePack) {
+  const std::string mesh = dir_ + "/sphere.obj";
+  {
+    std::ofstream out(mesh);
+    write_mesh(test::sphere(4), out, MeshFormat::kObj);
+  }
+  auto whole_pack_psnr = [&](const std::string& flag) {
+    const std::string out_dir = dir_ + "/rd" + flag;
+    std::string err;
+    EXPECT_EQ(geomip("rd --quick " + flag + " '" + mesh + "' -o '" + out_dir + "'", err), 0) << err;
+    std::istringstream lines(slurp(fs::path(out_dir) / "rd.csv"));
+    std::string line;
+    double best_bytes = -1, psnr_at_best = 0;
+    while (std::getline(lines, line)) {
+      if (line.rfind("geomip,", 0) != 0) continue;
+      std::istringstream fields(line.substr(7));
+      double bytes = 0, psnr = 0;
+      char comma;
+      fields >> bytes >> comma >> psnr;
+      if (bytes > best_bytes) best_bytes = bytes, psnr_at_best = psnr;
+    }
+    EXPECT_GT(best_bytes, 0) << flag;
+    return psnr_at_best;
+  };
+  const double plain = whole_pack_psnr("--no-fit"), fitted = whole_pack_psnr("--fit");
+  EXPECT_GT(fitted, plain + 0.5) << "fitted " << fitted << " dB, plain " << plain << " dB";
+  std::string err;
+  EXPECT_EQ(geomip("rd --quick --fit=x '" + mesh + "' -o '" + dir_ + "/bad'", err), 2);
+  EXPECT_FALSE(fs::exists(fs::path(dir_) / "bad" / "rd.csv"));
+}
+
 TEST_F(RdCli, MissingMeshFailsCleanly) {
   const std::string out_dir = dir_ + "/rd";
   std::string err;

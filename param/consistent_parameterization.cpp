@@ -363,7 +363,13 @@ ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::s
   ModelWork w;
   progress("partition", static_cast<double>(i));
   const auto t0 = Clock::now();
-  if (in.layout_quads.empty()) {
+  if (!in.side_guides.empty()) {
+    if (!in.auxiliary_points.empty() || !in.layout_quads.empty()) {
+      throw InvalidInput("parameterize_consistently: model '" + in.name +
+                         "' has guide lists per path and auxiliary points or a layout; give one of them");
+    }
+    w.partition = partition_mesh_guided(in.mesh, in.partition_points, in.side_guides);
+  } else if (in.layout_quads.empty()) {
     w.partition = partition_mesh(in.mesh, in.partition_points, in.auxiliary_points);
   } else {
     if (!in.auxiliary_points.empty()) {

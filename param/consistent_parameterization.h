@@ -29,6 +29,9 @@ struct ParameterizationInput {
   /// layout's corners (any number; QuadLayout::corners), corresponding across models.
   std::vector<int> partition_points;
   std::vector<int> auxiliary_points;  ///< genus 0: none or 4 path guides; genus 1: 8 (see partition_mesh())
+  /// Genus 0 instead of auxiliary_points: any number of guides per path, one list per path
+  /// (partition_mesh_guided(); what choose_partition_points() gives for a loop through the tips).
+  std::vector<std::vector<int>> side_guides;
   /// A quad layout over `partition_points` (QuadLayout::quads; partition_mesh_layout()): one patch per quad,
   /// any genus; the same quads in every model; auxiliary_points must then be empty. Empty = partition_mesh().
   std::vector<std::array<int, 4>> layout_quads;

@@ -179,15 +179,23 @@ class PathTracer {
   std::vector<int> touched_;
 };
 
-// One path to trace: from corner `from` to corner `to`, through `via` when >= 0.
+// One path to trace: from corner `from` to corner `to`, through the guides `via` in order (none when empty).
 struct PathSpec {
-  int from, to, via;
+  int from, to;
+  std::vector<int> via;
   std::vector<int> first_ok{}, last_ok{};  // allowed first / last steps; empty = any
   bool restricted = false;                 // first_ok and last_ok apply
 };
 
 std::string vertex_name(int v) {
   return "vertex " + std::to_string(v);
+}
+
+std::string through(const std::vector<int>& via) {
+  if (via.empty()) return "";
+  std::string s = via.size() == 1 ? " through vertex " : " through vertices ";
+  for (std::size_t i = 0; i < via.size(); ++i) s += (i ? ", " : "") + std::to_string(via[i]);
+  return s;
 }
 
 // The working state of one partition: the mesh being cut (split as needed), its connectivity, and the cut.
@@ -218,7 +226,7 @@ class Partitioner {
       if (path.empty()) {
         throw InvalidInput(std::string(kFn) + "cannot trace path " + std::to_string(k) + " from " +
                            vertex_name(specs[k].from) + " to " + vertex_name(specs[k].to) +
-                           (specs[k].via >= 0 ? " through " + vertex_name(specs[k].via) : std::string()) +
+                           through(specs[k].via) +
                            " without touching earlier paths; move the points further apart" +
                            (options_.split_degenerate ? "" : " or enable split_degenerate"));
       }
@@ -357,31 +365,43 @@ class Partitioner {
   const Connectivity& connectivity() const { return conn_; }
 
  private:
+  // Traces from → via[0] → via[1] → … → to, each leg a shortest path that avoids the earlier legs, the guides
+  // still ahead and the end corner (until the last leg). Empty when a leg cannot be traced.
   std::vector<int> trace_one(const PathSpec& s) {
-    blocked_[s.from] = blocked_[s.to] = 0;
-    if (s.via >= 0) blocked_[s.via] = 0;
-    std::vector<int> path;
-    if (s.via < 0) {
-      path = tracer_.shortest_path(result_.mesh, conn_, s.from, s.to, blocked_,
-                                   s.restricted ? &s.first_ok : nullptr, s.restricted ? &s.last_ok : nullptr);
-    } else {
-      blocked_[s.to] = 1;  // the first leg must not pass through the end corner
-      path = tracer_.shortest_path(result_.mesh, conn_, s.from, s.via, blocked_);
-      blocked_[s.to] = 0;
-      if (!path.empty()) {
-        for (int v : path) blocked_[v] = 1;
-        blocked_[s.via] = 0;
-        std::vector<int> second = tracer_.shortest_path(result_.mesh, conn_, s.via, s.to, blocked_);
-        for (int v : path) blocked_[v] = 0;
-        if (second.empty()) {
-          path.clear();
-        } else {
-          path.insert(path.end(), second.begin() + 1, second.end());
+    if (s.via.empty()) {
+      blocked_[s.from] = blocked_[s.to] = 0;
+      std::vector<int> path =
+          tracer_.shortest_path(result_.mesh, conn_, s.from, s.to, blocked_, s.restricted ? &s.first_ok : nullptr,
+                                s.restricted ? &s.last_ok : nullptr);
+      blocked_[s.from] = blocked_[s.to] = 1;
+      return path;
+    }
+    std::vector<int> stops = {s.from};
+    stops.insert(stops.end(), s.via.begin(), s.via.end());
+    stops.push_back(s.to);
+    for (int v : stops) blocked_[v] = 1;
+    std::vector<int> path = {s.from};
+    std::vector<int> legs;  // interior vertices of the legs traced so far, blocked while the path is traced
+    bool ok = true;
+    for (std::size_t i = 0; i + 1 < stops.size() && ok; ++i) {
+      blocked_[stops[i]] = blocked_[stops[i + 1]] = 0;
+      const std::vector<int> leg = tracer_.shortest_path(result_.mesh, conn_, stops[i], stops[i + 1], blocked_);
+      blocked_[stops[i]] = 1;
+      if (leg.empty()) {
+        ok = false;
+        break;
+      }
+      for (std::size_t j = 1; j < leg.size(); ++j) {
+        path.push_back(leg[j]);
+        if (j + 1 < leg.size() && !blocked_[leg[j]]) {
+          blocked_[leg[j]] = 1;
+          legs.push_back(leg[j]);
         }
       }
     }
-    blocked_[s.from] = blocked_[s.to] = 1;
-    if (s.via >= 0) blocked_[s.via] = 1;
+    for (int v : legs) blocked_[v] = 0;
+    for (int v : stops) blocked_[v] = 1;
+    if (!ok) path.clear();
     return path;
   }
 
@@ -500,13 +520,15 @@ void check_points(const TriMesh& mesh, const std::vector<int>& points, const std
   }
 }
 
-PartitionResult partition_genus0(const TriMesh& mesh, const std::vector<int>& p, const std::vector<int>& aux,
-                                 const PartitionOptions& options) {
+PartitionResult partition_genus0(const TriMesh& mesh, const std::vector<int>& p,
+                                 const std::vector<std::vector<int>>& guides, const PartitionOptions& options) {
   Partitioner part(mesh, options);
   std::vector<PathSpec> specs;
-  for (int k = 0; k < 4; ++k) specs.push_back({p[k], p[(k + 1) % 4], aux.empty() ? -1 : aux[k]});
   std::vector<int> special = p;
-  special.insert(special.end(), aux.begin(), aux.end());
+  for (int k = 0; k < 4; ++k) {
+    specs.push_back({p[k], p[(k + 1) % 4], guides[k]});
+    special.insert(special.end(), guides[k].begin(), guides[k].end());
+  }
   part.trace(specs, special);
 
   PartitionResult& r = part.result();
@@ -545,7 +567,7 @@ PartitionResult partition_genus1(const TriMesh& mesh, const std::vector<int>& p,
   const std::array<std::array<int, 2>, 8> ends = {
       {{0, 1}, {1, 0}, {2, 3}, {3, 2}, {0, 2}, {2, 0}, {1, 3}, {3, 1}}};
   std::vector<PathSpec> specs;
-  for (int k = 0; k < 8; ++k) specs.push_back({p[ends[k][0]], p[ends[k][1]], a[k]});
+  for (int k = 0; k < 8; ++k) specs.push_back({p[ends[k][0]], p[ends[k][1]], {a[k]}});
   std::vector<int> special = p;
   special.insert(special.end(), a.begin(), a.end());
   part.trace(specs, special);
@@ -732,7 +754,7 @@ PartitionResult partition_layout(const TriMesh& mesh, const QuadLayout& layout, 
   std::vector<PathSpec> specs;
   for (int e : order) {
     const int h = edge_half[e];
-    specs.push_back({corner_vertex(layout_from(layout, h)), corner_vertex(layout_to(layout, h)), -1});
+    specs.push_back({corner_vertex(layout_from(layout, h)), corner_vertex(layout_to(layout, h)), {}});
   }
   std::vector<int> traced_as(ne, -1);  // edge → index into part.paths()
   // First mesh step of traced layout half-edge h from its start corner, or -1 when not traced yet.
@@ -927,7 +949,9 @@ PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector
       throw InvalidInput(std::string(kFn) + "a genus-0 mesh takes 0 or 4 auxiliary points, got " +
                          std::to_string(auxiliary_points.size()));
     }
-    return partition_genus0(mesh, partition_points, auxiliary_points, options);
+    std::vector<std::vector<int>> guides(4);
+    for (std::size_t k = 0; k < auxiliary_points.size(); ++k) guides[k] = {auxiliary_points[k]};
+    return partition_genus0(mesh, partition_points, guides, options);
   }
   if (genus == 1) {
     if (auxiliary_points.size() != 8) {
@@ -940,6 +964,29 @@ PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector
   throw InvalidInput(std::string(kFn) + "the mesh has genus " + std::to_string(genus) +
                      "; only genus 0 (4 partition points) and genus 1 (4 partition + 8 auxiliary points) "
                      "are supported");
+}
+
+PartitionResult partition_mesh_guided(const TriMesh& closed_manifold, const std::vector<int>& partition_points,
+                                      const std::vector<std::vector<int>>& side_guides,
+                                      const PartitionOptions& options) {
+  const TriMesh& mesh = closed_manifold;
+  if (partition_points.size() != 4) {
+    throw InvalidInput(std::string(kFn) + "expected 4 partition points, got " +
+                       std::to_string(partition_points.size()));
+  }
+  if (side_guides.size() != 4) {
+    throw InvalidInput(std::string(kFn) + "expected one guide list per path (4), got " +
+                       std::to_string(side_guides.size()));
+  }
+  std::vector<int> all;
+  for (const auto& g : side_guides) all.insert(all.end(), g.begin(), g.end());
+  check_points(mesh, partition_points, all);
+  const int genus = checked_genus(mesh);
+  if (genus != 0) {
+    throw InvalidInput(std::string(kFn) + "guide lists per path are for genus 0; the mesh has genus " +
+                       std::to_string(genus));
+  }
+  return partition_genus0(mesh, partition_points, side_guides, options);
 }
 
 PartitionStats partition_stats(const PartitionResult& r) {

@@ -141,6 +141,18 @@ PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector
                                const std::vector<int>& auxiliary_points,
                                const PartitionOptions& options = {});
 
+/// Genus 0 with any number of guides per path: side_guides[k] (k = 0..3) lists, in order, the vertices path k
+/// (P_k → P_{k+1 mod 4}) passes through; partition_mesh(m, p, aux) is this with side_guides[k] = {aux[k]}.
+/// Each leg between consecutive guides is a shortest path avoiding the earlier legs, every other guide and
+/// every earlier path, so the loop stays simple; a loop that runs down a protrusion to a guide at its tip
+/// and back up its other side splits the protrusion lengthwise between the two patches (see
+/// choose_partition_points()). Everything else as partition_mesh() for genus 0.
+/// \throw InvalidInput as partition_mesh(), and when side_guides does not have 4 lists or the mesh is not
+///   genus 0.
+PartitionResult partition_mesh_guided(const TriMesh& closed_manifold, const std::vector<int>& partition_points,
+                                      const std::vector<std::vector<int>>& side_guides,
+                                      const PartitionOptions& options = {});
+
 /// A quad base domain (Praun, Sweldens, Schröder 2001, "Consistent mesh parameterizations"): corners on the
 /// mesh and quads between them. Quad q has corners corners[quads[q][0..3]], counter-clockwise seen from
 /// outside the surface (the orientation of the mesh's triangles); its side s runs from quads[q][s] to

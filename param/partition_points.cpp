@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <queue>
 #include <string>
 
 namespace geomip {
@@ -184,6 +185,229 @@ PartitionPoints outline_points(const TriMesh& m, const std::vector<int>& opp, co
   return pts;
 }
 
+// Tips: vertices at the end of protrusions, found as the prominent peaks of the geodesic distance d from
+// the outline (multi-source Dijkstra over the edges). Vertices are added in decreasing d; a vertex with no
+// added neighbour starts a component (its peak); where components meet, all but the one with the highest
+// peak end, with prominence d(peak) − d(meeting vertex) (0-dimensional persistence of the superlevel sets).
+// The highest peak has prominence d(peak). Returned: peaks of prominence >= min_prominence, most prominent
+// first, at most max_tips, with d and the outline entry nearest to each vertex (its foot).
+struct Tips {
+  std::vector<int> vertex;
+  std::vector<double> prominence;
+  std::vector<double> dist;  // per mesh vertex
+  std::vector<int> foot;     // per mesh vertex: outline entry
+};
+
+// Largest area / depth² half way down a tip's protrusion: a tube of girth c has c / depth (about 0.5–1.5 for
+// legs, ears and arms), a rounded cap about π.
+const double kTubeRatio = 2.0;
+// The corners' split of the loop may miss quarters by loop / kCornerSlack.
+const double kCornerSlack = 16.0;
+
+Tips find_tips(const TriMesh& m, const Outline& o, double min_prominence, int max_tips) {
+  const int nv = static_cast<int>(m.positions.size());
+  std::vector<std::vector<int>> adj(nv);
+  for (const auto& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      adj[t[k]].push_back(t[(k + 1) % 3]);  // each undirected edge once per direction on a closed mesh
+    }
+  }
+  Tips tips;
+  tips.dist.assign(nv, std::numeric_limits<double>::infinity());
+  tips.foot.assign(nv, -1);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+  for (std::size_t e = 0; e < o.vertex.size(); ++e) {
+    const int v = o.vertex[e];
+    if (tips.dist[v] > 0.0) {
+      tips.dist[v] = 0.0;
+      tips.foot[v] = static_cast<int>(e);
+      heap.push({0.0, v});
+    }
+  }
+  while (!heap.empty()) {
+    const auto [d, v] = heap.top();
+    heap.pop();
+    if (d > tips.dist[v]) continue;
+    for (int u : adj[v]) {
+      const double du = d + (m.positions[u] - m.positions[v]).norm();
+      if (du < tips.dist[u]) {
+        tips.dist[u] = du;
+        tips.foot[u] = tips.foot[v];
+        heap.push({du, u});
+      }
+    }
+  }
+  std::vector<int> order;
+  for (int v = 0; v < nv; ++v) {
+    if (!adj[v].empty() && std::isfinite(tips.dist[v])) order.push_back(v);
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return tips.dist[a] != tips.dist[b] ? tips.dist[a] > tips.dist[b] : a < b;
+  });
+  std::vector<int> parent(nv, -1), peak(nv, -1);
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  std::vector<std::pair<double, int>> peaks;  // (prominence, peak vertex)
+  for (int v : order) {
+    parent[v] = v;
+    peak[v] = v;
+    for (int u : adj[v]) {
+      if (parent[u] < 0) continue;
+      const int a = find(u), b = find(v);
+      if (a == b) continue;
+      // The component whose peak is lower ends here.
+      const bool a_higher = tips.dist[peak[a]] > tips.dist[peak[b]] ||
+                            (tips.dist[peak[a]] == tips.dist[peak[b]] && peak[a] < peak[b]);
+      const int keep = a_higher ? a : b, end = a_higher ? b : a;
+      peaks.push_back({tips.dist[peak[end]] - tips.dist[v], peak[end]});
+      parent[end] = keep;
+    }
+  }
+  if (!order.empty()) peaks.push_back({tips.dist[order.front()], order.front()});
+  std::sort(peaks.begin(), peaks.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  // A protrusion is a tube: half way down from its tip, the part above has an area of about its girth times
+  // that depth. The deepest point of a rounded half (a dome, the middle of a face) has a cap there instead,
+  // of area about π·depth²; those are not protrusions.
+  std::vector<double> vertex_area(nv, 0.0);
+  for (const auto& t : m.triangles) {
+    const double a = (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]).norm() / 6.0;
+    for (int v : t) vertex_area[v] += a;
+  }
+  std::vector<int> seen(nv, -1), stack;
+  for (const auto& [prominence, v] : peaks) {
+    if (prominence < min_prominence || static_cast<int>(tips.vertex.size()) >= max_tips) break;
+    const double depth = 0.5 * prominence, level = tips.dist[v] - depth;
+    double area = 0.0;
+    stack.assign(1, v);
+    seen[v] = v;
+    while (!stack.empty()) {
+      const int w = stack.back();
+      stack.pop_back();
+      area += vertex_area[w];
+      for (int u : adj[w]) {
+        if (seen[u] != v && tips.dist[u] >= level) {
+          seen[u] = v;
+          stack.push_back(u);
+        }
+      }
+    }
+    if (area > kTubeRatio * depth * depth) continue;
+    tips.vertex.push_back(v);
+    tips.prominence.push_back(prominence);
+  }
+  return tips;
+}
+
+// The outline loop of `base` (corners at outline entries `at`) rerouted through the tips of the shape's
+// protrusions: the loop follows the outline through guides spaced o.length / samples apart, and at the
+// outline entry nearest to a tip it runs down to the tip and back up another way, which splits the
+// protrusion lengthwise between the two patches. Corners are the guides nearest to quarters of the loop's
+// (estimated) length from outline entry `start` (the +a extreme). Empty when there is no tip or the loop does not partition.
+PartitionPoints tip_loop_points(const TriMesh& m, const Outline& o, int start,
+                                const PartitionPointsOptions& options, double total_area) {
+  PartitionPoints none;
+  const int count = static_cast<int>(o.vertex.size());
+  if (count < 16 || !options.tip_loop) return none;
+  const Tips tips = find_tips(m, o, options.tip_prominence * std::sqrt(total_area), options.max_tips);
+  if (tips.vertex.empty()) return none;
+  // Waypoints in loop order, starting at the +a extreme: (position along the outline, vertex, is a tip).
+  struct Way {
+    double along;  // arc length from entry at[0]
+    int vertex;
+    bool tip;
+    double extra;  // estimated length of the detour that starts at this tip's predecessor
+  };
+  std::vector<Way> ways;
+  auto along = [&](int entry) { return std::fmod(o.arc[entry] - o.arc[start] + 2.0 * o.length, o.length); };
+  std::vector<char> used(m.positions.size(), 0);
+  const int samples = std::max(8, options.outline_guides);
+  int next = 0;
+  for (int i = 0; i < count; ++i) {
+    const int entry = (start + i) % count;
+    const double a = along(entry);
+    if (a + 1e-12 < next * o.length / samples) continue;
+    while (next * o.length / samples <= a + 1e-12) ++next;
+    const int v = o.vertex[entry];
+    if (used[v]) continue;
+    used[v] = 1;
+    ways.push_back({a, v, false, 0.0});
+  }
+  for (std::size_t k = 0; k < tips.vertex.size(); ++k) {
+    const int v = tips.vertex[k];
+    if (used[v]) continue;
+    used[v] = 1;
+    ways.push_back({along(tips.foot[v]) + 1e-9 * (1 + k), v, true, 2.0 * tips.dist[v]});
+  }
+  std::stable_sort(ways.begin(), ways.end(), [](const Way& a, const Way& b) { return a.along < b.along; });
+  // Estimated loop length at each waypoint: outline arc plus the detours before it (a tip is half way down
+  // its own detour).
+  const std::size_t nw = ways.size();
+  std::vector<double> at_length(nw);
+  double detours = 0.0;
+  for (std::size_t i = 0; i < nw; ++i) {
+    at_length[i] = ways[i].along + detours + 0.5 * ways[i].extra;
+    detours += ways[i].extra;
+  }
+  const double loop = o.length + detours;
+  // Corners: the 4 waypoints that split the loop into quarters within loop / 16 each, with as many tips among
+  // them as possible (a corner turns the boundary by 90° in the square, which a protrusion's U-turn at its
+  // tip needs), the evenest split among those; if no 4 waypoints are that even, the evenest split.
+  std::array<std::size_t, 4> corner = {0, 0, 0, 0};
+  const double tolerance = loop / kCornerSlack;
+  int best_tips = -1;
+  double best_score = std::numeric_limits<double>::infinity();
+  for (std::size_t i0 = 0; i0 < nw; ++i0) {
+    for (std::size_t i1 = i0 + 1; i1 < nw; ++i1) {
+      const double g0 = std::abs(at_length[i1] - at_length[i0] - 0.25 * loop);
+      if (g0 > std::max(tolerance, best_score) && best_tips >= 0) continue;
+      for (std::size_t i2 = i1 + 1; i2 < nw; ++i2) {
+        const double g1 = std::abs(at_length[i2] - at_length[i1] - 0.25 * loop);
+        if (std::max(g0, g1) > std::max(tolerance, best_score) && best_tips >= 0) continue;
+        for (std::size_t i3 = i2 + 1; i3 < nw; ++i3) {
+          const double score = std::max({g0, g1, std::abs(at_length[i3] - at_length[i2] - 0.25 * loop),
+                                         std::abs(at_length[i0] + loop - at_length[i3] - 0.25 * loop)});
+          const int tip_count = ways[i0].tip + ways[i1].tip + ways[i2].tip + ways[i3].tip;
+          const bool even = score <= tolerance;
+          const bool best_even = best_score <= tolerance;
+          bool better;
+          if (even != best_even) {
+            better = even;
+          } else if (even && tip_count != best_tips) {
+            better = tip_count > best_tips;
+          } else {
+            better = score < best_score;
+          }
+          if (better || best_tips < 0) {
+            best_tips = tip_count;
+            best_score = score;
+            corner = {i0, i1, i2, i3};
+          }
+        }
+      }
+    }
+  }
+  if (best_tips < 0) return none;
+  PartitionPoints pts;
+  pts.side_guides.assign(4, {});
+  for (int k = 0; k < 4; ++k) {
+    pts.partition_points.push_back(ways[corner[k]].vertex);
+    for (std::size_t i = (corner[k] + 1) % nw; i != corner[(k + 1) % 4]; i = (i + 1) % nw) {
+      pts.side_guides[k].push_back(ways[i].vertex);
+    }
+  }
+  try {
+    partition_mesh_guided(m, pts.partition_points, pts.side_guides);
+  } catch (const Error&) {
+    return none;
+  }
+  return pts;
+}
+
 PartitionPoints genus0_points(const TriMesh& m, const PartitionPointsOptions& options) {
   const int nf = static_cast<int>(m.triangles.size());
   std::vector<double> area(nf);
@@ -243,6 +467,14 @@ PartitionPoints genus0_points(const TriMesh& m, const PartitionPointsOptions& op
     }
     try {
       partition_mesh(m, pts.partition_points, pts.auxiliary_points);
+      if (options.tip_loop) {
+        const Outline o = longest_outline(m, opp, n, a, b, offset);
+        const auto start = std::find(o.vertex.begin(), o.vertex.end(), pts.partition_points[0]);
+        if (start != o.vertex.end()) {
+          PartitionPoints tipped = tip_loop_points(m, o, static_cast<int>(start - o.vertex.begin()), options, total);
+          if (!tipped.partition_points.empty()) return tipped;
+        }
+      }
       return pts;
     } catch (const Error& e) {
       failures += std::string(" ") + e.what() + ";";

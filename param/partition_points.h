@@ -16,12 +16,23 @@ struct PartitionPoints {
   /// genus 0: 4 vertex ids guiding the 4 paths (empty when the outline is too short for them); genus 1: 8.
   /// In partition_mesh()'s order.
   std::vector<int> auxiliary_points;
+  /// genus 0 with a loop through the shape's tips (PartitionPointsOptions::tip_loop): the guides of
+  /// each of the 4 paths, for partition_mesh_guided(); auxiliary_points is then empty. Otherwise empty.
+  std::vector<std::vector<int>> side_guides;
 };
 
 struct PartitionPointsOptions {
   /// Genus 0 only: the cutting plane's normal is principal axis e_cut_axis (1 = longest, 3 = thinnest, the
   /// default; see choose_partition_points() for why). 1 cuts across the longest axis (the "equator").
   int cut_axis = 3;
+  /// Genus 0 only: route the loop through the tips of the shape's protrusions (see choose_partition_points()).
+  /// Off by default: measured mixed (docs/measurements.md, "A loop through the tips").
+  bool tip_loop = false;
+  /// With tip_loop: a protrusion counts when its tip stands at least tip_prominence · √(surface area)
+  /// (geodesic) above where it joins the rest of the shape.
+  double tip_prominence = 0.1;
+  int max_tips = 12;            ///< with tip_loop: at most this many tips, the most prominent first
+  int outline_guides = 64;      ///< with tip_loop: guides along the outline (spacing = its length / this)
   /// Genus 1 only: grid offsets are tried on an offset_steps × offset_steps lattice of the flat torus
   /// (cheap: one pass over the triangles each).
   int offset_steps = 16;
@@ -55,6 +66,19 @@ struct PartitionPointsOptions {
 ///   other principal planes are tried (normals e3, e2, e1, after options.cut_axis); on an outline too short
 ///   for distinct corners the corners are spread over its vertices without guides, and on a mesh of a few
 ///   triangles (a tetrahedron) the vertices extreme in ±e1, ±e2 are the last resort.
+///
+/// Genus 0 with options.tip_loop — the same outline, rerouted through the tips of protrusions (legs, ears),
+/// as geometry images cut through extremities (Gu, Gortler, Hoppe 2002), so that each protrusion is split
+/// lengthwise between the two patches instead of lying whole inside one square as a tube closed at one end:
+/// 1. d = geodesic distance from the outline (edge-graph Dijkstra); tips are the peaks of d whose prominence
+///    (0-dimensional persistence of its superlevel sets: how far d falls before the peak's region meets a
+///    higher one's) is at least tip_prominence · √area, and whose region half way down is a tube (area below
+///    2 · depth²), not the rounded middle of a half (a cap, area about π · depth²);
+/// 2. the loop follows the outline through outline_guides guides, and at the outline vertex nearest to each
+///    tip it runs down to the tip and back up another way (partition_mesh_guided());
+/// 3. the 4 corners are waypoints that split the loop's estimated length into quarters within 1/16, with as
+///    many tips among them as possible (a corner gives a tip's U-turn 90°); the evenest split otherwise.
+/// Without a tip, or when the rerouted loop does not partition, the plain outline's points are returned.
 ///
 /// Genus 1 — the 2×2 grid follows the torus's flat (conformal) coordinates:
 /// 1. a homology basis by tree–cotree (Eppstein 2003) gives two closed, non-exact 1-forms on the edges;

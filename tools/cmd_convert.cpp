@@ -81,7 +81,7 @@ int run_convert(const ConvertArgs& args) {
   const bool report = !args.common.quiet && !args.common.json;
   const auto t_start = std::chrono::steady_clock::now();
   const PreparedModels models =
-      prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches);
+      prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches, args.common.tip_loop);
 
   const std::optional<UpAxis> up = up_axis(args);
   const Eigen::Vector3d front = front_axis(args);

@@ -56,14 +56,16 @@ void write_param_obj(std::ostream& out, const ModelParameterization& m, const st
 }
 
 nlohmann::json param_json(const ModelParameterization& m, const std::string& mesh_path,
-                          const std::vector<int>& partition_points, const std::vector<int>& auxiliary_points) {
+                          const ParameterizationInput& in) {
+  const std::vector<int>& partition_points = in.partition_points;
   nlohmann::json j;
   j["mesh"] = mesh_path;
   j["vertices"] = m.mesh.positions.size();
   j["triangles"] = m.mesh.triangles.size();
   j["split_vertices"] = m.split_vertices;
   j["partition_points"] = partition_points;
-  j["auxiliary_points"] = auxiliary_points;
+  j["auxiliary_points"] = in.auxiliary_points;
+  if (!in.side_guides.empty()) j["side_guides"] = in.side_guides;  // a loop through the tips (as CORR.json)
   const auto& kCorner = unit_square_corners();
   nlohmann::json patches = nlohmann::json::array();
   std::size_t flipped = 0;
@@ -124,7 +126,7 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
 }
 
 int run_param(const ParamArgs& args) {
-  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param", args.common.quiet || args.common.json, args.common.patches);
+  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param", args.common.quiet || args.common.json, args.common.patches, args.common.tip_loop);
   const std::vector<ParameterizationInput>& inputs = models.inputs;
   const std::vector<std::string>& paths = models.paths;
 
@@ -146,7 +148,7 @@ int run_param(const ParamArgs& args) {
     const std::string stem = (std::filesystem::path(args.common.output) / inputs[i].name).string();
     write_file_atomically(stem + ".param.obj",
                           [&](std::ostream& out) { write_param_obj(out, result[i], paths[i]); });
-    nlohmann::json j = param_json(result[i], paths[i], inputs[i].partition_points, inputs[i].auxiliary_points);
+    nlohmann::json j = param_json(result[i], paths[i], inputs[i]);
     if (!inputs[i].layout_quads.empty()) j["layout_quads"] = inputs[i].layout_quads;  // corners: partition_points
     j["seconds"]["total_all_models"] = seconds;
     write_file_atomically(stem + ".param.json", [&](std::ostream& out) { out << j.dump(2) << "\n"; });

@@ -12,11 +12,8 @@ namespace {
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) { throw InvalidInput(path + ": " + what); }
 
-std::vector<PointSpec> points(const std::string& path, const nlohmann::json& model, const char* key, std::size_t m) {
+std::vector<PointSpec> point_list(const std::string& path, const nlohmann::json& list, const std::string& where) {
   std::vector<PointSpec> out;
-  if (!model.contains(key)) return out;
-  const auto& list = model.at(key);
-  const std::string where = "models[" + std::to_string(m) + "]." + key;
   if (!list.is_array()) fail(path, where + " must be an array");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const auto& p = list[i];
@@ -32,6 +29,11 @@ std::vector<PointSpec> points(const std::string& path, const nlohmann::json& mod
     out.push_back(s);
   }
   return out;
+}
+
+std::vector<PointSpec> points(const std::string& path, const nlohmann::json& model, const char* key, std::size_t m) {
+  if (!model.contains(key)) return {};
+  return point_list(path, model.at(key), "models[" + std::to_string(m) + "]." + key);
 }
 
 }  // namespace
@@ -78,6 +80,16 @@ std::vector<ModelSpec> read_correspondence(const std::string& path) {
     s.partition_points = points(path, model, "partition_points", m);
     s.auxiliary_points = points(path, model, "auxiliary_points", m);
     s.features = points(path, model, "features", m);
+    if (model.contains("side_guides")) {
+      const auto& lists = model.at("side_guides");
+      const std::string where = "models[" + std::to_string(m) + "].side_guides";
+      if (!lists.is_array() || lists.size() != 4) fail(path, where + " must be 4 lists of points, one per path");
+      for (std::size_t k = 0; k < 4; ++k) {
+        s.side_guides.push_back(point_list(path, lists[k], where + "[" + std::to_string(k) + "]"));
+      }
+      if (!s.auxiliary_points.empty()) fail(path, "models[" + std::to_string(m) + "] has both auxiliary_points and side_guides");
+      if (!quads.empty()) fail(path, "models[" + std::to_string(m) + "] has side_guides; a layout's paths take no guides");
+    }
     s.layout_quads = quads;
     if (!quads.empty()) {
       if (s.partition_points.empty())

@@ -7,6 +7,9 @@
 // QuadLayout in param/mesh_partition.h): each model's partition_points are then the layout's corners (any
 // number, the same in every model; quads index them, counter-clockwise seen from outside) and
 // auxiliary_points must be empty.
+// Optional per model, genus 0: "side_guides": [[P,...],[P,...],[P,...],[P,...]], any number of guides for each
+// of the 4 paths instead of auxiliary_points (partition_mesh_guided(); `geomip param` writes it for a loop
+// through the shape's tips).
 #pragma once
 
 #include <Eigen/Core>
@@ -26,6 +29,7 @@ struct PointSpec {
 struct ModelSpec {
   std::string mesh;  ///< resolved against the JSON file's directory
   std::vector<PointSpec> partition_points, auxiliary_points, features;
+  std::vector<std::vector<PointSpec>> side_guides;  ///< genus 0: 4 lists, or empty
   std::vector<std::array<int, 4>> layout_quads;  ///< the file's "layout" quads (the same in every model), or empty
 };
 

@@ -141,13 +141,14 @@ QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std
 }  // namespace
 
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file_arg,
-                              const std::string& command, bool quiet, int patches) {
+                              const std::string& command, bool quiet, int patches, bool tip_loop) {
   PreparedModels models;
   std::vector<ParameterizationInput>& inputs = models.inputs;
   std::vector<std::string>& paths = models.paths;
   std::vector<ModelSpec> specs;
   const std::string& points_file = points_file_arg;
   if (patches < 2) throw InvalidInput("--patches " + std::to_string(patches) + ": a layout needs at least 2");
+  if (tip_loop && patches != 2) throw InvalidInput("--tip-loop routes the two-square loop; it does not go with --patches " + std::to_string(patches));
   if (!points_file_arg.empty()) {
     if (!meshes.empty()) {
       throw InvalidInput("give either meshes or --points CORR.json (which names the meshes), not both");
@@ -155,13 +156,16 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
     if (patches != 2) {
       throw InvalidInput("--patches chooses an automatic layout; with --points CORR.json the file gives the points");
     }
+    if (tip_loop) {
+      throw InvalidInput("--tip-loop chooses automatic partition points; with --points CORR.json the file gives them");
+    }
     specs = read_correspondence(points_file_arg);
   } else {
     if (meshes.size() > 1) {
       throw InvalidInput("several meshes need --points CORR.json: their partition points must correspond");
     }
     if (meshes.empty()) throw InvalidInput("no mesh given (a MESH or --points CORR.json)");
-    specs.push_back(ModelSpec{meshes[0], {}, {}, {}, {}});
+    specs.push_back(ModelSpec{meshes[0], {}, {}, {}, {}, {}});
   }
 
   for (const auto& spec : specs) {
@@ -186,12 +190,19 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
     } else if (spec.partition_points.empty()) {
-      const PartitionPoints chosen = choose_partition_points(in.mesh);
+      PartitionPointsOptions point_options;
+      point_options.tip_loop = tip_loop;
+      const PartitionPoints chosen = choose_partition_points(in.mesh, point_options);
       in.partition_points = chosen.partition_points;
       in.auxiliary_points = chosen.auxiliary_points;
+      in.side_guides = chosen.side_guides;
     } else {
       in.partition_points = resolve_points(spec.partition_points, source, in.mesh, "partition_points", where);
       in.auxiliary_points = resolve_points(spec.auxiliary_points, source, in.mesh, "auxiliary_points", where);
+      for (std::size_t k = 0; k < spec.side_guides.size(); ++k) {
+        in.side_guides.push_back(resolve_points(spec.side_guides[k], source, in.mesh,
+                                                "side_guides[" + std::to_string(k) + "]", where));
+      }
       in.features = resolve_points(spec.features, source, in.mesh, "features", where);
       in.layout_quads = spec.layout_quads;
     }
@@ -218,6 +229,10 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
                   "stretch (never raises it), raises the L2 stretch (default 0: off)")
       ->check(CLI::Range(0, 10000));
   add_patches_option(cmd, args.patches);
+  cmd->add_flag("--tip-loop", args.tip_loop,
+                "Two squares (genus 0): route the cut down each protrusion (legs, ears) to its tip and back, "
+                "splitting it lengthwise between the squares (default off: helps some shapes, hurts others; "
+                "docs/measurements.md)");
 }
 
 void add_patches_option(CLI::App* cmd, int& patches) {

@@ -36,6 +36,8 @@ struct ModelArgs {
   /// 8g, 12g, … that partitions the mesh); another K = a K-quad layout (choose_quad_layout()). Only without
   /// CORR.json.
   int patches = 2;
+  /// --tip-loop: PartitionPointsOptions::tip_loop for automatic two-square points (genus 0, no CORR.json).
+  bool tip_loop = false;
 };
 
 /// Sets the parameterization's curvature sampling from `--sampling-exponent` and its L∞ pass from
@@ -49,9 +51,10 @@ void add_model_options(CLI::App* cmd, ModelArgs& args);
 /// the repair note ("geomip param"); `quiet` silences it. `patches`: see ModelArgs::patches.
 /// \throw InvalidInput when both or neither are given, several meshes come without CORR.json, a file is
 ///   unreadable, a point is out of range, `patches` < 2, `patches` ≠ 2 comes with CORR.json, or no K-quad
-///   layout fits the mesh (choose_quad_layout()).
+///   layout fits the mesh (choose_quad_layout()), or `tip_loop` comes with CORR.json.
+/// `tip_loop`: PartitionPointsOptions::tip_loop for automatically chosen two-square points.
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file,
-                              const std::string& command, bool quiet, int patches = 2);
+                              const std::string& command, bool quiet, int patches = 2, bool tip_loop = false);
 
 /// Registers `--patches K` on `cmd` (same name and help in every command).
 void add_patches_option(CLI::App* cmd, int& patches);

@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <random>
@@ -279,6 +281,144 @@ TEST(PartitionGenus0, ChosenPointsWorkOnCoarseMeshes) {
     EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "") << m.num_triangles() << " triangles";
     EXPECT_EQ(embedding_problems(r), "");
   }
+}
+
+// ----------------------------------------------------------------------------- genus 0, several guides a path
+
+// The vertices of `side` in order; true when `guides` appear in it in that order.
+bool passes_in_order(const std::vector<int>& side, const std::vector<int>& guides) {
+  auto at = side.begin();
+  for (int g : guides) {
+    at = std::find(at, side.end(), g);
+    if (at == side.end()) return false;
+  }
+  return true;
+}
+
+TEST(PartitionGuided, EveryPathPassesItsGuidesInOrder) {
+  const TriMesh m = sphere(4);
+  const std::vector<int> p = {nearest_vertex(m, {1, 0, 0}), nearest_vertex(m, {0, 1, 0}),
+                              nearest_vertex(m, {-1, 0, 0}), nearest_vertex(m, {0, -1, 0})};
+  // Path 0 climbs to the north pole and comes back down beside its way up; path 2 dips south twice.
+  const std::vector<std::vector<int>> guides = {
+      {nearest_vertex(m, Eigen::Vector3d(0.8, 0.1, 0.6).normalized()), nearest_vertex(m, {0, 0, 1}),
+       nearest_vertex(m, Eigen::Vector3d(0.1, 0.8, 0.6).normalized())},
+      {},
+      {nearest_vertex(m, Eigen::Vector3d(-0.9, -0.2, -0.4).normalized()),
+       nearest_vertex(m, Eigen::Vector3d(-0.6, -0.6, 0.1).normalized()),
+       nearest_vertex(m, Eigen::Vector3d(-0.2, -0.9, -0.4).normalized())},
+      {nearest_vertex(m, Eigen::Vector3d(0.7, -0.7, 0).normalized())}};
+  const PartitionResult r = partition_mesh_guided(m, p, guides);
+  EXPECT_EQ(test::check_partition(m, p, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_TRUE(passes_in_order(r.patches[0].sides[k].vertices, guides[k])) << "side " << k;
+  }
+}
+
+TEST(PartitionGuided, OneGuidePerPathIsPartitionMesh) {
+  const TriMesh m = sphere(4);
+  const std::vector<int> p = {nearest_vertex(m, {1, 0, 0}), nearest_vertex(m, {0, 1, 0}),
+                              nearest_vertex(m, {-1, 0, 0}), nearest_vertex(m, {0, -1, 0})};
+  const std::vector<int> aux = {nearest_vertex(m, Eigen::Vector3d(0.5, 0.5, 1).normalized()),
+                                nearest_vertex(m, {-0.7, 0.7, -0.1}), nearest_vertex(m, {-0.7, -0.7, -0.1}),
+                                nearest_vertex(m, {0.7, -0.7, -0.1})};
+  const PartitionResult a = partition_mesh(m, p, aux);
+  const PartitionResult b = partition_mesh_guided(m, p, {{aux[0]}, {aux[1]}, {aux[2]}, {aux[3]}});
+  EXPECT_EQ(a.face_patch, b.face_patch);
+  ASSERT_EQ(a.patches.size(), b.patches.size());
+  for (std::size_t q = 0; q < a.patches.size(); ++q) {
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(a.patches[q].sides[k].vertices, b.patches[q].sides[k].vertices);
+  }
+}
+
+TEST(PartitionGuided, BadGuideListsAreRejectedWithAClearMessage) {
+  const TriMesh m = sphere(2);
+  auto expect = [](const std::function<void()>& call, const std::string& fragment) {
+    try {
+      call();
+      ADD_FAILURE() << "no exception; expected one mentioning '" << fragment << "'";
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  expect([&] { partition_mesh_guided(m, {0, 5, 9, 20}, {{1}, {2}, {3}}); }, "one guide list per path (4), got 3");
+  expect([&] { partition_mesh_guided(m, {0, 5, 9, 20}, {{1, 2}, {}, {2}, {}}); }, "must be distinct");
+  expect([&] { partition_mesh_guided(m, {0, 5, 9, 20}, {{1}, {}, {9}, {}}); }, "must be distinct");
+  expect([&] { partition_mesh_guided(m, {0, 5, 9}, {{}, {}, {}, {}}); }, "expected 4 partition points");
+  const TriMesh torus = test::torus(16, 8);
+  expect([&] { partition_mesh_guided(torus, {0, 3, 20, 30}, {{}, {}, {}, {}}); }, "genus 0");
+}
+
+// A flat ellipsoid (semi-axes 3, 2, 1) with a spike of height 2.5 standing on its top (+z), sampled by
+// sphere(levels): the spike is a protrusion inside the +z half, away from the outline (the z = median loop).
+TriMesh spiked_ellipsoid(int levels) {
+  TriMesh m = sphere(levels);
+  for (auto& q : m.positions) {
+    const double theta = std::acos(std::clamp(q.z(), -1.0, 1.0));
+    const double spike = 2.5 * std::exp(-theta * theta / (0.12 * 0.12));
+    q = Eigen::Vector3d(3 * q.x(), 2 * q.y(), q.z() + spike);
+  }
+  return m;
+}
+
+int highest_vertex(const TriMesh& m) {
+  int best = 0;
+  for (int v = 1; v < static_cast<int>(m.positions.size()); ++v) {
+    if (m.positions[v].z() > m.positions[best].z()) best = v;
+  }
+  return best;
+}
+
+bool on_cut(const PartitionResult& r, int v) {
+  for (const auto& side : r.patches[0].sides) {
+    if (std::find(side.vertices.begin(), side.vertices.end(), v) != side.vertices.end()) return true;
+  }
+  return false;
+}
+
+TEST(PartitionTipLoop, TheLoopRunsDownASpikeAndSplitsItBetweenThePatches) {
+  const TriMesh m = spiked_ellipsoid(5);
+  const int tip = highest_vertex(m);
+  // The spike's upper half (z > 2.2 on a body of height 1): which patches hold its triangles.
+  auto spike_patches = [&](const PartitionResult& r) {
+    std::set<int> patches;
+    for (int f = 0; f < static_cast<int>(r.mesh.triangles.size()); ++f) {
+      double z = 0.0;
+      for (int v : r.mesh.triangles[f]) z += r.mesh.positions[v].z() / 3.0;
+      if (z > 2.2) patches.insert(r.face_patch[f]);
+    }
+    return patches;
+  };
+  const PartitionPoints plain = choose_partition_points(m);
+  const PartitionResult a = partition_mesh(m, plain.partition_points, plain.auxiliary_points);
+  EXPECT_FALSE(on_cut(a, tip));
+  EXPECT_EQ(spike_patches(a).size(), 1u) << "the plain outline leaves the spike whole inside one patch";
+
+  PartitionPointsOptions options;
+  options.tip_loop = true;
+  const PartitionPoints pts = choose_partition_points(m, options);
+  ASSERT_EQ(pts.side_guides.size(), 4u);
+  EXPECT_TRUE(pts.auxiliary_points.empty());
+  const PartitionResult b = partition_mesh_guided(m, pts.partition_points, pts.side_guides);
+  EXPECT_EQ(test::check_partition(m, pts.partition_points, b), "");
+  EXPECT_EQ(embedding_problems(b), "");
+  EXPECT_TRUE(on_cut(b, tip));
+  EXPECT_EQ(spike_patches(b).size(), 2u) << "the loop splits the spike lengthwise";
+  EXPECT_GT(partition_stats(b).area_balance, 0.8);
+}
+
+TEST(PartitionTipLoop, ARoundedShapeHasNoTipsAndKeepsThePlainOutline) {
+  // The deepest points of the two halves of an ellipsoid are domes, not protrusions.
+  TriMesh m = sphere(4);
+  for (auto& q : m.positions) q = Eigen::Vector3d(3 * q.x() + 0.2 * q.y(), 2 * q.y(), 0.7 * q.z());
+  PartitionPointsOptions options;
+  options.tip_loop = true;
+  const PartitionPoints tipped = choose_partition_points(m, options);
+  const PartitionPoints plain = choose_partition_points(m);
+  EXPECT_TRUE(tipped.side_guides.empty());
+  EXPECT_EQ(tipped.partition_points, plain.partition_points);
+  EXPECT_EQ(tipped.auxiliary_points, plain.auxiliary_points);
 }
 
 // ------------------------------------------------------------------------------------------- genus 1

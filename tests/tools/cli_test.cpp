@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -388,6 +389,72 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--points"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out + "/spot.param.obj"));
+}
+
+// --tip-loop routes the two-square loop down a spike to its tip; param.json lists the loop's guides as
+// side_guides, and the same points given back through CORR.json reproduce the same patches.
+TEST_F(CliParam, TipLoopGuidesRoundTripThroughCorrespondenceFiles) {
+  TriMesh m = test::sphere(4);
+  for (auto& q : m.positions) {
+    const double theta = std::acos(std::clamp(q.z(), -1.0, 1.0));
+    q = Eigen::Vector3d(3 * q.x(), 2 * q.y(), q.z() + 2.5 * std::exp(-theta * theta / (0.15 * 0.15)));
+  }
+  const std::string mesh = dir_ + "/spiked.obj";
+  {
+    std::ofstream out(mesh);
+    write_mesh(m, out, MeshFormat::kObj);
+  }
+  const Outcome r = geomip("param -q --tip-loop '" + mesh + "' -o '" + dir_ + "/tip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ + "/tip/spiked.param.json"));
+  ASSERT_TRUE(j.contains("side_guides")) << "the spike's tip is a guide of the loop";
+  ASSERT_EQ(j["side_guides"].size(), 4u);
+  EXPECT_TRUE(j["auxiliary_points"].empty());
+  int highest = 0;
+  for (int v = 1; v < static_cast<int>(m.positions.size()); ++v) {
+    if (m.positions[v].z() > m.positions[highest].z()) highest = v;
+  }
+  bool tip_guided = false;
+  for (const auto& list : j["side_guides"]) {
+    for (const auto& g : list) tip_guided = tip_guided || g.get<int>() == highest;
+  }
+  for (const auto& c : j["partition_points"]) tip_guided = tip_guided || c.get<int>() == highest;
+  EXPECT_TRUE(tip_guided) << "the highest vertex is a corner or a guide";
+
+  const std::string c = file("tip.json", "{\"models\": [{\"mesh\": \"" + mesh + "\", \"partition_points\": " +
+                                             j["partition_points"].dump() + ", \"side_guides\": " +
+                                             j["side_guides"].dump() + "}]}");
+  const Outcome again = geomip("param -q --points '" + c + "' -o '" + dir_ + "/again'");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const auto k = nlohmann::json::parse(slurp(dir_ + "/again/spiked.param.json"));
+  ASSERT_EQ(k["patches"].size(), j["patches"].size());
+  for (std::size_t p = 0; p < j["patches"].size(); ++p) {
+    EXPECT_EQ(k["patches"][p]["sides"], j["patches"][p]["sides"]) << "patch " << p;
+    EXPECT_EQ(k["patches"][p]["triangles"], j["patches"][p]["triangles"]) << "patch " << p;
+  }
+
+  // Bad guide lists and bad combinations: one line, exit 2, nothing written.
+  const std::string corners = j["partition_points"].dump();
+  for (const auto& [body, needle] : std::vector<std::pair<std::string, std::string>>{
+           {"\"side_guides\": [[1], [2], [3]]", "4 lists"},
+           {"\"side_guides\": [[1], [2], [3], \"x\"]", "side_guides[3]"},
+           {"\"auxiliary_points\": [1, 2, 3, 4], \"side_guides\": [[5], [6], [7], [8]]", "both"}}) {
+    const std::string bad = file("bad.json", "{\"models\": [{\"mesh\": \"" + mesh + "\", \"partition_points\": " +
+                                                 corners + ", " + body + "}]}");
+    const Outcome b = geomip("param -q --points '" + bad + "' -o '" + dir_ + "/bad'");
+    EXPECT_FALSE(b.crashed) << body;
+    EXPECT_EQ(b.exit_code, 2) << body << "\n" << b.err;
+    EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << b.err;
+    EXPECT_NE(b.err.find(needle), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(dir_ + "/bad")) << body;
+  }
+  for (const std::string& args : {"param -q --tip-loop --points '" + c + "' -o '" + dir_ + "/bad'",
+                                  "param -q --tip-loop --patches 4 '" + mesh + "' -o '" + dir_ + "/bad'"}) {
+    const Outcome b = geomip(args);
+    EXPECT_EQ(b.exit_code, 2) << args << "\n" << b.err;
+    EXPECT_NE(b.err.find("--tip-loop"), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(dir_ + "/bad")) << args;
+  }
 }
 
 // Issue #15 item 5: two features that lie the other way round on two models get the same common (u,v), so

@@ -32,7 +32,7 @@ struct PartitionPointsOptions {
   /// (geodesic) above where it joins the rest of the shape.
   double tip_prominence = 0.1;
   int max_tips = 12;            ///< with tip_loop: at most this many tips, the most prominent first
-  int outline_guides = 64;      ///< with tip_loop: guides along the outline (spacing = its length / this)
+  int outline_guides = 16;      ///< with tip_loop: guides along the outline (spacing = its length / this)
   /// Genus 1 only: grid offsets are tried on an offset_steps × offset_steps lattice of the flat torus
   /// (cheap: one pass over the triangles each).
   int offset_steps = 16;

@@ -2,16 +2,19 @@
 // consistent parameterization → geometry images (+ normal maps, + hole masks of repaired meshes) → the
 // progressive .gip pack (codec/pack.h), written atomically.
 #include "codec/pack.h"
+#include "gimage/surface_distance.h"
 #include "mesh/errors.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/convert_pipeline.h"
 #include "tools/model_inputs.h"
+#include "tools/pack_models.h"
 #include "tools/progress.h"
 
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -35,6 +38,7 @@ struct ConvertArgs {
   bool no_orientation_weights = false;
   bool no_lifting_update = false;
   bool fit = false;
+  bool choose_loop = false;  ///< --choose-loop: the plain loop or the tip loop, whichever prefixes are closer
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
   std::string front;  ///< +x, -x, +y, -y, +z, -z; empty: from the shape
 };
@@ -53,6 +57,24 @@ std::optional<UpAxis> up_axis(const ConvertArgs& args) {
 Eigen::Vector3d front_axis(const ConvertArgs& args) {
   if (args.front.size() != 2) return Eigen::Vector3d::Zero();
   return Eigen::Vector3d::Unit(args.front[1] - 'x') * (args.front[0] == '-' ? -1.0 : 1.0);
+}
+
+/// Prefix sizes --choose-loop compares the two packs at (those smaller than both packs).
+constexpr std::size_t kChooseLoopSizes[] = {2000, 4000, 8000, 16000};
+
+/// Mean PSNR (dB) of `pack`'s geometry decoded from each prefix in `sizes`, against `reference`.
+double mean_prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
+                        const TriMesh& reference) {
+  double sum = 0.0;
+  for (std::size_t size : sizes) {
+    codec::PackDecodeOptions decode;
+    decode.max_bytes = size;
+    decode.normals = false;
+    const codec::PackDecodeResult result = codec::decode_pack(pack, decode);
+    if (result.models.empty()) throw SolverFailure("convert --choose-loop: a prefix of the pack does not decode");
+    sum += measure_surface_distance(reference, decoded_mesh(result.models.front())).psnr_db;
+  }
+  return sum / static_cast<double>(sizes.size());
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -78,10 +100,20 @@ int run_convert(const ConvertArgs& args) {
   if (args.normal_mesh_steps > 0 && (args.common.meshes.size() > 1 || !args.common.points.empty()))
     throw InvalidInput("--normal-mesh moves samples off the parameterization, which the morphs of a consistent "
                        "set rely on: use it with one mesh");
+  if (args.choose_loop && (args.common.meshes.size() != 1 || !args.common.points.empty() ||
+                           args.common.patches != 2 || args.common.tip_loop))
+    throw InvalidInput("--choose-loop compares the automatic two-square loops of one mesh: give one MESH, "
+                       "without --points, --patches or --tip-loop");
   const bool report = !args.common.quiet && !args.common.json;
   const auto t_start = std::chrono::steady_clock::now();
-  const PreparedModels models =
+  PreparedModels models =
       prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches, args.common.tip_loop);
+  // --choose-loop: the tip loop as a second candidate, when the mesh has tips (otherwise it is the plain one).
+  std::optional<PreparedModels> tipped;
+  if (args.choose_loop) {
+    tipped = prepare_models(args.common.meshes, "", "geomip convert", true, 2, true);
+    if (tipped->inputs.front().side_guides.empty()) tipped.reset();
+  }
 
   const std::optional<UpAxis> up = up_axis(args);
   const Eigen::Vector3d front = front_axis(args);
@@ -110,7 +142,26 @@ int run_convert(const ConvertArgs& args) {
   options.up = up;
   options.front = front;
   options.progress = bar.callback();
-  const ConvertResult converted = convert_models(models, options);
+  ConvertResult converted = convert_models(models, options);
+  std::string loop = args.choose_loop ? "plain" : "";
+  double plain_psnr = NAN, tip_psnr = NAN;
+  if (tipped) {
+    ConvertResult with_tips = convert_models(*tipped, options);
+    const TriMesh& reference =
+        models.originals.front().positions.empty() ? models.inputs.front().mesh : models.originals.front();
+    std::vector<std::size_t> sizes;
+    for (std::size_t size : kChooseLoopSizes) {
+      if (size < converted.pack.size() && size < with_tips.pack.size()) sizes.push_back(size);
+    }
+    if (sizes.empty()) sizes.push_back(std::min(converted.pack.size(), with_tips.pack.size()));
+    plain_psnr = mean_prefix_psnr(converted.pack, sizes, reference);
+    tip_psnr = mean_prefix_psnr(with_tips.pack, sizes, reference);
+    if (tip_psnr > plain_psnr) {
+      converted = std::move(with_tips);
+      models = std::move(*tipped);
+      loop = "tips";
+    }
+  }
   const std::vector<std::uint8_t>& pack = converted.pack;
   write_file_atomically(args.common.output, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(pack.data()), static_cast<std::streamsize>(pack.size()));
@@ -136,6 +187,9 @@ int run_convert(const ConvertArgs& args) {
                                                  {"samples", converted.normal_mesh_candidates},
                                                  {"moved", converted.normal_mesh_moved},
                                                  {"mean_shift", converted.normal_mesh_mean_shift}}},
+                                {"loop", loop.empty() ? nlohmann::json(nullptr) : nlohmann::json(loop)},
+                                {"loop_psnr_db", {{"plain", std::isfinite(plain_psnr) ? nlohmann::json(plain_psnr) : nlohmann::json(nullptr)},
+                                                  {"tips", std::isfinite(tip_psnr) ? nlohmann::json(tip_psnr) : nlohmann::json(nullptr)}}},
                                 {"param_seconds", converted.param_seconds},
                                 {"resample_seconds", converted.resample_seconds},
                                 {"encode_seconds", converted.encode_seconds},
@@ -148,6 +202,14 @@ int run_convert(const ConvertArgs& args) {
                 args.no_normals ? ", geometry only" : ", with normal maps");
     std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
                 converted.resample_seconds, converted.encode_seconds);
+    if (args.choose_loop) {
+      if (std::isfinite(tip_psnr)) {
+        std::printf("loop: %s (mean PSNR of the 2-16 KB prefixes: plain %.2f dB, through the tips %.2f dB)\n",
+                    loop.c_str(), plain_psnr, tip_psnr);
+      } else {
+        std::printf("loop: plain (no protrusion tips found)\n");
+      }
+    }
   }
   return kExitOk;
 }
@@ -193,6 +255,9 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_flag("--no-lifting-update", args->no_lifting_update,
                 "Code the geometry with the plain interpolating wavelet, without the update step (ablations; "
                 "the pack is still format 5)");
+  cmd->add_flag("--choose-loop", args->choose_loop,
+                "One mesh, two squares: build the pack with the plain loop and with --tip-loop and keep the one "
+                "whose 2, 4, 8 and 16 KB prefixes are closer to the mesh (mean PSNR); about twice the time");
   cmd->add_option(
          "--up", args->up,
          "The models' up axis, stored with the front in each model's normalization (the viewer's frame; "

@@ -953,6 +953,49 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
 
 // Normal-mesh resampling is for one mesh: asked for with a consistent set it is refused before any work,
 // and it is off by default there.
+// --choose-loop builds the pack with the plain loop and with the tip loop and keeps the one whose prefixes
+// are closer to the mesh: the pack written is byte for byte one of the two, the one with the higher score.
+TEST_F(CliPack, ChooseLoopKeepsTheBetterOfTheTwoLoops) {
+  TriMesh m = test::sphere(4);
+  for (auto& q : m.positions) {
+    const double theta = std::acos(std::clamp(q.z(), -1.0, 1.0));
+    q = Eigen::Vector3d(3 * q.x(), 2 * q.y(), q.z() + 2.5 * std::exp(-theta * theta / (0.15 * 0.15)));
+  }
+  const std::string mesh = dir_ + "/spiked.obj";
+  {
+    std::ofstream out(mesh);
+    write_mesh(m, out, MeshFormat::kObj);
+  }
+  const std::string common = " --no-normals --level 5 '" + mesh + "' -o '" + dir_;
+  const Outcome r = geomip("convert --json --choose-loop" + common + "/chosen.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const double plain = j["loop_psnr_db"]["plain"], tips = j["loop_psnr_db"]["tips"];
+  EXPECT_TRUE(std::isfinite(plain) && std::isfinite(tips) && plain > 30 && tips > 30) << j.dump();
+  const std::string loop = j["loop"];
+  EXPECT_EQ(loop, tips > plain ? "tips" : "plain");
+  ASSERT_EQ(geomip("convert -q" + common + "/plain.gip'").exit_code, 0);
+  ASSERT_EQ(geomip("convert -q --tip-loop" + common + "/tips.gip'").exit_code, 0);
+  const std::string chosen = slurp(dir_ + "/chosen.gip");
+  EXPECT_EQ(chosen, slurp(dir_ + "/" + loop + ".gip"));
+  EXPECT_NE(slurp(dir_ + "/plain.gip"), slurp(dir_ + "/tips.gip")) << "the two loops differ on a spiked shape";
+
+  // A mesh without tips: the plain pack, no second candidate.
+  const Outcome s = geomip("convert --json --choose-loop --no-normals --level 4 '" + spot_ + "' -o '" + dir_ + "/spot.gip'");
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  const auto k = nlohmann::json::parse(s.out);
+  EXPECT_EQ(k["loop"], "plain");
+  EXPECT_TRUE(k["loop_psnr_db"]["tips"].is_null());
+
+  for (const std::string& args : {"convert -q --choose-loop --tip-loop" + common + "/bad.gip'",
+                                  "convert -q --choose-loop --patches 4" + common + "/bad.gip'"}) {
+    const Outcome b = geomip(args);
+    EXPECT_EQ(b.exit_code, 2) << args << "\n" << b.err;
+    EXPECT_NE(b.err.find("--choose-loop"), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(dir_ + "/bad.gip")) << args;
+  }
+}
+
 TEST_F(CliPack, NormalMeshRefusedForSeveralMeshes) {
   const std::string pack = dir_ + "/two.gip";
   const Outcome r = geomip("convert -q '" + spot_ + "' '" + spot_ + "' --normal-mesh 2 --level 3 -o '" + pack + "'");

@@ -350,18 +350,6 @@ TEST(PartitionGuided, BadGuideListsAreRejectedWithAClearMessage) {
   expect([&] { partition_mesh_guided(torus, {0, 3, 20, 30}, {{}, {}, {}, {}}); }, "genus 0");
 }
 
-// A flat ellipsoid (semi-axes 3, 2, 1) with a spike of height 2.5 standing on its top (+z), sampled by
-// sphere(levels): the spike is a protrusion inside the +z half, away from the outline (the z = median loop).
-TriMesh spiked_ellipsoid(int levels) {
-  TriMesh m = sphere(levels);
-  for (auto& q : m.positions) {
-    const double theta = std::acos(std::clamp(q.z(), -1.0, 1.0));
-    const double spike = 2.5 * std::exp(-theta * theta / (0.12 * 0.12));
-    q = Eigen::Vector3d(3 * q.x(), 2 * q.y(), q.z() + spike);
-  }
-  return m;
-}
-
 int highest_vertex(const TriMesh& m) {
   int best = 0;
   for (int v = 1; v < static_cast<int>(m.positions.size()); ++v) {
@@ -378,7 +366,7 @@ bool on_cut(const PartitionResult& r, int v) {
 }
 
 TEST(PartitionTipLoop, TheLoopRunsDownASpikeAndSplitsItBetweenThePatches) {
-  const TriMesh m = spiked_ellipsoid(5);
+  const TriMesh m = test::spiked_ellipsoid(5, 0.12);
   const int tip = highest_vertex(m);
   // The spike's upper half (z > 2.2 on a body of height 1): which patches hold its triangles.
   auto spike_patches = [&](const PartitionResult& r) {

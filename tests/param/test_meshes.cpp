@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <set>
@@ -168,6 +169,15 @@ std::string temp_dir(const std::string& tag) {
 
 // Two tori joined by a tube: genus 2. The tube's winding and matching are searched so that the result is a
 // consistently oriented closed manifold.
+TriMesh spiked_ellipsoid(int levels, double width) {
+  TriMesh m = sphere(levels);
+  for (auto& q : m.positions) {
+    const double theta = std::acos(std::clamp(q.z(), -1.0, 1.0));
+    q = Eigen::Vector3d(3 * q.x(), 2 * q.y(), q.z() + 2.5 * std::exp(-theta * theta / (width * width)));
+  }
+  return m;
+}
+
 TriMesh double_torus() {
   const int n = 16, mm = 8;
   const TriMesh a = test::torus(n, mm);

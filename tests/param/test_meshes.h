@@ -25,6 +25,10 @@ TriMesh pinched_tetrahedra();
 /// Unit sphere around the origin: a cube subdivided `levels` times (1-to-4) and projected, 12·4^levels
 /// triangles.
 TriMesh sphere(int levels);
+/// A flat ellipsoid (semi-axes 3, 2, 1) with a spike of height 2.5 on its top (+z, Gaussian profile of width
+/// `width` radians), sampled by sphere(levels): a protrusion inside the +z half, away from the z = median
+/// outline that choose_partition_points() cuts along.
+TriMesh spiked_ellipsoid(int levels, double width);
 /// Two tori (test::torus(16, 8)) joined by a tube: a closed, consistently oriented genus-2 mesh.
 TriMesh double_torus();
 /// Index of the vertex nearest to `p` (brute force).

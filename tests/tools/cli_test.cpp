@@ -394,11 +394,7 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
 // --tip-loop routes the two-square loop down a spike to its tip; param.json lists the loop's guides as
 // side_guides, and the same points given back through CORR.json reproduce the same patches.
 TEST_F(CliParam, TipLoopGuidesRoundTripThroughCorrespondenceFiles) {
-  TriMesh m = test::sphere(4);
-  for (auto& q : m.positions) {
-    const double theta = std::acos(std::clamp(q.z(), -1.0, 1.0));
-    q = Eigen::Vector3d(3 * q.x(), 2 * q.y(), q.z() + 2.5 * std::exp(-theta * theta / (0.15 * 0.15)));
-  }
+  const TriMesh m = test::spiked_ellipsoid(4, 0.15);
   const std::string mesh = dir_ + "/spiked.obj";
   {
     std::ofstream out(mesh);
@@ -956,11 +952,7 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
 // --choose-loop builds the pack with the plain loop and with the tip loop and keeps the one whose prefixes
 // are closer to the mesh: the pack written is byte for byte one of the two, the one with the higher score.
 TEST_F(CliPack, ChooseLoopKeepsTheBetterOfTheTwoLoops) {
-  TriMesh m = test::sphere(4);
-  for (auto& q : m.positions) {
-    const double theta = std::acos(std::clamp(q.z(), -1.0, 1.0));
-    q = Eigen::Vector3d(3 * q.x(), 2 * q.y(), q.z() + 2.5 * std::exp(-theta * theta / (0.15 * 0.15)));
-  }
+  const TriMesh m = test::spiked_ellipsoid(4, 0.15);
   const std::string mesh = dir_ + "/spiked.obj";
   {
     std::ofstream out(mesh);

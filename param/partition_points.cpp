@@ -1,6 +1,7 @@
 #include "param/partition_points.h"
 
 #include "mesh/errors.h"
+#include "param/geodesic_peaks.h"
 #include "param/mesh_partition.h"
 #include "mesh/mesh_topology.h"
 
@@ -206,67 +207,12 @@ const double kCornerSlack = 16.0;
 
 Tips find_tips(const TriMesh& m, const Outline& o, double min_prominence, int max_tips) {
   const int nv = static_cast<int>(m.positions.size());
-  std::vector<std::vector<int>> adj(nv);
-  for (const auto& t : m.triangles) {
-    for (int k = 0; k < 3; ++k) {
-      adj[t[k]].push_back(t[(k + 1) % 3]);  // each undirected edge once per direction on a closed mesh
-    }
-  }
+  const std::vector<std::vector<int>> adj = vertex_neighbours(m);
   Tips tips;
-  tips.dist.assign(nv, std::numeric_limits<double>::infinity());
-  tips.foot.assign(nv, -1);
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
-  for (std::size_t e = 0; e < o.vertex.size(); ++e) {
-    const int v = o.vertex[e];
-    if (tips.dist[v] > 0.0) {
-      tips.dist[v] = 0.0;
-      tips.foot[v] = static_cast<int>(e);
-      heap.push({0.0, v});
-    }
-  }
-  while (!heap.empty()) {
-    const auto [d, v] = heap.top();
-    heap.pop();
-    if (d > tips.dist[v]) continue;
-    for (int u : adj[v]) {
-      const double du = d + (m.positions[u] - m.positions[v]).norm();
-      if (du < tips.dist[u]) {
-        tips.dist[u] = du;
-        tips.foot[u] = tips.foot[v];
-        heap.push({du, u});
-      }
-    }
-  }
-  std::vector<int> order;
-  for (int v = 0; v < nv; ++v) {
-    if (!adj[v].empty() && std::isfinite(tips.dist[v])) order.push_back(v);
-  }
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return tips.dist[a] != tips.dist[b] ? tips.dist[a] > tips.dist[b] : a < b;
-  });
-  std::vector<int> parent(nv, -1), peak(nv, -1);
-  auto find = [&](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  std::vector<std::pair<double, int>> peaks;  // (prominence, peak vertex)
-  for (int v : order) {
-    parent[v] = v;
-    peak[v] = v;
-    for (int u : adj[v]) {
-      if (parent[u] < 0) continue;
-      const int a = find(u), b = find(v);
-      if (a == b) continue;
-      // The component whose peak is lower ends here.
-      const bool a_higher = tips.dist[peak[a]] > tips.dist[peak[b]] ||
-                            (tips.dist[peak[a]] == tips.dist[peak[b]] && peak[a] < peak[b]);
-      const int keep = a_higher ? a : b, end = a_higher ? b : a;
-      peaks.push_back({tips.dist[peak[end]] - tips.dist[v], peak[end]});
-      parent[end] = keep;
-    }
-  }
-  if (!order.empty()) peaks.push_back({tips.dist[order.front()], order.front()});
+  GeodesicDistance g = geodesic_distance(m, adj, o.vertex);
+  tips.dist = std::move(g.dist);
+  tips.foot = std::move(g.nearest);
+  std::vector<std::pair<double, int>> peaks = persistent_peaks(adj, tips.dist);  // (prominence, peak vertex)
   std::sort(peaks.begin(), peaks.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
   });

@@ -3,6 +3,7 @@
 #include "mesh/errors.h"
 #include "mesh/mesh_topology.h"
 #include "mesh/predicates.h"
+#include "param/geodesic_peaks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -540,11 +541,10 @@ void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int
 // least `min_persistence` times the largest distance, most persistent first, at most `max_tips`.
 std::vector<int> protrusion_tips(const TriMesh& mesh, double min_persistence, std::size_t max_tips) {
   const int nv = static_cast<int>(mesh.positions.size());
-  std::vector<std::vector<int>> adj(nv);
+  const std::vector<std::vector<int>> adj = vertex_neighbours(mesh);
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();
   double area = 0.0;
   for (const auto& t : mesh.triangles) {
-    for (int j = 0; j < 3; ++j) adj[t[j]].push_back(t[(j + 1) % 3]);
     const double a = (mesh.positions[t[1]] - mesh.positions[t[0]])
                          .cross(mesh.positions[t[2]] - mesh.positions[t[0]])
                          .norm();
@@ -559,47 +559,11 @@ std::vector<int> protrusion_tips(const TriMesh& mesh, double min_persistence, st
                           (mesh.positions[source] - centre).squaredNorm())
       source = v;
   }
-  std::vector<double> dist(nv, std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  dist[source] = 0.0;
-  queue.push({0.0, source});
-  while (!queue.empty()) {
-    const auto [d, v] = queue.top();
-    queue.pop();
-    if (d > dist[v]) continue;
-    for (int w : adj[v]) {
-      const double dw = d + (mesh.positions[w] - mesh.positions[v]).norm();
-      if (dw < dist[w]) {
-        dist[w] = dw;
-        queue.push({dw, w});
-      }
-    }
-  }
-  // Superlevel-set persistence by union-find, vertices in decreasing distance.
-  std::vector<int> order;
-  for (int v = 0; v < nv; ++v) {
-    if (!adj[v].empty()) order.push_back(v);
-  }
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return dist[a] != dist[b] ? dist[a] > dist[b] : a < b; });
-  std::vector<int> parent(nv, -1), peak(nv, -1);
-  std::function<int(int)> find = [&](int v) { return parent[v] == v ? v : parent[v] = find(parent[v]); };
-  std::vector<std::pair<double, int>> maxima;  // (persistence, vertex)
-  const double top = dist[order.front()];
-  for (int v : order) {
-    parent[v] = v;
-    peak[v] = v;
-    for (int w : adj[v]) {
-      if (parent[w] < 0) continue;
-      const int a = find(v), b = find(w);
-      if (a == b) continue;
-      // the region with the lower peak dies here
-      const int keep = dist[peak[a]] >= dist[peak[b]] ? a : b, die = keep == a ? b : a;
-      if (peak[die] != v) maxima.push_back({dist[peak[die]] - dist[v], peak[die]});
-      parent[die] = keep;
-    }
-  }
-  maxima.push_back({top, order.front()});  // the global maximum never dies
+  const std::vector<double> dist = geodesic_distance(mesh, adj, {source}).dist;
+  // Superlevel-set persistence; the global maximum's is the largest distance.
+  std::vector<std::pair<double, int>> maxima = persistent_peaks(adj, dist);  // (persistence, vertex)
+  double top = 0.0;
+  for (const auto& m : maxima) top = std::max(top, m.first);
   std::sort(maxima.begin(), maxima.end(), std::greater<>());
   std::vector<int> tips;
   for (const auto& [persistence, v] : maxima) {

@@ -14,6 +14,7 @@
 #include <numeric>
 #include <queue>
 #include <string>
+#include <tuple>
 
 namespace geomip {
 namespace {
@@ -249,11 +250,11 @@ Tips find_tips(const TriMesh& m, const Outline& o, double min_prominence, int ma
   return tips;
 }
 
-// The outline loop of `base` (corners at outline entries `at`) rerouted through the tips of the shape's
-// protrusions: the loop follows the outline through guides spaced o.length / samples apart, and at the
-// outline entry nearest to a tip it runs down to the tip and back up another way, which splits the
-// protrusion lengthwise between the two patches. Corners are the guides nearest to quarters of the loop's
-// (estimated) length from outline entry `start` (the +a extreme). Empty when there is no tip or the loop does not partition.
+// The outline `o` rerouted through the tips of the shape's protrusions: the loop follows the outline from
+// entry `start` (the +a extreme) through guides spaced o.length / outline_guides apart, and at the outline
+// entry nearest to a tip it runs down to the tip and back up another way, which splits the protrusion
+// lengthwise between the two patches. Corners: see below. Empty when there is no tip or the loop does not
+// partition.
 PartitionPoints tip_loop_points(const TriMesh& m, const Outline& o, int start,
                                 const PartitionPointsOptions& options, double total_area) {
   PartitionPoints none;
@@ -263,10 +264,10 @@ PartitionPoints tip_loop_points(const TriMesh& m, const Outline& o, int start,
   if (tips.vertex.empty()) return none;
   // Waypoints in loop order, starting at the +a extreme: (position along the outline, vertex, is a tip).
   struct Way {
-    double along;  // arc length from entry at[0]
+    double along;  // arc length along the outline from entry `start` (a tip: that of its foot)
     int vertex;
     bool tip;
-    double extra;  // estimated length of the detour that starts at this tip's predecessor
+    double extra;  // a tip: estimated length of its detour (twice its distance from the outline); else 0
   };
   std::vector<Way> ways;
   auto along = [&](int entry) { return std::fmod(o.arc[entry] - o.arc[start] + 2.0 * o.length, o.length); };
@@ -305,6 +306,11 @@ PartitionPoints tip_loop_points(const TriMesh& m, const Outline& o, int start,
   // tip needs), the evenest split among those; if no 4 waypoints are that even, the evenest split.
   std::array<std::size_t, 4> corner = {0, 0, 0, 0};
   const double tolerance = loop / kCornerSlack;
+  // Smaller is better: even splits first, then more tips among the even ones, then the evener split.
+  auto rank = [&](double score, int tip_count) {
+    const bool even = score <= tolerance;
+    return std::make_tuple(!even, even ? -tip_count : 0, score);
+  };
   int best_tips = -1;
   double best_score = std::numeric_limits<double>::infinity();
   for (std::size_t i0 = 0; i0 < nw; ++i0) {
@@ -318,17 +324,7 @@ PartitionPoints tip_loop_points(const TriMesh& m, const Outline& o, int start,
           const double score = std::max({g0, g1, std::abs(at_length[i3] - at_length[i2] - 0.25 * loop),
                                          std::abs(at_length[i0] + loop - at_length[i3] - 0.25 * loop)});
           const int tip_count = ways[i0].tip + ways[i1].tip + ways[i2].tip + ways[i3].tip;
-          const bool even = score <= tolerance;
-          const bool best_even = best_score <= tolerance;
-          bool better;
-          if (even != best_even) {
-            better = even;
-          } else if (even && tip_count != best_tips) {
-            better = tip_count > best_tips;
-          } else {
-            better = score < best_score;
-          }
-          if (better || best_tips < 0) {
+          if (best_tips < 0 || rank(score, tip_count) < rank(best_score, best_tips)) {
             best_tips = tip_count;
             best_score = score;
             corner = {i0, i1, i2, i3};

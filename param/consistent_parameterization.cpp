@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <random>
 #include <string>
@@ -246,6 +247,117 @@ std::size_t reconcile_seams(ModelParameterization& m) {
   return mismatches;
 }
 
+// Sliding seams: the sides are parameterized by chord length in each patch, which fixes how much of a side
+// each stretch of seam gets before either patch's interior is known. Each round moves every seam vertex along
+// its side, to where the L2 stretch energy Σ A3·L2² of its triangles in *both* patches is least (golden
+// section between its two side neighbours, never flipping a triangle on either side), then runs `sweeps`
+// global stretch sweeps over every patch with its boundary and features locked. Both copies of a seam vertex
+// get the same parameter, so the seams still agree (reconcile_seams() makes them bit-identical).
+void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>>& weights,
+                 const ParameterizationOptions& options) {
+  const std::size_t np = m.patches.size();
+  std::vector<std::vector<int>> local(np, std::vector<int>(m.mesh.positions.size(), -1));
+  std::vector<std::vector<std::vector<int>>> star(np);
+  std::vector<std::vector<Eigen::Vector3d>> positions(np);
+  for (std::size_t p = 0; p < np; ++p) {
+    const auto& patch = m.patches[p];
+    for (std::size_t i = 0; i < patch.vertices.size(); ++i) {
+      local[p][patch.vertices[i]] = static_cast<int>(i);
+      positions[p].push_back(m.mesh.positions[patch.vertices[i]]);
+    }
+    star[p].assign(patch.vertices.size(), {});
+    for (std::size_t t = 0; t < patch.triangles.size(); ++t) {
+      for (int v : patch.triangles[t]) star[p][v].push_back(static_cast<int>(t));
+    }
+  }
+  // Σ A3·L2² over the star of v in patch p (+inf when a triangle is flipped or degenerate).
+  auto star_energy = [&](std::size_t p, int v) {
+    double e = 0.0;
+    const auto& patch = m.patches[p];
+    for (int t : star[p][v]) {
+      const auto& tri = patch.triangles[t];
+      const Eigen::Vector3d q[3] = {positions[p][tri[0]], positions[p][tri[1]], positions[p][tri[2]]};
+      const Eigen::Vector2d uv[3] = {patch.uv[tri[0]], patch.uv[tri[1]], patch.uv[tri[2]]};
+      if (orient2d(uv[0], uv[1], uv[2]) <= 0) return std::numeric_limits<double>::infinity();
+      const double l2 = triangle_stretch(q, uv).l2;
+      const double a3 = 0.5 * (q[1] - q[0]).cross(q[2] - q[0]).norm();
+      double w = 1.0;
+      if (!weights[p].empty()) w = (weights[p][tri[0]] + weights[p][tri[1]] + weights[p][tri[2]]) / 3.0;
+      e += w * a3 * l2 * l2;
+    }
+    return e;
+  };
+  for (int round = 0; round < options.seam_slide_rounds; ++round) {
+    for (const SideLink& link : m.adjacency) {
+      if (link.patch == link.other_patch) continue;
+      if (std::make_pair(link.patch, link.side) > std::make_pair(link.other_patch, link.other_side)) continue;
+      auto& a = m.patches[link.patch];
+      auto& b = m.patches[link.other_patch];
+      const auto& side = a.sides[link.side];
+      for (std::size_t j = 1; j + 1 < side.size(); ++j) {
+        const int va = local[link.patch][side[j]], vb = local[link.other_patch][side[j]];
+        if (va < 0 || vb < 0) continue;
+        const Eigen::Vector2d old_a = a.uv[va], old_b = b.uv[vb];
+        auto place = [&](double s) {
+          a.uv[va] = point_on_side(link.side, s);
+          b.uv[vb] = point_on_side(link.other_side, link.reversed ? 1.0 - s : s);
+        };
+        auto energy = [&](double s) {
+          place(s);
+          return star_energy(link.patch, va) + star_energy(link.other_patch, vb);
+        };
+        const double s0 = position_on_side(old_a, link.side);
+        const double lo = position_on_side(a.uv[local[link.patch][side[j - 1]]], link.side);
+        const double hi = position_on_side(a.uv[local[link.patch][side[j + 1]]], link.side);
+        const double e0 = star_energy(link.patch, va) + star_energy(link.other_patch, vb);
+        // Golden section on [lo, hi], kept a little inside so that no seam edge collapses.
+        const double margin = 0.02 * (hi - lo);
+        double x0 = lo + margin, x3 = hi - margin;
+        if (!(x3 > x0)) continue;
+        constexpr double kGolden = 0.6180339887498949;
+        double x1 = x3 - kGolden * (x3 - x0), x2 = x0 + kGolden * (x3 - x0);
+        double f1 = energy(x1), f2 = energy(x2);
+        for (int it = 0; it < options.seam_slide_iterations; ++it) {
+          if (f1 <= f2) {
+            x3 = x2; x2 = x1; f2 = f1;
+            x1 = x3 - kGolden * (x3 - x0);
+            f1 = energy(x1);
+          } else {
+            x0 = x1; x1 = x2; f1 = f2;
+            x2 = x0 + kGolden * (x3 - x0);
+            f2 = energy(x2);
+          }
+        }
+        const double best = f1 <= f2 ? x1 : x2;
+        const double fbest = std::min(f1, f2);
+        if (fbest < e0 && std::isfinite(fbest)) {
+          place(best);
+        } else {
+          a.uv[va] = old_a;
+          b.uv[vb] = old_b;
+          (void)s0;
+        }
+      }
+    }
+    if (options.seam_slide_sweeps == 0) continue;
+    for_each_patch(np, options.threads, [&](std::size_t p) {
+      auto& patch = m.patches[p];
+      std::vector<char> locked(patch.vertices.size(), 0);
+      for (const auto& sd : patch.sides) {
+        for (int v : sd) locked[local[p][v]] = 1;
+      }
+      for (const FeatureLocation& f : m.features) {
+        if (f.patch == static_cast<int>(p) && f.vertex >= 0 && local[p][f.vertex] >= 0) locked[local[p][f.vertex]] = 1;
+      }
+      StretchOptimizationOptions o = options.base_optimization;
+      o.max_sweeps = options.seam_slide_sweeps;
+      o.seed = options.seed + 977u * static_cast<unsigned>(round + 1) + 13u * static_cast<unsigned>(p);
+      o.vertex.vertex_weights = weights[p].empty() ? nullptr : &weights[p];
+      optimize_stretch(positions[p], patch.triangles, patch.uv, locked, o);
+    });
+  }
+}
+
 // Progress of the whole run: 3 steps per model (one for phase A, two for phase C) plus phase B. Calls are
 // serialized, so the user's callback never runs on two threads at once.
 struct Progress {
@@ -345,6 +457,8 @@ PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size
   std::vector<double> base_weights;
   if (options.curvature_sampling) {
     pw.weights = curvature_sampling_weights(pw.local.positions, pw.local.triangles, options.sampling_weights);
+  }
+  if (!pw.weights.empty()) {
     for (int v : base.to_patch) base_weights.push_back(pw.weights[v]);
     base_options.vertex.vertex_weights = &base_weights;
   }
@@ -685,6 +799,13 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
       patch_progress(p, 1.0);
     });
     for (const StageSeconds& s : seconds) add_seconds(o.seconds, s);
+    if (options.seam_slide_rounds > 0) {
+      const auto t0 = Clock::now();
+      std::vector<std::vector<double>> weights(num_patches);
+      for (std::size_t p = 0; p < num_patches; ++p) weights[p] = w.patches[p].weights;
+      slide_seams(o, weights, options);
+      o.seconds.final_optimization += seconds_since(t0);
+    }
     o.seam_mismatches = reconcile_seams(o);
     // reconcile_seams may have moved seam vertices of a patch after its figures were taken (to a neighbour's
     // off-chord position): measure every patch again, so that `stretch` and `flipped` describe the output.

@@ -93,6 +93,12 @@ struct ParameterizationOptions {
   double linf_floor = 2.0;
   /// See `linf_sweeps`: fraction of the patch's current L∞ stretch below which a ring is not moved. In [0, 1].
   double linf_relative_floor = 0.85;
+  /// Sliding seams: rounds of moving every seam vertex along its side to where the stretch of its triangles
+  /// in both patches is least, each followed by `seam_slide_sweeps` global sweeps over every patch (boundary
+  /// and features locked). Frees the sides from their chord-length parameterization; 0 = off.
+  int seam_slide_rounds = 0;
+  std::size_t seam_slide_sweeps = 10;
+  int seam_slide_iterations = 12;  ///< golden-section steps per seam vertex and round
   /// Also compute the mean-value embedding of each full patch, the baseline the stretch figures are
   /// reported against (one sparse solve per patch).
   bool measure_mvc_baseline = true;

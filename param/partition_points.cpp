@@ -200,13 +200,11 @@ struct Tips {
   std::vector<int> foot;     // per mesh vertex: outline entry
 };
 
-// Largest area / depth² half way down a tip's protrusion: a tube of girth c has c / depth (about 0.5–1.5 for
-// legs, ears and arms), a rounded cap about π.
-const double kTubeRatio = 2.0;
 // The corners' split of the loop may miss quarters by loop / kCornerSlack.
 const double kCornerSlack = 16.0;
 
-Tips find_tips(const TriMesh& m, const Outline& o, double min_prominence, int max_tips) {
+// tube_ratio: largest area / depth² half way down a tip's protrusion (PartitionPointsOptions::tube_ratio).
+Tips find_tips(const TriMesh& m, const Outline& o, double min_prominence, int max_tips, double tube_ratio) {
   const int nv = static_cast<int>(m.positions.size());
   const std::vector<std::vector<int>> adj = vertex_neighbours(m);
   Tips tips;
@@ -243,7 +241,7 @@ Tips find_tips(const TriMesh& m, const Outline& o, double min_prominence, int ma
         }
       }
     }
-    if (area > kTubeRatio * depth * depth) continue;
+    if (area > tube_ratio * depth * depth) continue;
     tips.vertex.push_back(v);
     tips.prominence.push_back(prominence);
   }
@@ -260,7 +258,8 @@ PartitionPoints tip_loop_points(const TriMesh& m, const Outline& o, int start,
   PartitionPoints none;
   const int count = static_cast<int>(o.vertex.size());
   if (count < 16 || !options.tip_loop) return none;
-  const Tips tips = find_tips(m, o, options.tip_prominence * std::sqrt(total_area), options.max_tips);
+  const Tips tips =
+      find_tips(m, o, options.tip_prominence * std::sqrt(total_area), options.max_tips, options.tube_ratio);
   if (tips.vertex.empty()) return none;
   // Waypoints in loop order, starting at the +a extreme: (position along the outline, vertex, is a tip).
   struct Way {
@@ -272,7 +271,7 @@ PartitionPoints tip_loop_points(const TriMesh& m, const Outline& o, int start,
   std::vector<Way> ways;
   auto along = [&](int entry) { return std::fmod(o.arc[entry] - o.arc[start] + 2.0 * o.length, o.length); };
   std::vector<char> used(m.positions.size(), 0);
-  const int samples = std::max(8, options.outline_guides);
+  const int samples = std::max(4, options.outline_guides);
   int next = 0;
   for (int i = 0; i < count; ++i) {
     const int entry = (start + i) % count;
@@ -732,6 +731,10 @@ PartitionPoints choose_partition_points(const TriMesh& closed_manifold,
   if (options.cut_axis < 1 || options.cut_axis > 3) {
     throw InvalidInput(std::string(kFn) + "cut_axis must be 1, 2 or 3, got " +
                        std::to_string(options.cut_axis));
+  }
+  if (options.tip_loop && (!(options.tube_ratio > 0) || !std::isfinite(options.tube_ratio) ||
+                           !(options.tip_prominence >= 0) || !std::isfinite(options.tip_prominence))) {
+    throw InvalidInput(std::string(kFn) + "tube_ratio must be a positive number and tip_prominence >= 0");
   }
   if (*topo.genus == 0) return genus0_points(closed_manifold, options);
   if (*topo.genus == 1) return genus1_points(closed_manifold, options);

@@ -32,7 +32,10 @@ struct PartitionPointsOptions {
   /// (geodesic) above where it joins the rest of the shape.
   double tip_prominence = 0.1;
   int max_tips = 12;            ///< with tip_loop: at most this many tips, the most prominent first
-  int outline_guides = 16;      ///< with tip_loop: guides along the outline (spacing = its length / this)
+  int outline_guides = 16;      ///< with tip_loop: guides along the outline (spacing = its length / this; >= 4)
+  /// With tip_loop: a peak is a protrusion's tip when the region above half its depth has an area below
+  /// tube_ratio · depth² (a tube of girth c: c / depth, about 0.5–1.5 for legs and ears; a rounded cap: π).
+  double tube_ratio = 2.0;
   /// Genus 1 only: grid offsets are tried on an offset_steps × offset_steps lattice of the flat torus
   /// (cheap: one pass over the triangles each).
   int offset_steps = 16;
@@ -73,7 +76,7 @@ struct PartitionPointsOptions {
 /// 1. d = geodesic distance from the outline (edge-graph Dijkstra); tips are the peaks of d whose prominence
 ///    (0-dimensional persistence of its superlevel sets: how far d falls before the peak's region meets a
 ///    higher one's) is at least tip_prominence · √area, and whose region half way down is a tube (area below
-///    2 · depth²), not the rounded middle of a half (a cap, area about π · depth²);
+///    tube_ratio · depth², 2 by default), not the rounded middle of a half (a cap, area about π · depth²);
 /// 2. the loop follows the outline through outline_guides guides, and at the outline vertex nearest to each
 ///    tip it runs down to the tip and back up another way (partition_mesh_guided());
 /// 3. the 4 corners are waypoints that split the loop's estimated length into quarters within 1/16, with as

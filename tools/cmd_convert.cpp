@@ -63,6 +63,12 @@ Eigen::Vector3d front_axis(const ConvertArgs& args) {
 constexpr std::size_t kChooseLoopSizes[] = {2000, 4000, 8000, 16000};
 
 /// Mean PSNR (dB) of `pack`'s geometry decoded from each prefix in `sizes`, against `reference`.
+std::string format_db(double db) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f dB", db);
+  return text;
+}
+
 double mean_prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
                         const TriMesh& reference) {
   double sum = 0.0;
@@ -100,20 +106,35 @@ int run_convert(const ConvertArgs& args) {
   if (args.normal_mesh_steps > 0 && (args.common.meshes.size() > 1 || !args.common.points.empty()))
     throw InvalidInput("--normal-mesh moves samples off the parameterization, which the morphs of a consistent "
                        "set rely on: use it with one mesh");
+  const LoopKind loop_asked = loop_kind(args.common);
   if (args.choose_loop && (args.common.meshes.size() != 1 || !args.common.points.empty() ||
-                           args.common.patches != 2 || args.common.tip_loop))
+                           args.common.patches != 2 || loop_asked != LoopKind::kPlain))
     throw InvalidInput("--choose-loop compares the automatic two-square loops of one mesh: give one MESH, "
-                       "without --points, --patches or --tip-loop");
+                       "without --points, --patches, --tip-loop or --end-loop");
   const bool report = !args.common.quiet && !args.common.json;
   const auto t_start = std::chrono::steady_clock::now();
   PreparedModels models =
-      prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches, args.common.tip_loop);
-  // --choose-loop: the tip loop as a second candidate, when the mesh has tips (otherwise it is the plain one).
-  std::optional<PreparedModels> tipped;
+      prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches, loop_asked);
+  // --choose-loop: the tip loop and the end loop as further candidates, each when the mesh has tips for it
+  // and its loop differs from the ones before (otherwise it would build the same pack again).
+  std::vector<std::pair<LoopKind, PreparedModels>> candidates;
   if (args.choose_loop) {
-    tipped = prepare_models(args.common.meshes, "", "geomip convert", true, 2, true);
-    if (tipped->inputs.front().side_guides.empty()) tipped.reset();
+    for (LoopKind kind : {LoopKind::kTips, LoopKind::kEnds}) {
+      PreparedModels m = prepare_models(args.common.meshes, "", "geomip convert", true, 2, kind);
+      const ParameterizationInput& in = m.inputs.front();
+      if (in.side_guides.empty()) continue;
+      bool seen = false;
+      for (const auto& [k, other] : candidates) {
+        const ParameterizationInput& o = other.inputs.front();
+        seen = seen || (o.partition_points == in.partition_points && o.side_guides == in.side_guides &&
+                        default_seam_slide_rounds(k) == default_seam_slide_rounds(kind));
+      }
+      if (!seen) candidates.emplace_back(kind, std::move(m));
+    }
   }
+  auto slide_rounds = [&](LoopKind kind) {
+    return args.common.slide_seams >= 0 ? args.common.slide_seams : default_seam_slide_rounds(kind);
+  };
 
   const std::optional<UpAxis> up = up_axis(args);
   const Eigen::Vector3d front = front_axis(args);
@@ -132,6 +153,7 @@ int run_convert(const ConvertArgs& args) {
   options.hole_mask_level = args.hole_mask_level;
   options.sampling_exponent = args.common.sampling_exponent;
   options.linf_sweeps = static_cast<std::size_t>(args.common.linf_sweeps);
+  options.seam_slide_rounds = slide_rounds(loop_asked);
   options.normal_mesh_steps = args.normal_mesh_steps;
   options.normal_mesh_max_shift = args.normal_mesh_reach;
   options.frame_steps = args.frame_steps;
@@ -144,22 +166,40 @@ int run_convert(const ConvertArgs& args) {
   options.progress = bar.callback();
   ConvertResult converted = convert_models(models, options);
   std::string loop = args.choose_loop ? "plain" : "";
-  double plain_psnr = NAN, tip_psnr = NAN;
-  if (tipped) {
-    ConvertResult with_tips = convert_models(*tipped, options);
+  // Mean PSNR of each loop's 2–16 KB prefixes (NaN: not built, e.g. a mesh without tips).
+  double plain_psnr = NAN, tip_psnr = NAN, end_psnr = NAN;
+  if (!candidates.empty()) {
+    std::vector<ConvertResult> built;
+    std::size_t smallest = converted.pack.size();
+    for (auto& [kind, m] : candidates) {
+      ConvertOptions o = options;
+      o.seam_slide_rounds = slide_rounds(kind);
+      built.push_back(convert_models(m, o));
+      smallest = std::min(smallest, built.back().pack.size());
+    }
     const TriMesh& reference =
         models.originals.front().positions.empty() ? models.inputs.front().mesh : models.originals.front();
     std::vector<std::size_t> sizes;
     for (std::size_t size : kChooseLoopSizes) {
-      if (size < converted.pack.size() && size < with_tips.pack.size()) sizes.push_back(size);
+      if (size < smallest) sizes.push_back(size);
     }
-    if (sizes.empty()) sizes.push_back(std::min(converted.pack.size(), with_tips.pack.size()));
+    if (sizes.empty()) sizes.push_back(smallest);
     plain_psnr = mean_prefix_psnr(converted.pack, sizes, reference);
-    tip_psnr = mean_prefix_psnr(with_tips.pack, sizes, reference);
-    if (tip_psnr > plain_psnr) {
-      converted = std::move(with_tips);
-      models = std::move(*tipped);
-      loop = "tips";
+    double best = plain_psnr;
+    std::size_t chosen = candidates.size();  // none: the plain loop
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      const double psnr = mean_prefix_psnr(built[c].pack, sizes, reference);
+      (candidates[c].first == LoopKind::kTips ? tip_psnr : end_psnr) = psnr;
+      if (psnr > best) {
+        best = psnr;
+        chosen = c;
+      }
+    }
+    // Only now: `reference` may be a mesh of `models`.
+    if (chosen < candidates.size()) {
+      converted = std::move(built[chosen]);
+      models = std::move(candidates[chosen].second);
+      loop = candidates[chosen].first == LoopKind::kTips ? "tips" : "ends";
     }
   }
   const std::vector<std::uint8_t>& pack = converted.pack;
@@ -189,7 +229,8 @@ int run_convert(const ConvertArgs& args) {
                                                  {"mean_shift", converted.normal_mesh_mean_shift}}},
                                 {"loop", loop.empty() ? nlohmann::json(nullptr) : nlohmann::json(loop)},
                                 {"loop_psnr_db", {{"plain", std::isfinite(plain_psnr) ? nlohmann::json(plain_psnr) : nlohmann::json(nullptr)},
-                                                  {"tips", std::isfinite(tip_psnr) ? nlohmann::json(tip_psnr) : nlohmann::json(nullptr)}}},
+                                                  {"tips", std::isfinite(tip_psnr) ? nlohmann::json(tip_psnr) : nlohmann::json(nullptr)},
+                                                  {"ends", std::isfinite(end_psnr) ? nlohmann::json(end_psnr) : nlohmann::json(nullptr)}}},
                                 {"param_seconds", converted.param_seconds},
                                 {"resample_seconds", converted.resample_seconds},
                                 {"encode_seconds", converted.encode_seconds},
@@ -203,9 +244,11 @@ int run_convert(const ConvertArgs& args) {
     std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
                 converted.resample_seconds, converted.encode_seconds);
     if (args.choose_loop) {
-      if (std::isfinite(tip_psnr)) {
-        std::printf("loop: %s (mean PSNR of the 2-16 KB prefixes: plain %.2f dB, through the tips %.2f dB)\n",
-                    loop.c_str(), plain_psnr, tip_psnr);
+      if (std::isfinite(tip_psnr) || std::isfinite(end_psnr)) {
+        std::string scores = "plain " + format_db(plain_psnr);
+        if (std::isfinite(tip_psnr)) scores += ", through the tips " + format_db(tip_psnr);
+        if (std::isfinite(end_psnr)) scores += ", through the ends " + format_db(end_psnr);
+        std::printf("loop: %s (mean PSNR of the 2-16 KB prefixes: %s)\n", loop.c_str(), scores.c_str());
       } else {
         std::printf("loop: plain (no protrusion tips found)\n");
       }
@@ -256,8 +299,9 @@ CommandRunner add_convert_command(CLI::App& app) {
                 "Code the geometry with the plain interpolating wavelet, without the update step (ablations; "
                 "the pack is still format 5)");
   cmd->add_flag("--choose-loop", args->choose_loop,
-                "One mesh, two squares: build the pack with the plain loop and with --tip-loop and keep the one "
-                "whose 2, 4, 8 and 16 KB prefixes are closer to the mesh (mean PSNR); about twice the time");
+                "One mesh, two squares: build the pack with the plain loop, with --tip-loop and with --end-loop "
+                "(each when the mesh has tips) and keep the one whose 2, 4, 8 and 16 KB prefixes are closest to "
+                "the mesh (mean PSNR); up to three times the time");
   cmd->add_option(
          "--up", args->up,
          "The models' up axis, stored with the front in each model's normalization (the viewer's frame; "

@@ -119,6 +119,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   param.curvature_sampling = options.sampling_exponent > 0;
   param.sampling_weights.exponent = options.sampling_exponent;
   param.linf_sweeps = options.linf_sweeps;
+  param.seam_slide_rounds = options.seam_slide_rounds;
   param.progress = [&](const char* stage, double fraction) { progress(stage, 0.8 * fraction); };
   auto t0 = std::chrono::steady_clock::now();
   const std::vector<ModelParameterization> params = parameterize_consistently(models.inputs, param);

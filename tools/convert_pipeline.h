@@ -39,6 +39,8 @@ struct ConvertOptions {
   double sampling_exponent = 0;
   /// Sweeps of the parameterization's L∞ pass (ParameterizationOptions::linf_sweeps; 0 = off).
   std::size_t linf_sweeps = 0;
+  /// Sliding-seam rounds of the parameterization (ParameterizationOptions::seam_slide_rounds; 0 = off).
+  int seam_slide_rounds = 0;
   /// Normal-mesh resampling of the finest `normal_mesh_steps` wavelet steps' samples before coding
   /// (codec/normal_mesh.h; 0 = off). One model only: it moves samples off the parameterization, which the
   /// morphs of a consistent set rely on (InvalidInput when asked for with several models). -1 (default) =

@@ -140,15 +140,35 @@ QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std
 
 }  // namespace
 
+PartitionPointsOptions loop_options(LoopKind kind) {
+  PartitionPointsOptions o;
+  o.tip_loop = kind != LoopKind::kPlain;
+  if (kind == LoopKind::kEnds) {
+    o.outline_guides = 4;
+    o.tube_ratio = 2.5;
+  }
+  return o;
+}
+
+int default_seam_slide_rounds(LoopKind kind) { return kind == LoopKind::kEnds ? 10 : 0; }
+
+LoopKind loop_kind(const ModelArgs& args) {
+  if (args.tip_loop && args.end_loop) throw InvalidInput("--tip-loop and --end-loop are two different loops: give one");
+  return args.end_loop ? LoopKind::kEnds : args.tip_loop ? LoopKind::kTips : LoopKind::kPlain;
+}
+
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file_arg,
-                              const std::string& command, bool quiet, int patches, bool tip_loop) {
+                              const std::string& command, bool quiet, int patches, LoopKind loop) {
+  const bool tip_loop = loop != LoopKind::kPlain;
+  const char* loop_flag = loop == LoopKind::kEnds ? "--end-loop" : "--tip-loop";
   PreparedModels models;
   std::vector<ParameterizationInput>& inputs = models.inputs;
   std::vector<std::string>& paths = models.paths;
   std::vector<ModelSpec> specs;
   const std::string& points_file = points_file_arg;
   if (patches < 2) throw InvalidInput("--patches " + std::to_string(patches) + ": a layout needs at least 2");
-  if (tip_loop && patches != 2) throw InvalidInput("--tip-loop routes the two-square loop; it does not go with --patches " + std::to_string(patches));
+  if (tip_loop && patches != 2)
+    throw InvalidInput(std::string(loop_flag) + " routes the two-square loop; it does not go with --patches " + std::to_string(patches));
   if (!points_file_arg.empty()) {
     if (!meshes.empty()) {
       throw InvalidInput("give either meshes or --points CORR.json (which names the meshes), not both");
@@ -157,7 +177,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       throw InvalidInput("--patches chooses an automatic layout; with --points CORR.json the file gives the points");
     }
     if (tip_loop) {
-      throw InvalidInput("--tip-loop chooses automatic partition points; with --points CORR.json the file gives them");
+      throw InvalidInput(std::string(loop_flag) + " chooses automatic partition points; with --points CORR.json the file gives them");
     }
     specs = read_correspondence(points_file_arg);
   } else {
@@ -190,8 +210,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
     } else if (spec.partition_points.empty()) {
-      PartitionPointsOptions point_options;
-      point_options.tip_loop = tip_loop;
+      const PartitionPointsOptions point_options = loop_options(loop);
       const PartitionPoints chosen = choose_partition_points(in.mesh, point_options);
       in.partition_points = chosen.partition_points;
       in.auxiliary_points = chosen.auxiliary_points;
@@ -233,6 +252,14 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
                 "Two squares (genus 0): route the cut down each protrusion (legs, ears) to its tip and back, "
                 "splitting it lengthwise between the squares (default off: helps some shapes, hurts others; "
                 "docs/measurements.md)");
+  cmd->add_flag("--end-loop", args.end_loop,
+                "Two squares (genus 0): a loop through the shape's ends (hooves, nose, tail), joined by shortest "
+                "paths through 4 outline guides, with sliding seams (default off; helps the horse at low rates, "
+                "not the cow or the bunny: docs/measurements.md)");
+  cmd->add_option("--slide-seams", args.slide_seams,
+                  "Rounds of sliding seams: every seam vertex moves along its side to where its triangles in both "
+                  "patches are least stretched, then stretch sweeps (default: 10 with --end-loop, else 0)")
+      ->check(CLI::Range(0, 1000));
 }
 
 void add_patches_option(CLI::App* cmd, int& patches) {
@@ -246,6 +273,7 @@ void apply_sampling(const ModelArgs& args, ParameterizationOptions& options) {
   options.curvature_sampling = args.sampling_exponent > 0;
   options.sampling_weights.exponent = args.sampling_exponent;
   options.linf_sweeps = static_cast<std::size_t>(args.linf_sweeps);
+  options.seam_slide_rounds = args.slide_seams >= 0 ? args.slide_seams : default_seam_slide_rounds(loop_kind(args));
 }
 
 }  // namespace geomip::tools

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "param/consistent_parameterization.h"
+#include "param/partition_points.h"
 
 #include <CLI/CLI.hpp>
 
@@ -19,6 +20,20 @@ struct PreparedModels {
   /// must give back what the user had (the hole mask of a pack) compare against it.
   std::vector<TriMesh> originals;
 };
+
+/// The automatic two-square loop of a genus-0 mesh (no CORR.json): the plane section (kPlain), the same
+/// outline rerouted down every protrusion to its tip and back (kTips: `--tip-loop`), or a loop through the
+/// shape's ends (kEnds: `--end-loop`): tips found with a looser tube test (nose and tail besides the legs)
+/// and joined through 4 outline guides instead of 16, with sliding seams (ends_loop_options()).
+enum class LoopKind { kPlain, kTips, kEnds };
+
+/// PartitionPointsOptions for a loop kind (tip_loop off for kPlain).
+PartitionPointsOptions loop_options(LoopKind kind);
+
+/// Sliding-seam rounds (ParameterizationOptions::seam_slide_rounds) a loop kind gets when `--slide-seams`
+/// is not given: 10 for kEnds (measured on the horse: docs/measurements.md, "A loop through the ends"), 0
+/// otherwise.
+int default_seam_slide_rounds(LoopKind kind);
 
 /// The options every model-consuming command shares: MESH..., --points, -o, --json, --quiet.
 struct ModelArgs {
@@ -38,10 +53,17 @@ struct ModelArgs {
   int patches = 2;
   /// --tip-loop: PartitionPointsOptions::tip_loop for automatic two-square points (genus 0, no CORR.json).
   bool tip_loop = false;
+  /// --end-loop: LoopKind::kEnds (not with --tip-loop).
+  bool end_loop = false;
+  /// --slide-seams N: ParameterizationOptions::seam_slide_rounds; -1 = default_seam_slide_rounds() of the loop.
+  int slide_seams = -1;
 };
 
-/// Sets the parameterization's curvature sampling from `--sampling-exponent` and its L∞ pass from
-/// `--linf-sweeps`.
+/// The loop kind `--tip-loop` / `--end-loop` ask for. \throw InvalidInput when both are given.
+LoopKind loop_kind(const ModelArgs& args);
+
+/// Sets the parameterization's curvature sampling from `--sampling-exponent`, its L∞ pass from
+/// `--linf-sweeps` and its sliding seams from `--slide-seams` (or the loop kind's default).
 void apply_sampling(const ModelArgs& args, ParameterizationOptions& options);
 
 /// Registers ModelArgs' options on `cmd` (same names and help in every command).
@@ -51,10 +73,11 @@ void add_model_options(CLI::App* cmd, ModelArgs& args);
 /// the repair note ("geomip param"); `quiet` silences it. `patches`: see ModelArgs::patches.
 /// \throw InvalidInput when both or neither are given, several meshes come without CORR.json, a file is
 ///   unreadable, a point is out of range, `patches` < 2, `patches` ≠ 2 comes with CORR.json, or no K-quad
-///   layout fits the mesh (choose_quad_layout()), or `tip_loop` comes with CORR.json.
-/// `tip_loop`: PartitionPointsOptions::tip_loop for automatically chosen two-square points.
+///   layout fits the mesh (choose_quad_layout()), or `loop` is not kPlain with CORR.json or `patches` ≠ 2.
+/// `loop`: the automatically chosen two-square loop (LoopKind).
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file,
-                              const std::string& command, bool quiet, int patches = 2, bool tip_loop = false);
+                              const std::string& command, bool quiet, int patches = 2,
+                              LoopKind loop = LoopKind::kPlain);
 
 /// Registers `--patches K` on `cmd` (same name and help in every command).
 void add_patches_option(CLI::App* cmd, int& patches);

@@ -409,6 +409,34 @@ TEST(PartitionTipLoop, ARoundedShapeHasNoTipsAndKeepsThePlainOutline) {
   EXPECT_EQ(tipped.auxiliary_points, plain.auxiliary_points);
 }
 
+// The tube test decides what counts as a tip: an ellipsoid's two domes (area half way down about π·depth²)
+// are not tips at the default ratio 2 but are at 10; the end loop's settings (4 outline guides, ratio 2.5)
+// still route a valid loop over the spike's tip. A ratio that is not a positive number is refused.
+TEST(PartitionTipLoop, TheTubeRatioSeparatesTubesFromCaps) {
+  TriMesh ellipsoid = sphere(4);
+  for (auto& q : ellipsoid.positions) q = Eigen::Vector3d(3 * q.x() + 0.2 * q.y(), 2 * q.y(), 0.7 * q.z());
+  PartitionPointsOptions options;
+  options.tip_loop = true;
+  EXPECT_TRUE(choose_partition_points(ellipsoid, options).side_guides.empty());
+  options.tube_ratio = 10;
+  EXPECT_FALSE(choose_partition_points(ellipsoid, options).side_guides.empty()) << "domes pass a loose tube test";
+
+  const TriMesh m = test::spiked_ellipsoid(5, 0.12);
+  options.tube_ratio = 2.5;
+  options.outline_guides = 4;
+  const PartitionPoints pts = choose_partition_points(m, options);
+  ASSERT_EQ(pts.side_guides.size(), 4u);
+  const PartitionResult r = partition_mesh_guided(m, pts.partition_points, pts.side_guides);
+  EXPECT_EQ(test::check_partition(m, pts.partition_points, r), "");
+  EXPECT_EQ(embedding_problems(r), "");
+  EXPECT_TRUE(on_cut(r, highest_vertex(m)));
+
+  for (double bad : {0.0, -1.0, std::nan("")}) {
+    options.tube_ratio = bad;
+    EXPECT_THROW(choose_partition_points(m, options), InvalidInput) << bad;
+  }
+}
+
 // ------------------------------------------------------------------------------------------- genus 1
 
 struct TorusSetup {

@@ -949,9 +949,10 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
 
 // Normal-mesh resampling is for one mesh: asked for with a consistent set it is refused before any work,
 // and it is off by default there.
-// --choose-loop builds the pack with the plain loop and with the tip loop and keeps the one whose prefixes
-// are closer to the mesh: the pack written is byte for byte one of the two, the one with the higher score.
-TEST_F(CliPack, ChooseLoopKeepsTheBetterOfTheTwoLoops) {
+// --choose-loop builds the pack with the plain loop, the tip loop and the end loop and keeps the one whose
+// prefixes are closest to the mesh: the pack written is byte for byte the candidate with the highest score,
+// which the same convert with that loop alone writes.
+TEST_F(CliPack, ChooseLoopKeepsTheBestOfTheLoops) {
   const TriMesh m = test::spiked_ellipsoid(4, 0.15);
   const std::string mesh = dir_ + "/spiked.obj";
   {
@@ -964,26 +965,43 @@ TEST_F(CliPack, ChooseLoopKeepsTheBetterOfTheTwoLoops) {
   const auto j = nlohmann::json::parse(r.out);
   const double plain = j["loop_psnr_db"]["plain"], tips = j["loop_psnr_db"]["tips"];
   EXPECT_TRUE(std::isfinite(plain) && std::isfinite(tips) && plain > 30 && tips > 30) << j.dump();
+  std::string best = tips > plain ? "tips" : "plain";
+  if (!j["loop_psnr_db"]["ends"].is_null()) {
+    const double ends = j["loop_psnr_db"]["ends"];
+    EXPECT_TRUE(std::isfinite(ends) && ends > 30) << j.dump();
+    if (ends > std::max(plain, tips)) best = "ends";
+  }
   const std::string loop = j["loop"];
-  EXPECT_EQ(loop, tips > plain ? "tips" : "plain");
+  EXPECT_EQ(loop, best) << j.dump();
   ASSERT_EQ(geomip("convert -q" + common + "/plain.gip'").exit_code, 0);
   ASSERT_EQ(geomip("convert -q --tip-loop" + common + "/tips.gip'").exit_code, 0);
+  ASSERT_EQ(geomip("convert -q --end-loop" + common + "/ends.gip'").exit_code, 0);
   const std::string chosen = slurp(dir_ + "/chosen.gip");
   EXPECT_EQ(chosen, slurp(dir_ + "/" + loop + ".gip"));
-  EXPECT_NE(slurp(dir_ + "/plain.gip"), slurp(dir_ + "/tips.gip")) << "the two loops differ on a spiked shape";
+  EXPECT_NE(slurp(dir_ + "/plain.gip"), slurp(dir_ + "/tips.gip")) << "the loops differ on a spiked shape";
+  EXPECT_NE(slurp(dir_ + "/tips.gip"), slurp(dir_ + "/ends.gip")) << "the end loop slides its seams";
 
-  // A mesh without tips: the plain pack, no second candidate.
+  // A mesh without tips: the plain pack, no other candidate.
   const Outcome s = geomip("convert --json --choose-loop --no-normals --level 4 '" + spot_ + "' -o '" + dir_ + "/spot.gip'");
   ASSERT_EQ(s.exit_code, 0) << s.err;
   const auto k = nlohmann::json::parse(s.out);
   EXPECT_EQ(k["loop"], "plain");
   EXPECT_TRUE(k["loop_psnr_db"]["tips"].is_null());
+  EXPECT_TRUE(k["loop_psnr_db"]["ends"].is_null());
 
   for (const std::string& args : {"convert -q --choose-loop --tip-loop" + common + "/bad.gip'",
+                                  "convert -q --choose-loop --end-loop" + common + "/bad.gip'",
                                   "convert -q --choose-loop --patches 4" + common + "/bad.gip'"}) {
     const Outcome b = geomip(args);
     EXPECT_EQ(b.exit_code, 2) << args << "\n" << b.err;
     EXPECT_NE(b.err.find("--choose-loop"), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(dir_ + "/bad.gip")) << args;
+  }
+  for (const std::string& args : {"convert -q --tip-loop --end-loop" + common + "/bad.gip'",
+                                  "convert -q --end-loop --patches 4" + common + "/bad.gip'"}) {
+    const Outcome b = geomip(args);
+    EXPECT_EQ(b.exit_code, 2) << args << "\n" << b.err;
+    EXPECT_NE(b.err.find("--end-loop"), std::string::npos) << b.err;
     EXPECT_FALSE(fs::exists(dir_ + "/bad.gip")) << args;
   }
 }

@@ -58,6 +58,8 @@ struct RdArgs {
   int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
   int patches = 2;          // geomip: patches of the automatic layout (--patches)
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
+  bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)
+  bool end_loop = false;    // geomip: the loop through the ends (--end-loop, as `geomip convert`)
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -194,10 +196,11 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
 
 /// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only pack),
 /// then one job per prefix size: decode the first N bytes and build the level-N mesh.
-Series geomip_series(const std::string& mesh_path, int level, int patches, int normal_mesh_steps, bool fit,
-                     bool quick, std::vector<std::uint8_t>& pack_out, ProgressBar& progress) {
-  const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches);
+Series geomip_series(const std::string& mesh_path, int level, int patches, LoopKind loop, int normal_mesh_steps,
+                     bool fit, bool quick, std::vector<std::uint8_t>& pack_out, ProgressBar& progress) {
+  const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches, loop);
   ConvertOptions options;
+  options.seam_slide_rounds = default_seam_slide_rounds(loop);
   options.level = level;
   options.normals = false;
   options.normal_mesh_steps = normal_mesh_steps;
@@ -278,6 +281,10 @@ std::string point_row(const RdPoint& p) {
 }
 
 int run_rd(const RdArgs& args) {
+  if (args.tip_loop && args.end_loop) throw InvalidInput("--tip-loop and --end-loop are two different loops: give one");
+  const LoopKind loop = args.end_loop ? LoopKind::kEnds : args.tip_loop ? LoopKind::kTips : LoopKind::kPlain;
+  if (loop != LoopKind::kPlain && args.patches != 2)
+    throw InvalidInput(std::string(args.end_loop ? "--end-loop" : "--tip-loop") + " routes the two-square loop; it does not go with --patches " + std::to_string(args.patches));
   const auto start = std::chrono::steady_clock::now();
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
   const unsigned threads =
@@ -288,7 +295,7 @@ int run_rd(const RdArgs& args) {
   std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
   if (!args.no_geomip)
-    plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.normal_mesh_steps, args.fit, args.quick,
+    plan.push_back(geomip_series(args.mesh, args.level, args.patches, loop, args.normal_mesh_steps, args.fit, args.quick,
                                  pack, progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
@@ -446,6 +453,8 @@ CommandRunner add_rd_command(CLI::App& app) {
                 "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip "
                 "convert --fit`; slower: about 30 s at level 8); --no-fit: samples on the surface (default)");
   add_patches_option(cmd, args->patches);
+  cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");
+  cmd->add_flag("--end-loop", args->end_loop, "geomip: the two-square loop through the ends (as `geomip convert --end-loop`)");
   return [args] { return run_rd(*args); };
 }
 

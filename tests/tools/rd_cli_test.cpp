@@ -116,6 +116,30 @@ TEST_F(RdCli, FitRaisesTheWholePack) {
   EXPECT_FALSE(fs::exists(fs::path(dir_) / "bad" / "rd.csv"));
 }
 
+// `rd --end-loop` (`--tip-loop`) measures the pack `convert --no-normals --end-loop` writes, byte for byte;
+// both loops together, or a loop with --patches 4, exit 2 with nothing written.
+TEST_F(RdCli, LoopFlagsMeasureThatLoopsPack) {
+  const std::string mesh = dir_ + "/spiked.obj";
+  {
+    std::ofstream out(mesh);
+    write_mesh(test::spiked_ellipsoid(4, 0.15), out, MeshFormat::kObj);
+  }
+  std::string err;
+  for (const std::string flag : {"--end-loop", "--tip-loop"}) {
+    const std::string out_dir = dir_ + "/rd" + flag;
+    ASSERT_EQ(geomip("rd --quick --level 5 " + flag + " '" + mesh + "' -o '" + out_dir + "'", err), 0) << err;
+    ASSERT_EQ(geomip("convert -q --no-normals --level 5 " + flag + " '" + mesh + "' -o '" + dir_ + "/c.gip'", err), 0)
+        << err;
+    EXPECT_EQ(slurp(fs::path(out_dir) / "spiked.gip"), slurp(fs::path(dir_) / "c.gip")) << flag;
+  }
+  EXPECT_NE(slurp(fs::path(dir_) / "rd--end-loop" / "spiked.gip"), slurp(fs::path(dir_) / "rd--tip-loop" / "spiked.gip"));
+  for (const std::string args : {"--end-loop --tip-loop", "--end-loop --patches 4"}) {
+    EXPECT_EQ(geomip("rd --quick " + args + " '" + mesh + "' -o '" + dir_ + "/bad'", err), 2) << args;
+    EXPECT_NE(err.find("--end-loop"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(fs::path(dir_) / "bad")) << args;
+  }
+}
+
 TEST_F(RdCli, MissingMeshFailsCleanly) {
   const std::string out_dir = dir_ + "/rd";
   std::string err;

@@ -197,21 +197,35 @@ void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine&
   }
 }
 
+// Per patch: local id of each mesh vertex (−1 outside the patch) and the triangles around each local vertex.
+struct PatchIndex {
+  std::vector<std::vector<int>> local;             // [patch][mesh vertex]
+  std::vector<std::vector<std::vector<int>>> star;  // [patch][local vertex]: triangle ids
+};
+
+PatchIndex index_patches(const ModelParameterization& m) {
+  PatchIndex index;
+  index.local.assign(m.patches.size(), std::vector<int>(m.mesh.positions.size(), -1));
+  index.star.resize(m.patches.size());
+  for (std::size_t p = 0; p < m.patches.size(); ++p) {
+    const auto& patch = m.patches[p];
+    for (std::size_t i = 0; i < patch.vertices.size(); ++i) index.local[p][patch.vertices[i]] = static_cast<int>(i);
+    index.star[p].assign(patch.vertices.size(), {});
+    for (std::size_t t = 0; t < patch.triangles.size(); ++t) {
+      for (int v : patch.triangles[t]) index.star[p][v].push_back(static_cast<int>(t));
+    }
+  }
+  return index;
+}
+
 // Seam vertices sit at their chord-length position in both patches, so the two positions agree; where
 // coarse-to-fine could not put one there (a boundary vertex boxed in by long triangles), this moves the
 // vertex in the other patch to the same position if that flips nothing there, and copies the value bit for
 // bit. Returns the vertices whose positions still differ.
 std::size_t reconcile_seams(ModelParameterization& m) {
-  std::vector<std::vector<int>> local(m.patches.size(), std::vector<int>(m.mesh.positions.size(), -1));
-  std::vector<std::vector<std::vector<int>>> star(m.patches.size());
-  for (std::size_t p = 0; p < m.patches.size(); ++p) {
-    const auto& patch = m.patches[p];
-    for (std::size_t i = 0; i < patch.vertices.size(); ++i) local[p][patch.vertices[i]] = static_cast<int>(i);
-    star[p].assign(patch.vertices.size(), {});
-    for (std::size_t t = 0; t < patch.triangles.size(); ++t) {
-      for (int v : patch.triangles[t]) star[p][v].push_back(static_cast<int>(t));
-    }
-  }
+  const PatchIndex index = index_patches(m);
+  const auto& local = index.local;
+  const auto& star = index.star;
   auto star_valid = [&](std::size_t p, int v) {
     for (int t : star[p][v]) {
       const auto& tri = m.patches[p].triangles[t];
@@ -256,19 +270,12 @@ std::size_t reconcile_seams(ModelParameterization& m) {
 void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>>& weights,
                  const ParameterizationOptions& options) {
   const std::size_t np = m.patches.size();
-  std::vector<std::vector<int>> local(np, std::vector<int>(m.mesh.positions.size(), -1));
-  std::vector<std::vector<std::vector<int>>> star(np);
+  const PatchIndex index = index_patches(m);
+  const auto& local = index.local;
+  const auto& star = index.star;
   std::vector<std::vector<Eigen::Vector3d>> positions(np);
   for (std::size_t p = 0; p < np; ++p) {
-    const auto& patch = m.patches[p];
-    for (std::size_t i = 0; i < patch.vertices.size(); ++i) {
-      local[p][patch.vertices[i]] = static_cast<int>(i);
-      positions[p].push_back(m.mesh.positions[patch.vertices[i]]);
-    }
-    star[p].assign(patch.vertices.size(), {});
-    for (std::size_t t = 0; t < patch.triangles.size(); ++t) {
-      for (int v : patch.triangles[t]) star[p][v].push_back(static_cast<int>(t));
-    }
+    for (int v : m.patches[p].vertices) positions[p].push_back(m.mesh.positions[v]);
   }
   // Σ A3·L2² over the star of v in patch p (+inf when a triangle is flipped or degenerate).
   auto star_energy = [&](std::size_t p, int v) {
@@ -306,7 +313,6 @@ void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>
           place(s);
           return star_energy(link.patch, va) + star_energy(link.other_patch, vb);
         };
-        const double s0 = position_on_side(old_a, link.side);
         const double lo = position_on_side(a.uv[local[link.patch][side[j - 1]]], link.side);
         const double hi = position_on_side(a.uv[local[link.patch][side[j + 1]]], link.side);
         const double e0 = star_energy(link.patch, va) + star_energy(link.other_patch, vb);
@@ -332,10 +338,9 @@ void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>
         const double fbest = std::min(f1, f2);
         if (fbest < e0 && std::isfinite(fbest)) {
           place(best);
-        } else {
+        } else {  // back where it was (the search left it at its last trial)
           a.uv[va] = old_a;
           b.uv[vb] = old_b;
-          (void)s0;
         }
       }
     }

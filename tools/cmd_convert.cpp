@@ -38,7 +38,7 @@ struct ConvertArgs {
   bool no_orientation_weights = false;
   bool no_lifting_update = false;
   bool fit = false;
-  bool choose_loop = false;  ///< --choose-loop: the plain loop or the tip loop, whichever prefixes are closer
+  bool choose_loop = false;  ///< --choose-loop: the plain, tip or end loop, whichever prefixes are closest
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
   std::string front;  ///< +x, -x, +y, -y, +z, -z; empty: from the shape
 };
@@ -59,16 +59,16 @@ Eigen::Vector3d front_axis(const ConvertArgs& args) {
   return Eigen::Vector3d::Unit(args.front[1] - 'x') * (args.front[0] == '-' ? -1.0 : 1.0);
 }
 
-/// Prefix sizes --choose-loop compares the two packs at (those smaller than both packs).
+/// Prefix sizes --choose-loop compares the packs at (those smaller than every pack).
 constexpr std::size_t kChooseLoopSizes[] = {2000, 4000, 8000, 16000};
 
-/// Mean PSNR (dB) of `pack`'s geometry decoded from each prefix in `sizes`, against `reference`.
 std::string format_db(double db) {
   char text[32];
   std::snprintf(text, sizeof text, "%.2f dB", db);
   return text;
 }
 
+/// Mean PSNR (dB) of `pack`'s geometry decoded from each prefix in `sizes`, against `reference`.
 double mean_prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
                         const TriMesh& reference) {
   double sum = 0.0;
@@ -115,8 +115,11 @@ int run_convert(const ConvertArgs& args) {
   const auto t_start = std::chrono::steady_clock::now();
   PreparedModels models =
       prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches, loop_asked);
+  auto slide_rounds = [&](LoopKind kind) {
+    return args.common.slide_seams >= 0 ? args.common.slide_seams : default_seam_slide_rounds(kind);
+  };
   // --choose-loop: the tip loop and the end loop as further candidates, each when the mesh has tips for it
-  // and its loop differs from the ones before (otherwise it would build the same pack again).
+  // and it differs from the ones before (otherwise it would build the same pack again).
   std::vector<std::pair<LoopKind, PreparedModels>> candidates;
   if (args.choose_loop) {
     for (LoopKind kind : {LoopKind::kTips, LoopKind::kEnds}) {
@@ -127,14 +130,11 @@ int run_convert(const ConvertArgs& args) {
       for (const auto& [k, other] : candidates) {
         const ParameterizationInput& o = other.inputs.front();
         seen = seen || (o.partition_points == in.partition_points && o.side_guides == in.side_guides &&
-                        default_seam_slide_rounds(k) == default_seam_slide_rounds(kind));
+                        slide_rounds(k) == slide_rounds(kind));
       }
       if (!seen) candidates.emplace_back(kind, std::move(m));
     }
   }
-  auto slide_rounds = [&](LoopKind kind) {
-    return args.common.slide_seams >= 0 ? args.common.slide_seams : default_seam_slide_rounds(kind);
-  };
 
   const std::optional<UpAxis> up = up_axis(args);
   const Eigen::Vector3d front = front_axis(args);

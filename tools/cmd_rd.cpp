@@ -281,10 +281,9 @@ std::string point_row(const RdPoint& p) {
 }
 
 int run_rd(const RdArgs& args) {
-  if (args.tip_loop && args.end_loop) throw InvalidInput("--tip-loop and --end-loop are two different loops: give one");
-  const LoopKind loop = args.end_loop ? LoopKind::kEnds : args.tip_loop ? LoopKind::kTips : LoopKind::kPlain;
-  if (loop != LoopKind::kPlain && args.patches != 2)
-    throw InvalidInput(std::string(args.end_loop ? "--end-loop" : "--tip-loop") + " routes the two-square loop; it does not go with --patches " + std::to_string(args.patches));
+  // Before the baselines' work: bad loop options fail at once.
+  const LoopKind loop = loop_kind(args.tip_loop, args.end_loop);
+  check_loop_patches(loop, args.patches);
   const auto start = std::chrono::steady_clock::now();
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
   const unsigned threads =

@@ -138,6 +138,8 @@ QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std
                      " patches partitions it; give its layout in a --points CORR.json");
 }
 
+const char* loop_flag(LoopKind loop) { return loop == LoopKind::kEnds ? "--end-loop" : "--tip-loop"; }
+
 }  // namespace
 
 PartitionPointsOptions loop_options(LoopKind kind) {
@@ -152,23 +154,27 @@ PartitionPointsOptions loop_options(LoopKind kind) {
 
 int default_seam_slide_rounds(LoopKind kind) { return kind == LoopKind::kEnds ? 10 : 0; }
 
-LoopKind loop_kind(const ModelArgs& args) {
-  if (args.tip_loop && args.end_loop) throw InvalidInput("--tip-loop and --end-loop are two different loops: give one");
-  return args.end_loop ? LoopKind::kEnds : args.tip_loop ? LoopKind::kTips : LoopKind::kPlain;
+LoopKind loop_kind(bool tip_loop, bool end_loop) {
+  if (tip_loop && end_loop) throw InvalidInput("--tip-loop and --end-loop are two different loops: give one");
+  return end_loop ? LoopKind::kEnds : tip_loop ? LoopKind::kTips : LoopKind::kPlain;
+}
+
+void check_loop_patches(LoopKind loop, int patches) {
+  if (loop != LoopKind::kPlain && patches != 2)
+    throw InvalidInput(std::string(loop_flag(loop)) + " routes the two-square loop; it does not go with --patches " +
+                       std::to_string(patches));
 }
 
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file_arg,
                               const std::string& command, bool quiet, int patches, LoopKind loop) {
   const bool tip_loop = loop != LoopKind::kPlain;
-  const char* loop_flag = loop == LoopKind::kEnds ? "--end-loop" : "--tip-loop";
   PreparedModels models;
   std::vector<ParameterizationInput>& inputs = models.inputs;
   std::vector<std::string>& paths = models.paths;
   std::vector<ModelSpec> specs;
   const std::string& points_file = points_file_arg;
   if (patches < 2) throw InvalidInput("--patches " + std::to_string(patches) + ": a layout needs at least 2");
-  if (tip_loop && patches != 2)
-    throw InvalidInput(std::string(loop_flag) + " routes the two-square loop; it does not go with --patches " + std::to_string(patches));
+  check_loop_patches(loop, patches);
   if (!points_file_arg.empty()) {
     if (!meshes.empty()) {
       throw InvalidInput("give either meshes or --points CORR.json (which names the meshes), not both");
@@ -177,7 +183,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       throw InvalidInput("--patches chooses an automatic layout; with --points CORR.json the file gives the points");
     }
     if (tip_loop) {
-      throw InvalidInput(std::string(loop_flag) + " chooses automatic partition points; with --points CORR.json the file gives them");
+      throw InvalidInput(std::string(loop_flag(loop)) + " chooses automatic partition points; with --points CORR.json the file gives them");
     }
     specs = read_correspondence(points_file_arg);
   } else {

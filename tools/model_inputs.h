@@ -60,7 +60,12 @@ struct ModelArgs {
 };
 
 /// The loop kind `--tip-loop` / `--end-loop` ask for. \throw InvalidInput when both are given.
-LoopKind loop_kind(const ModelArgs& args);
+LoopKind loop_kind(bool tip_loop, bool end_loop);
+inline LoopKind loop_kind(const ModelArgs& args) { return loop_kind(args.tip_loop, args.end_loop); }
+
+/// \throw InvalidInput (naming the flag) when `loop` is not kPlain and `patches` ≠ 2: the loops are of the
+/// two-square partition.
+void check_loop_patches(LoopKind loop, int patches);
 
 /// Sets the parameterization's curvature sampling from `--sampling-exponent`, its L∞ pass from
 /// `--linf-sweeps` and its sliding seams from `--slide-seams` (or the loop kind's default).

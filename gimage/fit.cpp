@@ -136,7 +136,9 @@ FitResult fit_geometry_images(const TriMesh& original, const GeometryImages& ima
   const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   const int level = images.geometry.front().level;
   const int size = images.geometry.front().size();
-  const UniformRemeshResult remesh = uniform_remesh(images, level);
+  UniformRemeshResult remesh = uniform_remesh(images, level);
+  if (options.quad_split == QuadSplit::kShorter)
+    split_along_shorter_diagonals(remesh, level, {&remesh.mesh.positions});
   const std::vector<Eigen::Vector3d>& p0 = remesh.mesh.positions;
   const std::size_t nv = p0.size();
 

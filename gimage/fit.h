@@ -43,6 +43,7 @@
 #pragma once
 
 #include "gimage/resample.h"
+#include "gimage/uniform_remesh.h"
 #include "mesh/mesh.h"
 
 #include <cstddef>
@@ -66,6 +67,10 @@ struct FitOptions {
   std::uint64_t seed = 0xf17;
   /// Worker threads for the closest-point queries; 0 = std::thread::hardware_concurrency().
   unsigned threads = 0;
+  /// The split of the remesh's quads the fit is made for: kFixed for `geomip remesh`'s face list, kShorter for
+  /// packs (decoded along the shorter diagonals; chosen here from the unfitted samples and kept through the
+  /// fit — a decoder choosing from the fitted, decoded samples agrees on nearly every quad).
+  QuadSplit quad_split = QuadSplit::kFixed;
   /// Optional hole mask, as HoleMaskResult::quads (per patch, per quad j·2^level + i, 1 = masked); empty =
   /// none.
   std::vector<std::vector<std::uint8_t>> hole_quads;

@@ -99,6 +99,52 @@ UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches,
   return result;
 }
 
+void split_along_shorter_diagonals(UniformRemeshResult& remesh, int level,
+                                   const std::vector<const std::vector<Eigen::Vector3d>*>& models) {
+  if (models.empty()) throw InvalidInput("split_along_shorter_diagonals: no model positions");
+  for (const auto* positions : models) {
+    if (positions == nullptr || positions->size() != remesh.mesh.positions.size()) {
+      throw InvalidInput("split_along_shorter_diagonals: a model's positions do not match the remesh");
+    }
+  }
+  if (level < 0 || level > kMaxGeometryImageLevel) {
+    throw InvalidInput("split_along_shorter_diagonals: level " + std::to_string(level) + " is out of range");
+  }
+  const int intervals = 1 << level;
+  const int n = intervals + 1;
+  const std::size_t num_patches = remesh.grid_vertex.size();
+  if (remesh.mesh.triangles.size() != 2 * num_patches * static_cast<std::size_t>(intervals) * intervals) {
+    throw InvalidInput("split_along_shorter_diagonals: the remesh is not a level-" + std::to_string(level) +
+                       " grid triangulation");
+  }
+  std::size_t t = 0;
+  for (std::size_t p = 0; p < num_patches; ++p) {
+    const auto& g = remesh.grid_vertex[p];
+    for (int j = 0; j < intervals; ++j) {
+      for (int i = 0; i < intervals; ++i, t += 2) {
+        const bool corner = (i == 0 || i == intervals - 1) && (j == 0 || j == intervals - 1);
+        if (corner) continue;
+        const int a = g[j * n + i], b = g[j * n + i + 1], c = g[(j + 1) * n + i + 1], d = g[(j + 1) * n + i];
+        double ac_minus_bd = 0.0;
+        for (const auto* positions : models) {
+          const auto& x = *positions;
+          ac_minus_bd += (x[a] - x[c]).squaredNorm() - (x[b] - x[d]).squaredNorm();
+        }
+        bool along_ac = (i + j + static_cast<int>(p)) % 2 == 0;
+        if (ac_minus_bd < 0.0) along_ac = true;
+        if (ac_minus_bd > 0.0) along_ac = false;
+        if (along_ac) {
+          remesh.mesh.triangles[t] = {a, b, c};
+          remesh.mesh.triangles[t + 1] = {a, c, d};
+        } else {
+          remesh.mesh.triangles[t] = {a, b, d};
+          remesh.mesh.triangles[t + 1] = {b, c, d};
+        }
+      }
+    }
+  }
+}
+
 UniformRemeshResult uniform_remesh(const GeometryImages& images, int level) {
   if (images.geometry.empty()) throw InvalidInput("uniform_remesh: no geometry images");
   const int n = images.geometry[0].level;

@@ -38,6 +38,28 @@ struct UniformRemeshResult {
 UniformRemeshResult uniform_remesh_connectivity(std::size_t num_patches,
                                                 const std::vector<SideLink>& adjacency, int level);
 
+/// How each grid quad of a remesh is split into two triangles.
+enum class QuadSplit {
+  /// uniform_remesh_connectivity()'s rule: (i + j + p) even → a–c, else b–d. Depends on the layout alone.
+  kFixed,
+  /// Along the shorter 3D diagonal (Gu et al. 2002): the piecewise-linear surface then follows ridges and
+  /// valleys that cross the grid's diagonals instead of zig-zagging across them.
+  kShorter,
+};
+
+/// Re-splits the quads of `remesh` — uniform_remesh_connectivity() at `level`, triangles 2q and 2q + 1 of quad
+/// q = (p · 2^level + j) · 2^level + i, in that numbering — along their shorter diagonal. `models` holds the
+/// vertex positions of one or more models in remesh's vertex numbering (a consistent set: the squared
+/// diagonal lengths are summed over the models, so all of them keep one face list). A quad keeps the fixed
+/// rule when both diagonals are equally long, and always when it touches a patch corner: only corner quads of
+/// two patches can share three vertices, and check_quad_layout() accepts a layout for the fixed rule's corner
+/// splits, so the result is as manifold and as oriented as the fixed split. Below level 2 every quad touches a
+/// corner: nothing changes. Deterministic (no tolerance, one comparison of sums of squares per quad).
+/// \throw InvalidInput when `models` is empty or a model's size differs from remesh's vertex count, or the
+///   triangle count does not match `level`.
+void split_along_shorter_diagonals(UniformRemeshResult& remesh, int level,
+                                   const std::vector<const std::vector<Eigen::Vector3d>*>& models);
+
 /// Uniform remesh of `images` at `level` ≤ the images' level: the connectivity above with the positions of
 /// the nested level-`level` grid samples (every 2^(n−level)-th sample of the level-n images).
 /// \throw InvalidInput when there are no images, they differ in level, `level` is above it or negative, or

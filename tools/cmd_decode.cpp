@@ -27,6 +27,7 @@ struct DecodeArgs {
   long long bytes = -1;
   int level = -1;
   int draco = 0;  // glTF output: Draco position bits, 0 = no Draco
+  std::string quad_split = "shorter";
   bool json = false;
   bool quiet = false;
 };
@@ -120,12 +121,18 @@ int run_decode(const DecodeArgs& args) {
                         : (out.parent_path() / (out.stem().string() + "." + model.name + out.extension().string()))
                               .string());
   }
+  // Every model's grids choose the quad split together, so the models of a consistent pack keep one face
+  // list (as far as their hole masks agree).
+  std::vector<const codec::DecodedModel*> all_models;
+  for (const auto& model : decoded.models) all_models.push_back(&model);
+  const QuadSplitOptions split{.split = args.quad_split == "fixed" ? QuadSplit::kFixed : QuadSplit::kShorter,
+                               .chosen_by = all_models};
   nlohmann::json j_models = nlohmann::json::array();
   for (std::size_t m = 0; m < decoded.models.size(); ++m) {
     // glTF carries per-patch texture coordinates and the normal maps' normals (seams not welded); the
     // other formats get the welded mesh.
-    const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level) : TexturedMesh{};
-    const TriMesh mesh = gltf ? TriMesh{} : decoded_mesh(decoded.models[m], args.level);
+    const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level, split) : TexturedMesh{};
+    const TriMesh mesh = gltf ? TriMesh{} : decoded_mesh(decoded.models[m], args.level, split);
     const TriMesh& written = gltf ? textured.mesh : mesh;
     write_file_atomically(paths[m], [&](std::ostream& o) {
       if (gltf)
@@ -183,6 +190,11 @@ CommandRunner add_decode_command(CLI::App& app) {
   cmd->add_flag("--draco{14}", args->draco,
                 "glTF output compressed by Draco (KHR_draco_mesh_compression): positions quantized to BITS bits "
                 "(--draco=BITS, 1..30; default 14), normals 10, texture coordinates 12");
+  cmd->add_option("--quad-split", args->quad_split,
+                  "How grid quads become triangles: shorter (along the shorter diagonal; every model of the pack "
+                  "chooses together, so they share one face list) or fixed (the layout's rule, as geomip remesh)")
+      ->check(CLI::IsMember({"shorter", "fixed"}))
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No report");
   return [args] { return run_decode(*args); };

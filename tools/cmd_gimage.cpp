@@ -69,7 +69,9 @@ int run_gimage(const GimageArgs& args) {
     double fit_seconds = 0;
     if (args.fit) {
       t0 = std::chrono::steady_clock::now();
-      images = fit_geometry_images(result[i].mesh, images).images;
+      FitOptions fit;
+      fit.quad_split = QuadSplit::kShorter;  // as `geomip remesh` and `geomip decode` split the quads by default
+      images = fit_geometry_images(result[i].mesh, images, fit).images;
       fit_seconds = seconds_since(t0);
     }
     const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string();

@@ -66,11 +66,13 @@ int run_morph(const MorphArgs& args) {
 
   std::filesystem::create_directories(args.output);
   const auto schedule = wavelet ? morph::MorphSchedule::kWavelet : morph::MorphSchedule::kLinear;
+  // The morph's two ends choose the quad split together: every frame gets the same face list.
+  const std::vector<const codec::DecodedModel*> ends{&decoded.models[args.from], &decoded.models[args.to]};
   for (int k = 0; k < args.frames; ++k) {
     const float t = args.frames == 1 ? 0.0f : static_cast<float>(k) / static_cast<float>(args.frames - 1);
     const auto positions = morph::evaluate_morph(a, b, t, schedule);
     for (std::size_t p = 0; p < positions.size(); ++p) frame.geometry[p].values = positions[p];
-    const TriMesh mesh = decoded_mesh(frame, args.level);
+    const TriMesh mesh = decoded_mesh(frame, args.level, {.chosen_by = ends});
     char name[32];
     std::snprintf(name, sizeof name, "morph_%04d.obj", k);
     const std::string path = (std::filesystem::path(args.output) / name).string();

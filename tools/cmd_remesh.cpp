@@ -38,6 +38,7 @@ struct RemeshArgs {
   bool glb = false;
   int draco = 0;  ///< the GLB's Draco position bits, 0 = no Draco
   bool fit = false;  ///< least-squares fitted samples (gimage/fit.h) for the uniform remesh
+  std::string quad_split = "shorter";
 };
 
 int run_remesh(const RemeshArgs& args) {
@@ -74,6 +75,12 @@ int run_remesh(const RemeshArgs& args) {
   std::filesystem::create_directories(args.common.output);
 
   nlohmann::json summary = nlohmann::json::array();
+  // Uniform: every model's images and remesh first, so that the models of a set choose the quad split
+  // together (one face list), then the files.
+  const QuadSplit split = args.quad_split == "fixed" ? QuadSplit::kFixed : QuadSplit::kShorter;
+  std::vector<GeometryImages> uniform_images;
+  std::vector<UniformRemeshResult> remeshes;
+  std::vector<double> remesh_seconds_of, fit_seconds_of;
   for (std::size_t i = 0; i < result.size() && uniform; ++i) {
     t0 = std::chrono::steady_clock::now();
     ResampleOptions resample;
@@ -83,13 +90,28 @@ int run_remesh(const RemeshArgs& args) {
     double fit_seconds = 0;
     if (args.fit) {
       t0 = std::chrono::steady_clock::now();
-      images = fit_geometry_images(result[i].mesh, images).images;
+      FitOptions fit;
+      fit.quad_split = split;
+      images = fit_geometry_images(result[i].mesh, images, fit).images;
       fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     t0 = std::chrono::steady_clock::now();
-    const UniformRemeshResult remesh = uniform_remesh(images, args.level);
-    const double remesh_seconds =
-        resample_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    remeshes.push_back(uniform_remesh(images, args.level));
+    remesh_seconds_of.push_back(resample_seconds +
+                                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    fit_seconds_of.push_back(fit_seconds);
+    uniform_images.push_back(std::move(images));
+  }
+  std::vector<const std::vector<Eigen::Vector3d>*> split_by;
+  for (const auto& r : remeshes) split_by.push_back(&r.mesh.positions);
+  if (split == QuadSplit::kShorter)
+    for (auto& r : remeshes) split_along_shorter_diagonals(r, args.level, split_by);
+  std::vector<const GeometryImages*> images_of_set;
+  for (const auto& g : uniform_images) images_of_set.push_back(&g);
+  for (std::size_t i = 0; i < remeshes.size(); ++i) {
+    const UniformRemeshResult& remesh = remeshes[i];
+    const GeometryImages& images = uniform_images[i];
+    const double remesh_seconds = remesh_seconds_of[i], fit_seconds = fit_seconds_of[i];
     const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() +
                              ".M" + std::to_string(args.level);
     write_file_atomically(stem + ".obj",
@@ -99,7 +121,7 @@ int run_remesh(const RemeshArgs& args) {
                             [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kPly); });
     }
     if (args.glb) {
-      const TexturedMesh textured = textured_mesh(images);
+      const TexturedMesh textured = textured_mesh(images, split, images_of_set);
       write_file_atomically(stem + ".glb", [&](std::ostream& out) {
         write_gltf(textured.mesh, textured.attributes, out, {.binary = true, .draco_position_bits = args.draco});
       });
@@ -206,6 +228,12 @@ CommandRunner add_remesh_command(CLI::App& app) {
                 "Uniform remesh: move every sample along its normal so that the remesh is a least-squares fit of "
                 "the surface, not its interpolant (gimage/fit.h; same faces, seams welded); --no-fit: samples on "
                 "the surface (default)");
+  cmd->add_option("--quad-split", args->quad_split,
+                  "Uniform remesh: how grid quads become triangles: shorter (along the shorter diagonal, the "
+                  "models of a set choosing together: one face list) or fixed (a rule of the layout alone, the "
+                  "same for any shapes)")
+      ->check(CLI::IsMember({"shorter", "fixed"}))
+      ->capture_default_str();
   cmd->add_flag("--ply", args->ply, "Also write DIR/<stem>.M<K>.ply (binary)");
   cmd->add_flag("--glb", args->glb,
                 "Also write DIR/<stem>.M<K>.glb: glTF with each patch's (u,v) as TEXCOORD_0 and the normal "

@@ -80,6 +80,7 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
 GeometryImages fit_images(const GeometryImages& images, const TriMesh& surface, const HoleMaskResult& mask,
                           int mask_level) {
   FitOptions fit;
+  fit.quad_split = QuadSplit::kShorter;  // what `geomip decode` does with a pack
   if (!mask.quads.empty()) {
     const int level = images.geometry.front().level, shift = level - mask_level;
     const int n = 1 << level, coarse = 1 << mask_level;

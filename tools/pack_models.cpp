@@ -29,7 +29,29 @@ struct GridSample {
 
 /// decoded_mesh() with `weld` choosing whether seams are welded (the model's seams) or not (every patch its
 /// own vertices); `origin`, if given, receives each output vertex's first grid sample.
-TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld, std::vector<GridSample>* origin) {
+/// The level-`level` samples of `model`'s grids in `remesh`'s vertex numbering (seam samples written once per
+/// patch; the codec keeps them bit-identical).
+std::vector<Eigen::Vector3d> grid_positions(const UniformRemeshResult& remesh, const codec::DecodedModel& model,
+                                            int level) {
+  const int grid_level = model.geometry.front().level;
+  const int stride = 1 << (grid_level - level);
+  const int n = (1 << level) + 1;
+  const int grid_n = (1 << grid_level) + 1;
+  std::vector<Eigen::Vector3d> positions(remesh.mesh.positions.size(), Eigen::Vector3d::Zero());
+  for (std::size_t p = 0; p < model.geometry.size(); ++p) {
+    const codec::Grid3& grid = model.geometry[p];
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const float* v = grid.values.data() + 3 * (static_cast<std::size_t>(j * stride) * grid_n + i * stride);
+        positions[remesh.grid_vertex[p][static_cast<std::size_t>(j) * n + i]] = {v[0], v[1], v[2]};
+      }
+    }
+  }
+  return positions;
+}
+
+TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld, const QuadSplitOptions& split,
+                          std::vector<GridSample>* origin) {
   if (model.geometry.empty()) throw InvalidInput("decoded_mesh: the model has no patches");
   const int grid_level = model.geometry.front().level;
   if (level < 0) level = grid_level;
@@ -43,6 +65,20 @@ TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld
       adjacency.push_back({s.patch, s.side, s.other_patch, s.other_side, s.reversed});
   }
   UniformRemeshResult remesh = uniform_remesh_connectivity(model.geometry.size(), adjacency, level);
+  if (split.split == QuadSplit::kShorter) {
+    std::vector<std::vector<Eigen::Vector3d>> chosen_by;
+    if (split.chosen_by.empty()) chosen_by.push_back(grid_positions(remesh, model, level));
+    for (const codec::DecodedModel* other : split.chosen_by) {
+      if (other == nullptr || other->geometry.size() != model.geometry.size() ||
+          other->geometry.front().level != grid_level) {
+        throw InvalidInput("decoded_mesh: a model choosing the quad split has another layout or grid level");
+      }
+      chosen_by.push_back(grid_positions(remesh, *other, level));
+    }
+    std::vector<const std::vector<Eigen::Vector3d>*> views;
+    for (const auto& positions : chosen_by) views.push_back(&positions);
+    split_along_shorter_diagonals(remesh, level, views);
+  }
 
   const int stride = 1 << (grid_level - level);
   const int n = (1 << level) + 1;
@@ -106,14 +142,14 @@ TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld
 
 }  // namespace
 
-TriMesh decoded_mesh(const codec::DecodedModel& model, int level) {
-  return decoded_mesh_impl(model, level, /*weld=*/true, nullptr);
+TriMesh decoded_mesh(const codec::DecodedModel& model, int level, const QuadSplitOptions& split) {
+  return decoded_mesh_impl(model, level, /*weld=*/true, split, nullptr);
 }
 
-TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level) {
+TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level, const QuadSplitOptions& split) {
   std::vector<GridSample> origin;
   TexturedMesh result;
-  result.mesh = decoded_mesh_impl(model, level, /*weld=*/false, &origin);
+  result.mesh = decoded_mesh_impl(model, level, /*weld=*/false, split, &origin);
   const int grid_level = model.geometry.front().level;
   if (level < 0) level = grid_level;
   const double intervals = static_cast<double>(1 << level);
@@ -150,13 +186,26 @@ TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level) 
   return result;
 }
 
-TexturedMesh textured_mesh(const GeometryImages& images) {
-  const codec::PackModelInput input = pack_model_input("", images, nullptr, !images.normals.empty());
+namespace {
+
+codec::DecodedModel model_of(const GeometryImages& images, bool normals) {
+  const codec::PackModelInput input = pack_model_input("", images, nullptr, normals && !images.normals.empty());
   codec::DecodedModel model;
   model.geometry = input.geometry;
   model.normals = input.normals;
   model.seams = input.seams;
-  return decoded_textured_mesh(model);
+  return model;
+}
+
+}  // namespace
+
+TexturedMesh textured_mesh(const GeometryImages& images, QuadSplit split,
+                           const std::vector<const GeometryImages*>& chosen_by) {
+  std::vector<codec::DecodedModel> others;
+  for (const GeometryImages* g : chosen_by) others.push_back(model_of(*g, false));
+  std::vector<const codec::DecodedModel*> views;
+  for (const auto& m : others) views.push_back(&m);
+  return decoded_textured_mesh(model_of(images, true), -1, {.split = split, .chosen_by = views});
 }
 
 }  // namespace geomip::tools

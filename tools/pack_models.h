@@ -4,9 +4,11 @@
 #include "codec/pack.h"
 #include "gimage/hole_mask.h"
 #include "gimage/resample.h"
+#include "gimage/uniform_remesh.h"
 #include "mesh/gltf_io.h"
 #include "mesh/mesh.h"
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -17,12 +19,26 @@ namespace geomip::tools {
 codec::PackModelInput pack_model_input(const std::string& name, const GeometryImages& images,
                                        const HoleMaskResult* mask, bool normals);
 
+/// How decoded_mesh() splits the grid's quads into triangles.
+struct QuadSplitOptions {
+  /// kShorter (default): along the shorter diagonal (gimage/uniform_remesh.h split_along_shorter_diagonals;
+  /// measured 2026-12-03: +0.6…+0.85 dB at full decode and at 32 KB, +0.15 at 8.8 KB on bunny, horse and
+  /// armadillo, docs/measurements.md). kFixed: uniform_remesh_connectivity()'s rule, as `geomip remesh`.
+  QuadSplit split = QuadSplit::kShorter;
+  /// The models whose grids choose the diagonals, their squared lengths summed (empty: the model itself).
+  /// Give every model of a consistent pack (or a morph's two ends) so that all share one face list; each
+  /// needs the same patch count and grid level as the model.
+  std::span<const codec::DecodedModel* const> chosen_by = {};
+};
+
 /// The level-`level` mesh of a decoded model (level ≤ its grid level; -1 = the grid level): the nested grid
-/// triangulated as `geomip remesh` does (gimage/uniform_remesh.h: same face list for every model of a
-/// consistent pack), seams welded, quads over filled holes left out (a coarse quad is left out when all the
-/// grid quads it covers are masked) and unreferenced vertices dropped.
-/// \throw InvalidInput for a level outside [0, grid level] or a model without patches.
-TriMesh decoded_mesh(const codec::DecodedModel& model, int level = -1);
+/// triangulated (gimage/uniform_remesh.h; the quads split as `split` says), seams welded, quads over filled
+/// holes left out (a coarse quad is left out when all the grid quads it covers are masked) and unreferenced
+/// vertices dropped. Every triangle is oriented as with the fixed split, and the face list depends only on the
+/// layout, the level, the hole mask and (kShorter) the grids of `split.chosen_by`.
+/// \throw InvalidInput for a level outside [0, grid level], a model without patches, or a `chosen_by` model
+///   of another patch count or grid level.
+TriMesh decoded_mesh(const codec::DecodedModel& model, int level = -1, const QuadSplitOptions& split = {});
 
 /// A mesh with per-vertex attributes for texture-mapped formats (glTF).
 struct TexturedMesh {
@@ -36,10 +52,14 @@ struct TexturedMesh {
 /// vertex normals when the model has no normal maps; +z where a texel is still zero). Vertices on a seam
 /// appear once per patch with bit-identical positions (the codec keeps seam samples identical), so the
 /// surface does not crack.
-TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level = -1);
+TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level = -1,
+                                   const QuadSplitOptions& split = {});
 
 /// The same for geometry images that were not coded (`geomip remesh --glb`): decoded_textured_mesh() of the
-/// images as they are, at their own level; normals from their normal maps when they have them.
-TexturedMesh textured_mesh(const GeometryImages& images);
+/// images as they are, at their own level, the quads split as `split` says (kShorter: chosen by the images
+/// of `chosen_by` together, or by `images` alone when it is empty); normals from their normal maps when they
+/// have them.
+TexturedMesh textured_mesh(const GeometryImages& images, QuadSplit split = QuadSplit::kShorter,
+                           const std::vector<const GeometryImages*>& chosen_by = {});
 
 }  // namespace geomip::tools

@@ -591,26 +591,33 @@ TEST_F(CliGimage, ConsistentSetSharesTheFaceList) {
   EXPECT_TRUE(fs::exists(out + "/b.normals.exr"));
 }
 
-// remesh --fit (gimage/fit.h): the same face list as without it and for both models of the set, closed, genus 0,
-// and closer to each original (symmetric RMS; the ratios measured: docs/measurements.md, "Fitted geometry
-// images"). --fit without a uniform remesh exits 2 with one line.
+// remesh --fit (gimage/fit.h): one face list for both models of the set (with --quad-split fixed also the
+// same as without --fit), closed, genus 0, and closer to each original (symmetric RMS; the ratios measured:
+// docs/measurements.md, "Fitted geometry images"). --fit without a uniform remesh exits 2 with one line.
 TEST_F(CliGimage, FitKeepsTheConsistentFaceListAndGetsCloser) {
   const std::string corr = sphere_pair();
   const std::string out = dir_ + "/out";
-  for (const char* fit : {"--fit", "--no-fit"}) {
-    const Outcome r = geomip("remesh --quiet --points '" + corr + "' --level 4 " + fit + " -o '" + out + "/" +
-                             (fit + 2) + "'");
-    ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* split : {"shorter", "fixed"}) {
+    for (const char* fit : {"--fit", "--no-fit"}) {
+      const Outcome r = geomip("remesh --quiet --points '" + corr + "' --level 4 " + fit + " --quad-split " +
+                               split + " -o '" + out + "/" + split + (fit + 2) + "'");
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+    }
   }
-  std::vector<std::array<int, 3>> faces;
+  std::vector<std::array<int, 3>> faces, fixed_faces;
   for (const char* name : {"a", "b"}) {
     SCOPED_TRACE(name);
     const TriMesh original = read_mesh(dir_ + "/" + name + ".obj");
-    const TriMesh fitted = read_mesh(out + "/fit/" + name + ".M4.obj");
-    const TriMesh plain = read_mesh(out + "/no-fit/" + name + ".M4.obj");
-    if (faces.empty()) faces = plain.triangles;
-    EXPECT_EQ(fitted.triangles, faces);
-    EXPECT_EQ(plain.triangles, faces);
+    const TriMesh fitted = read_mesh(out + "/shorterfit/" + name + ".M4.obj");
+    const TriMesh plain = read_mesh(out + "/shorterno-fit/" + name + ".M4.obj");
+    const TriMesh fitted_fixed = read_mesh(out + "/fixedfit/" + name + ".M4.obj");
+    const TriMesh plain_fixed = read_mesh(out + "/fixedno-fit/" + name + ".M4.obj");
+    if (faces.empty()) faces = fitted.triangles;
+    if (fixed_faces.empty()) fixed_faces = plain_fixed.triangles;
+    EXPECT_EQ(fitted.triangles, faces);  // both models of the set
+    EXPECT_EQ(fitted_fixed.triangles, fixed_faces);
+    EXPECT_EQ(plain_fixed.triangles, fixed_faces);
+    EXPECT_EQ(plain.num_triangles(), fixed_faces.size());
     const TopologyReport t = analyze_topology(fitted);
     EXPECT_EQ(t.boundary_edges, 0u);
     EXPECT_TRUE(t.manifold);
@@ -1052,20 +1059,25 @@ TEST_F(CliPack, CodecSwitchesForAblations) {
                    "--tangential-shift");
 }
 
-// convert --fit: the whole pack decodes to the same faces as without it and closer to the mesh (symmetric RMS;
-// the ratio measured: docs/measurements.md, "Fitted geometry images"); --fit=x exits 2 with one line.
+// convert --fit: the whole pack decodes closer to the mesh (symmetric RMS; the ratio measured:
+// docs/measurements.md, "Fitted geometry images"), and with `decode --quad-split fixed` to the same faces as
+// without it (the default split follows the decoded samples); --fit=x exits 2 with one line.
 TEST_F(CliPack, FitDecodesCloserToTheMesh) {
   const TriMesh original = read_mesh(spot_);
-  std::vector<TriMesh> decoded;
+  std::vector<TriMesh> decoded, fixed;
   for (const char* fit : {"--fit", "--no-fit"}) {
-    const std::string pack = dir_ + "/fit.gip", obj = dir_ + "/fit.obj";
+    const std::string pack = dir_ + "/fit.gip", obj = dir_ + "/fit.obj", fixed_obj = dir_ + "/fit-fixed.obj";
     const Outcome c = geomip("convert -q '" + spot_ + "' --level 5 --no-normals " + fit + " -o '" + pack + "'");
     ASSERT_EQ(c.exit_code, 0) << c.err;
     const Outcome d = geomip("decode -q '" + pack + "' -o '" + obj + "'");
     ASSERT_EQ(d.exit_code, 0) << d.err;
     decoded.push_back(read_mesh(obj));
+    const Outcome f = geomip("decode -q '" + pack + "' --quad-split fixed -o '" + fixed_obj + "'");
+    ASSERT_EQ(f.exit_code, 0) << f.err;
+    fixed.push_back(read_mesh(fixed_obj));
   }
-  EXPECT_EQ(decoded[0].triangles, decoded[1].triangles);
+  EXPECT_EQ(fixed[0].triangles, fixed[1].triangles);
+  EXPECT_EQ(decoded[0].num_triangles(), fixed[0].num_triangles());
   const double ratio =
       measure_surface_distance(original, decoded[0]).rms / measure_surface_distance(original, decoded[1]).rms;
   RecordProperty("spot_rms_ratio", std::to_string(ratio));
@@ -1074,6 +1086,45 @@ TEST_F(CliPack, FitDecodesCloserToTheMesh) {
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
   EXPECT_FALSE(fs::exists(dir_ + "/bad.gip"));
+}
+
+// decode --quad-split: shorter (default) and fixed give the same vertices, watertight genus-0 meshes of the
+// same size with different diagonals, and the shorter split is closer to the mesh; the models of a consistent
+// pack share one face list; a bad value exits 2 with one line and nothing written.
+TEST_F(CliPack, QuadSplitShorterIsCloserAndSharedByTheSet) {
+  const TriMesh original = read_mesh(spot_);
+  const std::string pack = dir_ + "/spot.gip";
+  ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 5 --no-normals -o '" + pack + "'").exit_code, 0);
+  std::vector<TriMesh> meshes;
+  for (const char* split : {"shorter", "fixed"}) {
+    const std::string obj = dir_ + "/" + split + ".obj";
+    const Outcome d = geomip("decode -q '" + pack + "' --quad-split " + split + " -o '" + obj + "'");
+    ASSERT_EQ(d.exit_code, 0) << d.err;
+    meshes.push_back(read_mesh(obj));
+    const TopologyReport t = analyze_topology(meshes.back());
+    EXPECT_EQ(t.boundary_edges, 0u) << split;
+    EXPECT_TRUE(t.manifold) << split;
+    EXPECT_EQ(t.genus, 0) << split;
+  }
+  EXPECT_EQ(meshes[0].positions, meshes[1].positions);
+  EXPECT_EQ(meshes[0].num_triangles(), meshes[1].num_triangles());
+  EXPECT_NE(meshes[0].triangles, meshes[1].triangles);
+  const double ratio =
+      measure_surface_distance(original, meshes[0]).rms / measure_surface_distance(original, meshes[1]).rms;
+  RecordProperty("spot_rms_ratio", std::to_string(ratio));
+  EXPECT_LT(ratio, 1.0);
+
+  const std::string corr = sphere_pair(), set = dir_ + "/pair.gip";
+  ASSERT_EQ(geomip("convert -q --points '" + corr + "' --level 4 --no-normals -o '" + set + "'").exit_code, 0);
+  ASSERT_EQ(geomip("decode -q '" + set + "' -o '" + dir_ + "/pair.obj'").exit_code, 0);
+  const TriMesh a = read_mesh(dir_ + "/pair.a.obj"), b = read_mesh(dir_ + "/pair.b.obj");
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_NE(a.positions, b.positions);
+  ASSERT_EQ(geomip("decode -q '" + set + "' --quad-split fixed -o '" + dir_ + "/pair-fixed.obj'").exit_code, 0);
+  EXPECT_NE(read_mesh(dir_ + "/pair-fixed.a.obj").triangles, a.triangles);
+
+  expect_bad_input("decode -q '" + pack + "' --quad-split diagonal -o '" + dir_ + "/bad.obj'", "--quad-split");
+  EXPECT_FALSE(fs::exists(dir_ + "/bad.obj"));
 }
 
 // --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch

@@ -55,6 +55,26 @@ function checkAgainstNative(label, pack, bytes, m, positions, index) {
   const inRange = index.every((v) => v < positions.length / 3);
   check(index.length === quads * 6 && inRange,
         `${label}: ${index.length / 3} triangles = 2 × ${quads} quads outside the hole mask, indices in range`);
+  // Each quad's two triangles share its shorter diagonal (ties either way), and both keep the grid's orientation.
+  const d2 = (u, v) => {
+    let s = 0;
+    for (let k = 0; k < 3; ++k) s += (positions[3 * u + k] - positions[3 * v + k]) ** 2;
+    return s;
+  };
+  let longer = 0, badShape = 0;
+  for (let t = 0; t + 5 < index.length; t += 6) {
+    const [a, b, c] = index.slice(t, t + 3), [e, f, g] = index.slice(t + 3, t + 6);
+    // (a, b, c), (a, c, d): diagonal a–c, other b–d; (a, b, d), (b, c, d): diagonal b–d, other a–c.
+    if (a === e && c === f) {
+      if (d2(a, c) > d2(b, g)) ++longer;
+    } else if (b === e && c === g) {
+      if (d2(b, c) > d2(a, f)) ++longer;
+    } else {
+      ++badShape;
+    }
+  }
+  check(longer === 0 && badShape === 0,
+        `${label}: every quad split along its shorter diagonal (${longer} along the longer, ${badShape} not a quad)`);
 }
 
 for (const spec of specs) {

@@ -11,8 +11,9 @@
 // `userData.geomip` holds the same fields. Vertices: every grid sample of every patch of the model
 // ((2^level+1)² per patch, patch by patch, row-major: the geometry-image order of web/geomip.js's decode()),
 // positions in the model's units, normals from the pack's normal maps (nearest sample) or, without them,
-// three's computeVertexNormals(). Triangles: two per grid quad, quads of the hole mask left out; seams are
-// shared positions (bit-identical samples), so the surface has no cracks. Options: `model` (index in a
+// three's computeVertexNormals(). Triangles: two per grid quad, split along the quad's shorter diagonal (as
+// `geomip decode` does by default; ties along b–d), rebuilt with each level; quads of the hole mask left out;
+// seams are shared positions (bit-identical samples), so the surface has no cracks. Options: `model` (index in a
 // consistent pack, default 0), `minInterval` (ms between decodes while streaming, default 100).
 // The bytes are read by one streamed GET (fetch); parse(arrayBuffer) decodes bytes already in memory.
 import { BufferAttribute, BufferGeometry, Loader } from 'three';
@@ -92,17 +93,12 @@ function update(geometry, result, m, bytes, total, done) {
     position = new BufferAttribute(new Float32Array(count * 3), 3);
     geometry.setAttribute('position', position);
     geometry.setAttribute('normal', new BufferAttribute(new Float32Array(count * 3), 3));
-    geometry.userData.holeKey = null;
   }
   for (let p = 0; p < model.numPatches; ++p) position.array.set(model.geometry[p], p * per * 3);
   position.needsUpdate = true;
 
-  // triangles: rebuilt only when the hole mask changes (the coarse mask of the manifest, then the fine one)
-  const holeKey = `${model.holeMaskLevel}:${model.holeMask.map((h) => h.reduce((a, b) => a + b, 0)).join(',')}`;
-  if (geometry.userData.holeKey !== holeKey) {
-    geometry.setIndex(new BufferAttribute(gridIndex(model, size), 1));
-    geometry.userData.holeKey = holeKey;
-  }
+  // triangles: each quad along its shorter diagonal, so rebuilt with every level (the positions changed)
+  geometry.setIndex(new BufferAttribute(gridIndex(model, size), 1));
 
   const normal = geometry.getAttribute('normal');
   if (model.normals.length === model.numPatches) {
@@ -128,6 +124,12 @@ function update(geometry, result, m, bytes, total, done) {
 
 /// Two triangles per grid quad, patch by patch, leaving out the quads whose hole-mask cell is set (the
 /// quad's centre in the mask's grid, as the viewers do).
+// Squared distance between samples u and v of one patch's xyz grid.
+function dist2(x, u, v) {
+  const dx = x[3 * u] - x[3 * v], dy = x[3 * u + 1] - x[3 * v + 1], dz = x[3 * u + 2] - x[3 * v + 2];
+  return dx * dx + dy * dy + dz * dz;
+}
+
 function gridIndex(model, size) {
   const res = model.holeMaskLevel >= 0 ? 1 << model.holeMaskLevel : 0;
   const per = size * size;
@@ -140,8 +142,10 @@ function gridIndex(model, size) {
           const qj = Math.min(res - 1, Math.floor((j + 0.5) / (size - 1) * res));
           if (model.holeMask[p][qj * res + qi]) continue;
         }
-        const a = p * per + j * size + i;
-        out.push(a, a + 1, a + size, a + 1, a + size + 1, a + size);
+        const a = p * per + j * size + i, b = a + 1, c = a + size + 1, d = a + size;
+        const x = model.geometry[p], k = j * size + i;
+        if (dist2(x, k, k + size + 1) < dist2(x, k + 1, k + size)) out.push(a, b, c, a, c, d);
+        else out.push(a, b, d, b, c, d);
       }
   return new Uint32Array(out);
 }

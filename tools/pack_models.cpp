@@ -27,8 +27,6 @@ struct GridSample {
   int patch, i, j;
 };
 
-/// decoded_mesh() with `weld` choosing whether seams are welded (the model's seams) or not (every patch its
-/// own vertices); `origin`, if given, receives each output vertex's first grid sample.
 /// The level-`level` samples of `model`'s grids in `remesh`'s vertex numbering (seam samples written once per
 /// patch; the codec keeps them bit-identical).
 std::vector<Eigen::Vector3d> grid_positions(const UniformRemeshResult& remesh, const codec::DecodedModel& model,
@@ -50,6 +48,9 @@ std::vector<Eigen::Vector3d> grid_positions(const UniformRemeshResult& remesh, c
   return positions;
 }
 
+/// decoded_mesh() with `weld` choosing whether seams are welded (the model's seams) or not (every patch its
+/// own vertices; the quads split as in the welded mesh: each split depends only on the quad's corners);
+/// `origin`, if given, receives each output vertex's first grid sample.
 TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld, const QuadSplitOptions& split,
                           std::vector<GridSample>* origin) {
   if (model.geometry.empty()) throw InvalidInput("decoded_mesh: the model has no patches");

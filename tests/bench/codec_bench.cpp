@@ -20,6 +20,9 @@
 // thread:
 //   codec_bench --decode-once FILE.gip full|increments|shown
 // (full: decode_pack; increments: 64 PackDecoder updates, models at the end; shown: models after each).
+// Draco's side of the same count: the mesh encoded as in --stream (14 bits, level 10), then decoded once by
+// geomip::draco_decode (bitstream → geomip mesh); count only that call:
+//   valgrind --tool=callgrind --toggle-collect='geomip::draco_decode*' codec_bench --draco-decode-once MESH.obj
 //
 // Rate–distortion report instead of benchmarks:
 //   codec_bench --rd FILE.geometry.exr|synthetic [--filter linear|cubic|both] [--steps N] [--bits B] [--mesh
@@ -370,6 +373,18 @@ int decode_once(const std::string& path, const std::string& mode) {
   return 0;
 }
 
+/// --draco-decode-once MESH: see the file comment.
+int draco_decode_once(const char* mesh_path) {
+  const geomip::TriMesh mesh = geomip::read_mesh(mesh_path);
+  const geomip::DracoResult draco =
+      geomip::draco_encode(mesh, {.quantization_bits = 14, .compression_level = 10, .decode_runs = 1});
+  geomip::TriMesh decoded;
+  if (!geomip::draco_decode(draco.bytes.data(), draco.bytes.size(), decoded)) return 2;
+  std::printf("%s: %zu Draco bytes decoded to %zu vertices\n", mesh_path, draco.bytes.size(),
+              decoded.positions.size());
+  return 0;
+}
+
 }  // namespace
 
 int normals_report(int argc, char** argv);          // normals_report.cpp
@@ -379,6 +394,7 @@ int main(int argc, char** argv) {
   if (argc >= 3 && std::strcmp(argv[1], "--normals") == 0) return normals_report(argc, argv);
   if (argc == 3 && std::strcmp(argv[1], "--normals-shading") == 0) return normals_shading_report(argc, argv);
   if (argc == 4 && std::strcmp(argv[1], "--decode-once") == 0) return decode_once(argv[2], argv[3]);
+  if (argc == 3 && std::strcmp(argv[1], "--draco-decode-once") == 0) return draco_decode_once(argv[2]);
   if (argc == 3 && std::strcmp(argv[1], "--pack") == 0) return pack_report(argv[2]);
   if ((argc == 3 || argc == 4) && std::strcmp(argv[1], "--stream") == 0)
     return stream_report(argv[2], argc == 4 ? argv[3] : nullptr);

@@ -3,6 +3,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -11,7 +12,6 @@ namespace geomip::viewer {
 namespace {
 
 constexpr int kMaxBands = 8;
-constexpr std::uint32_t kRestart = 0xFFFFFFFFu;
 
 const char* kVertexShader = R"(#version 330 core
 uniform sampler2DArray geom_a;
@@ -118,7 +118,48 @@ struct ModelGpu {
   int level = 0, num_patches = 0, bands = 1, normal_size = 0, hole_level = 0;
   bool has_normals = false, has_holes = false;
   GLuint geometry = 0, normals = 0, holes = 0;
+  std::vector<float> full;  ///< the model as drawn unmorphed (its bands summed): [patch · size² + j·size + i] · 3
 };
+
+/// Triangles of `model`'s level-`level` grids (grid-local vertex ids j·s + i, s = 2^level + 1; patch p's
+/// 6·4^level indices from p · 6·4^level): each quad split along its shorter diagonal, as `geomip decode` splits
+/// them (gimage/uniform_remesh.h split_along_shorter_diagonals: the four corner quads of a patch and ties
+/// along a–c when i + j + p is even, b–d otherwise).
+std::vector<std::uint32_t> grid_triangles(const ModelGpu& model, int level) {
+  const int intervals = 1 << level;
+  const std::uint32_t s = static_cast<std::uint32_t>(intervals) + 1;
+  const int size = (1 << model.level) + 1, stride = 1 << (model.level - level);
+  std::vector<std::uint32_t> idx;
+  idx.reserve(static_cast<std::size_t>(model.num_patches) * 6 * intervals * intervals);
+  for (int p = 0; p < model.num_patches; ++p) {
+    const float* x = model.full.data() + static_cast<std::size_t>(p) * size * size * 3;
+    auto d2 = [&](int i0, int j0, int i1, int j1) {  // squared distance of two level-`level` samples
+      const float* u = x + (static_cast<std::size_t>(j0 * stride) * size + static_cast<std::size_t>(i0 * stride)) * 3;
+      const float* v = x + (static_cast<std::size_t>(j1 * stride) * size + static_cast<std::size_t>(i1 * stride)) * 3;
+      double sum = 0;
+      for (int k = 0; k < 3; ++k) sum += (static_cast<double>(u[k]) - v[k]) * (static_cast<double>(u[k]) - v[k]);
+      return sum;
+    };
+    for (int j = 0; j < intervals; ++j) {
+      for (int i = 0; i < intervals; ++i) {
+        const std::uint32_t a = static_cast<std::uint32_t>(j) * s + static_cast<std::uint32_t>(i), b = a + 1,
+                            c = a + s + 1, d = a + s;
+        bool along_ac = (i + j + p) % 2 == 0;
+        const bool corner = (i == 0 || i == intervals - 1) && (j == 0 || j == intervals - 1);
+        if (!corner) {
+          const double ac_minus_bd = d2(i, j, i + 1, j + 1) - d2(i + 1, j, i, j + 1);
+          if (ac_minus_bd < 0) along_ac = true;
+          if (ac_minus_bd > 0) along_ac = false;
+        }
+        if (along_ac)
+          idx.insert(idx.end(), {a, b, c, a, c, d});
+        else
+          idx.insert(idx.end(), {a, b, d, b, c, d});
+      }
+    }
+  }
+  return idx;
+}
 
 GLuint make_array(GLenum internal, GLenum format, GLenum type, int w, int layers, const void* data, GLenum filter) {
   GLuint tex = 0;
@@ -138,13 +179,20 @@ GLuint make_array(GLenum internal, GLenum format, GLenum type, int w, int layers
 struct Renderer::Impl {
   GLuint program = 0, vao = 0;
   std::vector<ModelGpu> models;
-  std::map<int, std::pair<GLuint, GLsizei>> grids;  // level → (index buffer, index count)
+  /// (model, level) → (index buffer of every patch's triangles, indices per patch); rebuilt after
+  /// set_models(), since the split follows the positions.
+  std::map<std::pair<int, int>, std::pair<GLuint, GLsizei>> grids;
   std::map<std::string, GLint> uniforms;
 
   GLint uniform(const char* name) {
     auto it = uniforms.find(name);
     if (it != uniforms.end()) return it->second;
     return uniforms[name] = glGetUniformLocation(program, name);
+  }
+
+  void free_grids() {
+    for (auto& [key, g] : grids) glDeleteBuffers(1, &g.first);
+    grids.clear();
   }
 
   void free_models() {
@@ -154,25 +202,21 @@ struct Renderer::Impl {
       if (m.holes) glDeleteTextures(1, &m.holes);
     }
     models.clear();
+    free_grids();
   }
 
-  std::pair<GLuint, GLsizei> grid(int level) {
-    auto it = grids.find(level);
+  /// The triangles of model `m` at `level` (grid_triangles()).
+  std::pair<GLuint, GLsizei> grid(int m, int level) {
+    const std::pair<int, int> key{m, level};
+    auto it = grids.find(key);
     if (it != grids.end()) return it->second;
-    // One triangle strip per row of quads, rows separated by the primitive-restart index.
-    const std::uint32_t s = (1u << level) + 1;
-    std::vector<std::uint32_t> idx;
-    idx.reserve(static_cast<std::size_t>(2 * s + 1) * (s - 1));
-    for (std::uint32_t j = 0; j + 1 < s; ++j) {
-      for (std::uint32_t i = 0; i < s; ++i) idx.insert(idx.end(), {j * s + i, (j + 1) * s + i});
-      idx.push_back(kRestart);
-    }
+    const std::vector<std::uint32_t> idx = grid_triangles(models[m], level);
     GLuint buf = 0;
     glGenBuffers(1, &buf);
     glBindVertexArray(vao);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buf);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * 4), idx.data(), GL_STATIC_DRAW);
-    return grids[level] = {buf, static_cast<GLsizei>(idx.size())};
+    return grids[key] = {buf, static_cast<GLsizei>(idx.size() / static_cast<std::size_t>(models[m].num_patches))};
   }
 };
 
@@ -197,7 +241,6 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
 
 Renderer::~Renderer() {
   impl_->free_models();
-  for (auto& [level, g] : impl_->grids) glDeleteBuffers(1, &g.first);
   glDeleteVertexArrays(1, &impl_->vao);
   glDeleteProgram(impl_->program);
 }
@@ -218,6 +261,12 @@ void Renderer::set_models(const std::vector<morph::SceneModel>& models) {
     g.bands = m.bands;
     g.geometry = make_array(GL_RGB32F, GL_RGB, GL_FLOAT, m.size(), m.num_patches * m.bands, m.positions.data(),
                             GL_NEAREST);
+    const std::size_t per = static_cast<std::size_t>(m.size()) * m.size() * 3;
+    g.full.assign(static_cast<std::size_t>(m.num_patches) * per, 0.0f);
+    for (int p = 0; p < m.num_patches; ++p)
+      for (int b = 0; b < m.bands; ++b)
+        for (std::size_t k = 0; k < per; ++k)
+          g.full[p * per + k] += m.positions[(static_cast<std::size_t>(p) * m.bands + b) * per + k];
     if (m.normal_level >= 0) {
       g.has_normals = true;
       g.normal_size = (1 << m.normal_level) + 1;
@@ -245,12 +294,12 @@ void Renderer::draw(const RenderSettings& s) {
   const ModelGpu& b = morph ? im.models[s.target] : a;
   const float t = morph ? s.t : 0.0f;
   const int level = s.level < 0 ? a.level : std::clamp(s.level, 0, a.level);
-  const auto [index_buffer, index_count] = im.grid(level);
+  // A morph is drawn with the split of the end it is nearer (so each end looks exactly as that model alone;
+  // the diagonals change once, at t = 0.5). `geomip morph` instead keeps one face list for all its frames.
+  const auto [index_buffer, index_count] = im.grid(morph && t >= 0.5f ? s.target : s.source, level);
 
   glEnable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
-  glEnable(GL_PRIMITIVE_RESTART);
-  glPrimitiveRestartIndex(kRestart);
   glPolygonMode(GL_FRONT_AND_BACK, s.wireframe ? GL_LINE : GL_FILL);
   glUseProgram(im.program);
   glBindVertexArray(im.vao);
@@ -296,7 +345,8 @@ void Renderer::draw(const RenderSettings& s) {
     glUniform1i(im.uniform("patch_index"), p);
     glUniform1i(im.uniform("layer_a"), p * a.bands);
     glUniform1i(im.uniform("layer_b"), p * b.bands);
-    glDrawElements(GL_TRIANGLE_STRIP, index_count, GL_UNSIGNED_INT, nullptr);
+    glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p) * index_count * sizeof(std::uint32_t)));
   }
   glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   glBindVertexArray(0);

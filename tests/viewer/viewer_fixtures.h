@@ -183,13 +183,36 @@ inline std::vector<std::uint8_t> cpu_coverage(const morph::SceneModel& model, in
           if (w0 >= 0 && w1 >= 0 && w2 >= 0) mask[static_cast<std::size_t>(y) * width + x] = 1;
         }
     };
+    // Squared 3D distance between grid samples (i0, j0) and (i1, j1), as the renderer computes it.
+    auto d2 = [&](int i0, int j0, int i1, int j1) {
+      double sum = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double e = static_cast<double>(pos(i0, j0, k)) - pos(i1, j1, k);
+        sum += e * e;
+      }
+      return sum;
+    };
     for (int j = 0; j + 1 < s; ++j)
       for (int i = 0; i + 1 < s; ++i) {
         if (hole(i, j)) continue;
         const auto &a = screen[j * s + i], &b = screen[j * s + i + 1], &c = screen[(j + 1) * s + i],
                    &d = screen[(j + 1) * s + i + 1];
-        raster(a, c, b);  // the renderer's strips split quads along b–c
-        raster(c, d, b);
+        // The renderer's split (and `geomip decode`'s): along the shorter diagonal; the four corner quads of a
+        // patch and ties along a–d when i + j + p is even, b–c otherwise.
+        bool along_ad = (i + j + p) % 2 == 0;
+        const bool corner = (i == 0 || i == s - 2) && (j == 0 || j == s - 2);
+        if (!corner) {
+          const double ad = d2(i, j, i + 1, j + 1), bc = d2(i + 1, j, i, j + 1);
+          if (ad < bc) along_ad = true;
+          if (ad > bc) along_ad = false;
+        }
+        if (along_ad) {
+          raster(a, b, d);
+          raster(a, d, c);
+        } else {
+          raster(a, c, b);
+          raster(c, d, b);
+        }
       }
   }
   return mask;

@@ -12,7 +12,8 @@
 // ((2^level+1)² per patch, patch by patch, row-major: the geometry-image order of web/geomip.js's decode()),
 // positions in the model's units, normals from the pack's normal maps (nearest sample) or, without them,
 // three's computeVertexNormals(). Triangles: two per grid quad, split along the quad's shorter diagonal (as
-// `geomip decode` does by default; ties along b–d), rebuilt with each level; quads of the hole mask left out;
+// `geomip decode` does by default, except that decode keeps the layout's rule at the four corner quads of a
+// patch, where it welds patches; ties along b–d), rebuilt with each level; quads of the hole mask left out;
 // seams are shared positions (bit-identical samples), so the surface has no cracks. Options: `model` (index in a
 // consistent pack, default 0), `minInterval` (ms between decodes while streaming, default 100).
 // The bytes are read by one streamed GET (fetch); parse(arrayBuffer) decodes bytes already in memory.

@@ -1,13 +1,13 @@
 // WebGL2 renderer of geomip scene models — the desktop viewer's (stream_viewer/renderer.cpp) in the browser:
-// each patch is one index buffer of triangle strips over the (2^k+1)² grid whose vertex shader fetches the
-// positions from a float texture array (vertex texture fetch, no vertex attributes), so a refinement is a
-// texture upload, not a new mesh; normal-map shading (the pack's normal maps, linearly filtered), hole
+// each patch is drawn from one index buffer of triangles over the (2^k+1)² grid (each quad split along its
+// shorter diagonal, rebuilt with each refinement) whose vertex shader fetches the positions from a float
+// texture array (vertex texture fetch, no vertex attributes), so a refinement is a texture upload and an index
+// buffer, not a new mesh; normal-map shading (the pack's normal maps, linearly filtered), hole
 // discard (the hole mask, one texel per quad), seams that never crack (the codec's seam samples are
 // bit-identical in the glued patches and every patch is drawn at the same level), morphs between two models
 // of the same layout with per-band weights (linear, or the wavelet schedule of morph/scene_model.h).
 
 const kMaxBands = 8;
-const kRestart = 0xffffffff;
 export const kBackground = [26, 26, 31];
 
 const kVertexShader = `#version 300 es
@@ -183,7 +183,6 @@ export class Renderer {
   constructor(gl) {
     this.gl = gl;
     this.models = [];
-    this.grids = new Map();
     const compile = (type, src) => {
       const s = gl.createShader(type);
       gl.shaderSource(s, src);
@@ -206,22 +205,43 @@ export class Renderer {
     return this.uniforms.get(name);
   }
 
-  grid(level) {
-    if (this.grids.has(level)) return this.grids.get(level);
-    const gl = this.gl, s = (1 << level) + 1;
-    const idx = new Uint32Array((2 * s + 1) * (s - 1));
+  /// Model `m`'s triangles (grid-local vertex ids j·s + i, patch p's 6·4^level indices from p · 6·4^level):
+  /// each quad split along its shorter diagonal as `geomip decode` and `geomip-view` split it (the four corner
+  /// quads of a patch and ties along a–c when i + j + p is even, b–d otherwise), the bands summed.
+  indexBuffer(m) {
+    const gl = this.gl, n = 1 << m.level, s = n + 1, per = s * s * 3;
+    const idx = new Uint32Array(m.numPatches * n * n * 6);
+    const x = new Float32Array(per);
     let k = 0;
-    for (let j = 0; j + 1 < s; ++j) {
-      for (let i = 0; i < s; ++i) { idx[k++] = j * s + i; idx[k++] = (j + 1) * s + i; }
-      idx[k++] = kRestart;  // WebGL2: primitive restart is always on, at the type's largest index
+    for (let p = 0; p < m.numPatches; ++p) {
+      x.fill(0);
+      for (let b = 0; b < m.bands; ++b) {
+        const base = (p * m.bands + b) * per;
+        for (let q = 0; q < per; ++q) x[q] += m.positions[base + q];
+      }
+      const d2 = (u, v) => {
+        const dx = x[3 * u] - x[3 * v], dy = x[3 * u + 1] - x[3 * v + 1], dz = x[3 * u + 2] - x[3 * v + 2];
+        return dx * dx + dy * dy + dz * dz;
+      };
+      for (let j = 0; j < n; ++j)
+        for (let i = 0; i < n; ++i) {
+          const a = j * s + i, b = a + 1, c = a + s + 1, d = a + s;
+          let ac = (i + j + p) % 2 === 0;
+          if (!((i === 0 || i === n - 1) && (j === 0 || j === n - 1))) {
+            const diff = d2(a, c) - d2(b, d);
+            if (diff < 0) ac = true;
+            if (diff > 0) ac = false;
+          }
+          if (ac) { idx[k++] = a; idx[k++] = b; idx[k++] = c; idx[k++] = a; idx[k++] = c; idx[k++] = d; }
+          else { idx[k++] = a; idx[k++] = b; idx[k++] = d; idx[k++] = b; idx[k++] = c; idx[k++] = d; }
+        }
     }
     gl.bindVertexArray(this.vao);
     const buffer = gl.createBuffer();
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, buffer);
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, idx, gl.STATIC_DRAW);
-    const g = { buffer, count: idx.length };
-    this.grids.set(level, g);
-    return g;
+    gl.bindVertexArray(null);
+    return { buffer, count: 6 * n * n };
   }
 
   texture(internal, format, type, size, layers, data, filter) {
@@ -239,12 +259,16 @@ export class Renderer {
   /// Replaces the models by `scene` (GeomipDecoder.scene().models): one texture upload per model.
   setModels(scene) {
     const gl = this.gl;
-    for (const m of this.models) for (const t of [m.geometry, m.normals, m.holes]) if (t) gl.deleteTexture(t);
+    for (const m of this.models) {
+      for (const t of [m.geometry, m.normals, m.holes]) if (t) gl.deleteTexture(t);
+      gl.deleteBuffer(m.index.buffer);
+    }
     this.models = scene.map((m) => {
       const size = (1 << m.level) + 1;
       const g = { level: m.level, numPatches: m.numPatches, bands: m.bands, normals: null, holes: null };
       g.geometry = this.texture(gl.RGB32F, gl.RGB, gl.FLOAT, size, m.numPatches * m.bands, m.positions,
                                 gl.NEAREST);
+      g.index = this.indexBuffer(m);
       if (m.normalLevel >= 0) {  // RGB16F: filterable in WebGL2 without extensions
         g.normalSize = (1 << m.normalLevel) + 1;
         g.normals = this.texture(gl.RGB16F, gl.RGB, gl.FLOAT, g.normalSize, m.numPatches, m.normals, gl.LINEAR);
@@ -273,7 +297,8 @@ export class Renderer {
     const w = bandWeights(morph ? t : 0, a.bands, schedule);
     if (!morph) w.target.fill(0);
     while (w.source.length < kMaxBands) { w.source.push(0); w.target.push(0); }
-    const { buffer, count } = this.grid(a.level);
+    // A morph is drawn with the split of the end it is nearer, so each end looks exactly as that model alone.
+    const { buffer, count } = (morph && t >= 0.5 ? b : a).index;
     gl.enable(gl.DEPTH_TEST);
     gl.disable(gl.CULL_FACE);
     gl.useProgram(this.program);
@@ -301,7 +326,7 @@ export class Renderer {
       gl.uniform1i(this.uniform('patch_index'), p);
       gl.uniform1i(this.uniform('layer_a'), p * a.bands);
       gl.uniform1i(this.uniform('layer_b'), p * b.bands);
-      gl.drawElements(gl.TRIANGLE_STRIP, count, gl.UNSIGNED_INT, 0);
+      gl.drawElements(gl.TRIANGLES, count, gl.UNSIGNED_INT, p * count * 4);
     }
     gl.bindVertexArray(null);
   }

@@ -209,8 +209,16 @@ async function silhouette(packPath, w, h, camera) {
         }
         const v00 = project(p, j * size + i), v10 = project(p, j * size + i + 1);
         const v01 = project(p, (j + 1) * size + i), v11 = project(p, (j + 1) * size + i + 1);
-        tri(v00, v10, v01);
-        tri(v10, v11, v01);
+        // The page's split (and geomip decode's): the shorter diagonal; corner quads and ties by i + j + p.
+        const at = (k) => [0, 1, 2].map((c) => m.positions[(p * size * size + k) * 3 + c]);
+        const d2 = (u, v) => { const a = at(u), b = at(v); return (a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2; };
+        let ac = (i + j + p) % 2 === 0;
+        if (!((i === 0 || i === size - 2) && (j === 0 || j === size - 2))) {
+          const diff = d2(j * size + i, (j + 1) * size + i + 1) - d2(j * size + i + 1, (j + 1) * size + i);
+          if (diff < 0) ac = true;
+          if (diff > 0) ac = false;
+        }
+        if (ac) { tri(v00, v10, v11); tri(v00, v11, v01); } else { tri(v00, v10, v01); tri(v10, v11, v01); }
       }
   decoder.dispose();
   return mask;

@@ -121,14 +121,18 @@ int run_decode(const DecodeArgs& args) {
                         : (out.parent_path() / (out.stem().string() + "." + model.name + out.extension().string()))
                               .string());
   }
-  // Every model's grids choose the quad split together, so the models of a consistent pack keep one face
-  // list (as far as their hole masks agree).
-  std::vector<const codec::DecodedModel*> all_models;
-  for (const auto& model : decoded.models) all_models.push_back(&model);
-  const QuadSplitOptions split{.split = args.quad_split == "fixed" ? QuadSplit::kFixed : QuadSplit::kShorter,
-                               .chosen_by = all_models};
+  const QuadSplit quad_split = args.quad_split == "fixed" ? QuadSplit::kFixed : QuadSplit::kShorter;
   nlohmann::json j_models = nlohmann::json::array();
   for (std::size_t m = 0; m < decoded.models.size(); ++m) {
+    // The models of the same layout (a consistent pack: all of them) choose the quad split together, so they
+    // keep one face list (as far as their hole masks agree).
+    std::vector<const codec::DecodedModel*> same_layout;
+    for (const auto& other : decoded.models) {
+      if (other.geometry.size() == decoded.models[m].geometry.size() &&
+          other.geometry.front().level == decoded.models[m].geometry.front().level)
+        same_layout.push_back(&other);
+    }
+    const QuadSplitOptions split{.split = quad_split, .chosen_by = same_layout};
     // glTF carries per-patch texture coordinates and the normal maps' normals (seams not welded); the
     // other formats get the welded mesh.
     const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level, split) : TexturedMesh{};

@@ -66,32 +66,34 @@ TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld
       adjacency.push_back({s.patch, s.side, s.other_patch, s.other_side, s.reversed});
   }
   UniformRemeshResult remesh = uniform_remesh_connectivity(model.geometry.size(), adjacency, level);
+  remesh.mesh.positions = grid_positions(remesh, model, level);
   if (split.split == QuadSplit::kShorter) {
-    std::vector<std::vector<Eigen::Vector3d>> chosen_by;
-    if (split.chosen_by.empty()) chosen_by.push_back(grid_positions(remesh, model, level));
+    // The model's own positions are used as they are; the other choosing models' are gathered.
+    std::vector<std::vector<Eigen::Vector3d>> others;
+    std::vector<const std::vector<Eigen::Vector3d>*> views;
+    if (split.chosen_by.empty()) views.push_back(&remesh.mesh.positions);
+    others.reserve(split.chosen_by.size());
     for (const codec::DecodedModel* other : split.chosen_by) {
       if (other == nullptr || other->geometry.size() != model.geometry.size() ||
           other->geometry.front().level != grid_level) {
         throw InvalidInput("decoded_mesh: a model choosing the quad split has another layout or grid level");
       }
-      chosen_by.push_back(grid_positions(remesh, *other, level));
+      if (other == &model) {
+        views.push_back(&remesh.mesh.positions);
+      } else {
+        others.push_back(grid_positions(remesh, *other, level));
+        views.push_back(&others.back());
+      }
     }
-    std::vector<const std::vector<Eigen::Vector3d>*> views;
-    for (const auto& positions : chosen_by) views.push_back(&positions);
     split_along_shorter_diagonals(remesh, level, views);
   }
 
-  const int stride = 1 << (grid_level - level);
   const int n = (1 << level) + 1;
-  const int grid_n = (1 << grid_level) + 1;
-  std::vector<GridSample> first(remesh.mesh.positions.size(), GridSample{-1, 0, 0});
-  for (std::size_t p = 0; p < model.geometry.size(); ++p) {
-    const codec::Grid3& grid = model.geometry[p];
+  std::vector<GridSample> first(origin ? remesh.mesh.positions.size() : 0, GridSample{-1, 0, 0});
+  for (std::size_t p = 0; origin && p < model.geometry.size(); ++p) {
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
-        const float* v = grid.values.data() + 3 * (static_cast<std::size_t>(j * stride) * grid_n + i * stride);
         const int id = remesh.grid_vertex[p][static_cast<std::size_t>(j) * n + i];
-        remesh.mesh.positions[id] = {v[0], v[1], v[2]};
         if (first[id].patch < 0) first[id] = {static_cast<int>(p), i, j};
       }
     }

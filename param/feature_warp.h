@@ -70,6 +70,15 @@ struct FeatureWarpOptions {
   /// as soon as it has left as many features unreached as the best one so far; the pass with the fewest
   /// unreached features is kept. 0: one pass in the given order, with steps aside. Negative: InvalidInput.
   int reorder_passes = 3;
+  /// After the passes, the features they left short (and no proof rules out) walk on from the best pass's
+  /// embedding with a barrier relaxation: projected Newton steps on the symmetric Dirichlet energy of the map
+  /// from the input embedding (infinite at a flat triangle, so the fans the warp squeezed open up again and
+  /// nothing flips) over the free vertices within 24 rings, the feature drawn to its target by a quadratic
+  /// term of growing weight and placed exactly on it once its star is positive there. If some are still
+  /// short, every feature walks that way from the input embedding instead (the short ones first), and that
+  /// result is kept when fewer features end short. The embedding is then no longer the warp's PL map of the
+  /// input, only fold-free with the same boundary. false: the passes' result as it is.
+  bool relax_unreached = true;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after
   /// the Delaunay flips that follow a move, in every pass (`reorder_passes`; a later pass lists the features in
@@ -107,6 +116,9 @@ struct FeatureWarpResult {
   /// result is the best pass's; `events`, `repaired_vertices`, `steps`, `detours` and
   /// `min_warp_triangle_area` are over all passes.
   int passes = 0;
+  /// Features the passes left short that the barrier relaxation (`FeatureWarpOptions::relax_unreached`)
+  /// brought to their targets.
+  std::size_t relaxed = 0;
   /// Base triangles with signed area <= 0 after the warp, checked with exact predicates: always 0 unless
   /// `keep_base_mesh_valid` is false.
   std::size_t flipped_triangles = 0;
@@ -130,8 +142,10 @@ struct FeatureWarpResult {
 /// incident to a moving feature move only when repaired (they are then within a few rings of a moving one).
 /// A pass that leaves targets unreached is followed by passes in other orders from the input uv
 /// (`FeatureWarpOptions::reorder_passes`); `uv` and the result are those of the pass with the fewest unreached
-/// features. A target may still be left unreached (reported in `unreached`, never folded); how often that
-/// happens for near and far targets is in docs/measurements.md.
+/// features, and the features it left short then walk on with a barrier relaxation
+/// (`FeatureWarpOptions::relax_unreached`; boundary vertices stay bit-identical, nothing flips). A target may
+/// still be left unreached (reported in `unreached`, never folded); how often that happens for near and far
+/// targets is in docs/measurements.md.
 ///
 /// \param triangles  #F base-mesh triangles, 0-based indices into `uv`, counter-clockwise (positive area).
 /// \param uv         #V positions in [0,1]²: corners at the square's corners, boundary vertices with a

@@ -194,6 +194,7 @@ RandomCase random_case(int n, std::mt19937& rng, double reach) {
 struct TrialFigures {
   std::size_t features = 0, unreached = 0, events = 0, repaired = 0, max_events = 0, max_repaired = 0;
   std::size_t reordered = 0, rescued = 0;  // warps that needed more than one pass; of those, reaching every target
+  std::size_t relaxed = 0;  // features the barrier relaxation brought in after the passes
   std::map<std::string, std::size_t> reasons;  // why features stopped short: the reason up to its position
   double seconds = 0;
 };
@@ -229,6 +230,7 @@ TrialFigures run_random_trials(int trials, double reach, unsigned seed) {
     }
     fig.features += c.features.size();
     fig.unreached += r.unreached.size();
+    fig.relaxed += r.relaxed;
     fig.events += r.events;
     fig.repaired += r.repaired_vertices;
     fig.max_events = std::max(fig.max_events, r.events);
@@ -237,7 +239,8 @@ TrialFigures run_random_trials(int trials, double reach, unsigned seed) {
   std::cout << "[ figures  ] " << trials << " trials, 20x20 grid, 3-6 features, reach " << reach << ": unreached "
             << fig.unreached << "/" << fig.features << ", events " << fig.events << " (max " << fig.max_events
             << "), repaired vertices " << fig.repaired << " (max " << fig.max_repaired << "), warps in more than one pass "
-            << fig.reordered << " (all targets reached in " << fig.rescued << "), " << 1e3 * fig.seconds / trials
+            << fig.reordered << " (all targets reached in " << fig.rescued << "), brought in by the relaxation "
+            << fig.relaxed << ", " << 1e3 * fig.seconds / trials
             << " ms per warp\n";
   for (const auto& [why, count] : fig.reasons) std::cout << "[ figures  ]   " << count << " x " << why << "\n";
   return fig;
@@ -255,13 +258,15 @@ TEST(WarpFeatures, RandomNearbyTargetsAreReachedWithoutFlippedTriangles) {
 
 // Targets anywhere: features sweep past each other's stars across the grid. Nothing may fold; a feature that
 // cannot get through is reported (its error is in the result), never forced. Every target here is reachable
-// (no base triangle of features only), so the count is what the warp still fails: 4 of 93 with the reordered
-// passes (14 of 93 with one pass; docs/measurements.md, "Feature warp stress test"). Some warps must need the
-// later passes and reach every target there, or the passes are untested.
+// (no base triangle of features only), so the count is what the warp still fails: 1 of 93 with the barrier
+// relaxation after the reordered passes (4 without it, 14 with one pass; docs/measurements.md, "Feature warp
+// stress test"). Some warps must need the later passes and reach every target there, and some features must
+// come in only by the relaxation, or those are untested.
 TEST(WarpFeatures, RandomFarTargetsNeverFoldTheBaseMesh) {
   const TrialFigures fig = run_random_trials(20, 2.0, 77);
-  EXPECT_LE(fig.unreached, 4u);
+  EXPECT_LE(fig.unreached, 1u);
   EXPECT_GT(fig.rescued, 0u);
+  EXPECT_GE(fig.relaxed, 3u);
 }
 
 // The caveat of §3.4: the plain PL warp maps vertices only, and straight-edged base triangles can invert.

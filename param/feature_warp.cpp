@@ -1338,25 +1338,38 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
     }
     walk_all(triangles, best_uv, relaxer, features, targets, left);
     if (!left.empty()) {
-      // Still short: every feature walks again from the input embedding (no squeezed fans to undo), the
-      // ones still short first; kept when fewer features end short.
-      std::vector<Vec2> fresh = uv;
-      BarrierRelaxer from_input(triangles, uv, fresh, features);
-      std::vector<int> queue = left;
+      // Still short: every feature walks again from the input embedding (no squeezed fans to undo), in up to
+      // kOrders orders (the ones still short first, then last, then everything reversed, then the first order
+      // rotated by 1, 2, 3); the order that leaves the fewest features short is kept when that is fewer than
+      // before. (Measured on the stress test's seeds 78 / 79: 1 order 10 / 8 short, 3 orders 7 / 6, 6 orders
+      // 5 / 4, 12 orders 5 / 4.)
+      constexpr int kOrders = 6;
+      std::vector<int> first = left, rest;
       for (int k = 0; k < int(features.size()); ++k) {
-        if (std::find(queue.begin(), queue.end(), k) == queue.end() && uv[features[k]] != targets[k] &&
-            !provably_unreachable(triangles, uv, features, targets, from_input.star(features[k])))
-          queue.push_back(k);
+        if (std::find(first.begin(), first.end(), k) == first.end() && uv[features[k]] != targets[k] &&
+            !provably_unreachable(triangles, uv, features, targets, relaxer.star(features[k])))
+          rest.push_back(k);
       }
-      walk_all(triangles, fresh, from_input, features, targets, queue);
-      std::size_t short_before = 0, short_after = 0;
-      for (std::size_t k = 0; k < features.size(); ++k) {
-        short_before += best_uv[features[k]] != targets[k];
-        short_after += fresh[features[k]] != targets[k];
-      }
-      if (short_after < short_before) {
-        best_uv.swap(fresh);
-        left = queue;
+      std::size_t fewest = 0;
+      for (std::size_t k = 0; k < features.size(); ++k) fewest += best_uv[features[k]] != targets[k];
+      std::vector<std::vector<int>> tried;
+      for (int o = 0; o < kOrders && !left.empty(); ++o) {
+        std::vector<int> queue = o == 1 ? rest : first;
+        queue.insert(queue.end(), (o == 1 ? first : rest).begin(), (o == 1 ? first : rest).end());
+        if (o == 2) std::reverse(queue.begin(), queue.end());
+        if (o >= 3) std::rotate(queue.begin(), queue.begin() + std::ptrdiff_t((o - 2) % queue.size()), queue.end());
+        if (std::find(tried.begin(), tried.end(), queue) != tried.end()) continue;  // a few features: repeats
+        tried.push_back(queue);
+        std::vector<Vec2> fresh = uv;
+        BarrierRelaxer from_input(triangles, uv, fresh, features);
+        walk_all(triangles, fresh, from_input, features, targets, queue);
+        std::size_t short_now = 0;
+        for (std::size_t k = 0; k < features.size(); ++k) short_now += fresh[features[k]] != targets[k];
+        if (short_now < fewest) {
+          fewest = short_now;
+          best_uv.swap(fresh);
+          left = queue;
+        }
       }
     }
     // Every feature short now (the route from the input may leave short one that the warp had brought in).

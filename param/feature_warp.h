@@ -75,8 +75,8 @@ struct FeatureWarpOptions {
   /// from the input embedding (infinite at a flat triangle, so the fans the warp squeezed open up again and
   /// nothing flips) over the free vertices within 24 rings, the feature drawn to its target by a quadratic
   /// term of growing weight and placed exactly on it once its star is positive there. If some are still
-  /// short, every feature walks that way from the input embedding instead (the short ones first), and that
-  /// result is kept when fewer features end short. The embedding is then no longer the warp's PL map of the
+  /// short, every feature walks that way from the input embedding instead, in up to 6 orders, and the order
+  /// that leaves the fewest short is kept when that is fewer than before. The embedding is then no longer the warp's PL map of the
   /// input, only fold-free with the same boundary. false: the passes' result as it is.
   bool relax_unreached = true;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`

@@ -943,9 +943,11 @@ struct RestTriangle {
 
 class BarrierRelaxer {
  public:
+  /// `budget`: Newton iterations left for all relaxers of one warp_features call (shared, decremented; at 0
+  /// newton_region() does nothing, so walks stall and the features stay short).
   BarrierRelaxer(const std::vector<Tri>& triangles, const std::vector<Vec2>& rest, std::vector<Vec2>& uv,
-                 const std::vector<int>& features)
-      : triangles_(triangles), uv_(uv), free_(uv.size(), 1), star_(uv.size()) {
+                 const std::vector<int>& features, std::size_t& budget)
+      : triangles_(triangles), uv_(uv), budget_(budget), free_(uv.size(), 1), star_(uv.size()) {
     for (int f : features) free_[f] = 0;
     for (std::size_t v = 0; v < uv.size(); ++v) {
       if (on_boundary(uv[v])) free_[v] = 0;
@@ -1015,7 +1017,7 @@ class BarrierRelaxer {
       }
       return e;
     };
-    for (int it = 0; it < iterations; ++it) {
+    for (int it = 0; it < iterations && budget_ > 0; ++it, --budget_) {
       std::vector<Eigen::Triplet<double>> entries;
       Eigen::VectorXd grad = Eigen::VectorXd::Zero(2 * n);
       for (int t : tris) {
@@ -1193,6 +1195,7 @@ class BarrierRelaxer {
 
   const std::vector<Tri>& triangles_;
   std::vector<Vec2>& uv_;
+  std::size_t& budget_;
   std::vector<char> free_;
   std::vector<std::vector<int>> star_;
   std::vector<RestTriangle> rest_;
@@ -1331,7 +1334,8 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
   if (options.relax_unreached && !best.unreached.empty()) {
     // The features the passes left short (and no proof rules out) walk on with the barrier relaxation, from
     // the best pass's embedding; the input embedding is the rest shape.
-    BarrierRelaxer relaxer(triangles, uv, best_uv, features);
+    std::size_t budget = options.relax_iterations;
+    BarrierRelaxer relaxer(triangles, uv, best_uv, features, budget);
     std::vector<int> left;
     for (int k : best.unreached) {
       if (!provably_unreachable(triangles, uv, features, targets, relaxer.star(features[k]))) left.push_back(k);
@@ -1361,7 +1365,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         if (std::find(tried.begin(), tried.end(), queue) != tried.end()) continue;  // a few features: repeats
         tried.push_back(queue);
         std::vector<Vec2> fresh = uv;
-        BarrierRelaxer from_input(triangles, uv, fresh, features);
+        BarrierRelaxer from_input(triangles, uv, fresh, features, budget);
         walk_all(triangles, fresh, from_input, features, targets, queue);
         std::size_t short_now = 0;
         for (std::size_t k = 0; k < features.size(); ++k) short_now += fresh[features[k]] != targets[k];
@@ -1372,6 +1376,7 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
         }
       }
     }
+    best.relax_iterations = options.relax_iterations - budget;
     // Every feature short now (the route from the input may leave short one that the warp had brought in).
     std::vector<int> unreached;
     std::vector<std::string> reasons;

@@ -79,6 +79,10 @@ struct FeatureWarpOptions {
   /// that leaves the fewest short is kept when that is fewer than before. The embedding is then no longer the warp's PL map of the
   /// input, only fold-free with the same boundary. false: the passes' result as it is.
   bool relax_unreached = true;
+  /// Upper bound on the relaxation's Newton iterations (each one sparse solve over at most the 24 rings
+  /// around a feature) over the whole call; when they are spent the features still short stay short. Bounds
+  /// the fallback's time on large patches (the stress test's far warps use up to 6,500; docs/measurements.md).
+  std::size_t relax_iterations = 20000;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after
   /// the Delaunay flips that follow a move, in every pass (`reorder_passes`; a later pass lists the features in
@@ -119,6 +123,8 @@ struct FeatureWarpResult {
   /// Features the passes left short that the barrier relaxation (`FeatureWarpOptions::relax_unreached`)
   /// brought to their targets.
   std::size_t relaxed = 0;
+  /// Newton iterations the relaxation spent (at most `FeatureWarpOptions::relax_iterations`).
+  std::size_t relax_iterations = 0;
   /// Base triangles with signed area <= 0 after the warp, checked with exact predicates: always 0 unless
   /// `keep_base_mesh_valid` is false.
   std::size_t flipped_triangles = 0;

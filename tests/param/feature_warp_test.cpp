@@ -195,6 +195,7 @@ struct TrialFigures {
   std::size_t features = 0, unreached = 0, events = 0, repaired = 0, max_events = 0, max_repaired = 0;
   std::size_t reordered = 0, rescued = 0;  // warps that needed more than one pass; of those, reaching every target
   std::size_t relaxed = 0;  // features the barrier relaxation brought in after the passes
+  std::size_t max_relax_iterations = 0;  // the relaxation's Newton iterations in one warp, at most
   std::map<std::string, std::size_t> reasons;  // why features stopped short: the reason up to its position
   double seconds = 0;
 };
@@ -231,6 +232,8 @@ TrialFigures run_random_trials(int trials, double reach, unsigned seed) {
     fig.features += c.features.size();
     fig.unreached += r.unreached.size();
     fig.relaxed += r.relaxed;
+    fig.max_relax_iterations = std::max(fig.max_relax_iterations, r.relax_iterations);
+    EXPECT_LE(r.relax_iterations, FeatureWarpOptions{}.relax_iterations);
     fig.events += r.events;
     fig.repaired += r.repaired_vertices;
     fig.max_events = std::max(fig.max_events, r.events);
@@ -240,7 +243,8 @@ TrialFigures run_random_trials(int trials, double reach, unsigned seed) {
             << fig.unreached << "/" << fig.features << ", events " << fig.events << " (max " << fig.max_events
             << "), repaired vertices " << fig.repaired << " (max " << fig.max_repaired << "), warps in more than one pass "
             << fig.reordered << " (all targets reached in " << fig.rescued << "), brought in by the relaxation "
-            << fig.relaxed << ", " << 1e3 * fig.seconds / trials
+            << fig.relaxed << " (Newton iterations at most " << fig.max_relax_iterations << " per warp), "
+            << 1e3 * fig.seconds / trials
             << " ms per warp\n";
   for (const auto& [why, count] : fig.reasons) std::cout << "[ figures  ]   " << count << " x " << why << "\n";
   return fig;

@@ -929,8 +929,8 @@ FeatureWarpResult warp_pass(const std::vector<Tri>& triangles, std::vector<Vec2>
 // infinite at a flat triangle instead: the symmetric Dirichlet energy of the map from the input embedding
 // (the rest shape) to the current one, E = Σ_t A_t (‖J_t‖² + ‖J_t⁻¹‖²), minimized by projected Newton steps
 // over all free vertices at once (each step scaled to keep every triangle positive, then halved until E
-// decreases and the exact predicate finds every triangle positive). The whole patch relaxes first; then the
-// short feature becomes a variable too, drawn to its target by a quadratic term whose weight doubles while
+// decreases and the exact predicate finds every triangle positive). The 24 rings around the short feature
+// relax first; then the feature becomes a variable too, drawn to its target by a quadratic term whose weight doubles while
 // it gains less than a tenth of its remaining way per round (so it moves together with the vertices around
 // it), and it is placed exactly on its target once its star is positive there. Nothing ever flips, whatever
 // the outcome.
@@ -968,18 +968,19 @@ class BarrierRelaxer {
   static constexpr int kRings = 24;
   const std::vector<int>& star(int v) const { return star_[v]; }
 
-  /// Projected Newton iterations on E over the free vertices within `rings` rings of `center` (the others
-  /// held): per triangle the Hessian of A·(‖J‖² + ‖J⁻¹‖²) in J, its negative eigenvalues clamped to 0, chained
-  /// to the triangle's vertices; one sparse solve for all; the step scaled to 0.8 of the largest one that
-  /// keeps every triangle positive, then halved until E decreases and every triangle is positive by the
-  /// exact predicate. Squeezed fans are chains of vertices that only move together: vertex-by-vertex steps
-  /// creep, a joint step opens them.
   /// A (feature) vertex that is a variable too, drawn toward `to` by weight·|x − to|².
   struct Pull {
     int v = -1;
     Vec2 to;
     double weight = 0;
   };
+  /// Projected Newton iterations on E (plus the pulls' terms) over the free vertices within `rings` rings of
+  /// `center` and the pulled vertices (the others held): per triangle the Hessian of A·(‖J‖² + ‖J⁻¹‖²) in J,
+  /// its negative eigenvalues clamped to 0, chained to the triangle's vertices; one sparse solve for all; the
+  /// step scaled to 0.8 of the largest one that keeps every triangle positive, then halved until the energy
+  /// decreases and every triangle is positive by the exact predicate. Stops early when an iteration gains
+  /// less than 10⁻⁹ of the energy or finds no step. Squeezed fans are chains of vertices that only move
+  /// together: vertex-by-vertex steps creep, a joint step opens them.
   void newton_region(int center, int rings, int iterations, const std::vector<Pull>& pulls = {}) {
     std::vector<int> region = ring_region(center, rings);
     for (const Pull& p : pulls) {
@@ -1201,13 +1202,12 @@ class BarrierRelaxer {
   std::vector<RestTriangle> rest_;
 };
 
-
-/// Draws feature f toward `to` with the barrier relaxation (above): f is a variable of the Newton
-/// iterations, with a quadratic term toward `to` whose weight doubles while it gains less than a tenth of its
-/// remaining way per round. With `exact`, f is placed exactly on `to` once its star is positive there (true
-/// then); otherwise it is done within `near` of `to` (true). False when it stalled.
+/// Draws feature f to `to` with the barrier relaxation (above): f is a variable of the Newton iterations,
+/// with a quadratic term toward `to` whose weight doubles while it gains less than a tenth of its remaining
+/// way per round, and is placed exactly on `to` once its star is positive there (true). False when it
+/// stalled.
 bool pull_feature(const std::vector<Tri>& triangles, std::vector<Vec2>& uv, BarrierRelaxer& relaxer, int f,
-                  const Vec2& to, bool exact, double near) {
+                  const Vec2& to) {
   constexpr int kRounds = 200, kIterations = 3, kMaxDoublings = 60;
   const int rings = BarrierRelaxer::kRings;
   const auto star_positive_at = [&](const Vec2& y) {
@@ -1222,13 +1222,12 @@ bool pull_feature(const std::vector<Tri>& triangles, std::vector<Vec2>& uv, Barr
   double weight = 0;
   int doublings = 0;
   for (int round = 0; round < kRounds; ++round) {
-    if (exact && star_positive_at(to)) {
+    if (star_positive_at(to)) {
       uv[f] = to;
       relaxer.newton_region(f, rings, kIterations);
       return true;
     }
     const double before = (to - uv[f]).norm();
-    if (!exact && before <= near) return true;
     if (weight == 0) weight = relaxer.region_energy(f, rings) / (before * before);
     relaxer.newton_region(f, rings, kIterations, {{f, to, weight}});
     const double after = (to - uv[f]).norm();
@@ -1243,13 +1242,13 @@ bool pull_feature(const std::vector<Tri>& triangles, std::vector<Vec2>& uv, Barr
 /// Walks feature k straight to its target with pull_feature(), after the region has relaxed (the warp may
 /// have left it strained). True when it arrived exactly. (Routing around other features through a waypoint
 /// beside them, as the warp does, left more features short here: 19 → 23 of 285 on the stress test's seeds
-/// 77–79.)
+/// 77–79, measured with one order of the walk from the input.)
 bool relax_walk(const std::vector<Tri>& triangles, std::vector<Vec2>& uv, BarrierRelaxer& relaxer,
                 const std::vector<int>& features, int k, const Vec2& target) {
   constexpr int kFirstIterations = 50;
   const int f = features[k];
   relaxer.newton_region(f, BarrierRelaxer::kRings, kFirstIterations);
-  return pull_feature(triangles, uv, relaxer, f, target, true, 0);
+  return pull_feature(triangles, uv, relaxer, f, target);
 }
 
 /// relax_walk() for each feature of `short_ones` (indices into `features`) in turn, again over those that

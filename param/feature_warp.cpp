@@ -1023,10 +1023,7 @@ class BarrierRelaxer {
       Eigen::VectorXd grad = Eigen::VectorXd::Zero(2 * n);
       for (int t : tris) {
         const Tri& tr = triangles_[t];
-        Eigen::Matrix2d xm;
-        xm.col(0) = uv_[tr[1]] - uv_[tr[0]];
-        xm.col(1) = uv_[tr[2]] - uv_[tr[0]];
-        const Eigen::Matrix2d j = xm * rest_[t].s;
+        const Eigen::Matrix2d j = jacobian(t, uv_);
         const double d = j.determinant();
         if (!(d > 0)) return;  // not expected: every accepted state is positive
         const double a = rest_[t].area, f = j.squaredNorm();
@@ -1119,22 +1116,30 @@ class BarrierRelaxer {
       }
       double alpha = std::min(1.0, 0.8 * alpha_max);
       const double e0 = energy(uv_);
-      std::vector<Vec2> trial = uv_;
-      bool accepted = false;
+      // Trial positions are written in place (the variables' start kept to go back), not into a copy of uv.
+      std::vector<Vec2> start(static_cast<std::size_t>(n));
+      for (int v : region) {
+        if (dof[v] >= 0) start[static_cast<std::size_t>(dof[v])] = uv_[v];
+      }
+      double e1 = e0;
       for (int halving = 0; halving < 40 && alpha > 0; ++halving, alpha *= 0.5) {
         for (int v : region) {
-          if (dof[v] >= 0) trial[v] = uv_[v] + alpha * Vec2(step[2 * dof[v]], step[2 * dof[v] + 1]);
+          if (dof[v] >= 0)
+            uv_[v] = start[static_cast<std::size_t>(dof[v])] + alpha * Vec2(step[2 * dof[v]], step[2 * dof[v] + 1]);
         }
-        if (energy(trial) < e0 && positive(tris, trial)) {
-          accepted = true;
+        const double e = energy(uv_);
+        if (e < e0 && positive(tris, uv_)) {
+          e1 = e;
           break;
         }
       }
-      if (!accepted) return;
-      for (int v : region) {
-        if (dof[v] >= 0) uv_[v] = trial[v];
+      if (e1 == e0) {  // no step accepted: back to the start
+        for (int v : region) {
+          if (dof[v] >= 0) uv_[v] = start[static_cast<std::size_t>(dof[v])];
+        }
+        return;
       }
-      if (e0 - energy(uv_) < 1e-9 * e0) return;
+      if (e0 - e1 < 1e-9 * e0) return;
     }
   }
 
@@ -1175,12 +1180,17 @@ class BarrierRelaxer {
     return region;
   }
 
-  double triangle_energy(int t, const std::vector<Vec2>& x) const {
+  /// J of triangle t at positions x: [x1 − x0, x2 − x0]·S.
+  Eigen::Matrix2d jacobian(int t, const std::vector<Vec2>& x) const {
     const Tri& tr = triangles_[t];
     Eigen::Matrix2d xm;
     xm.col(0) = x[tr[1]] - x[tr[0]];
     xm.col(1) = x[tr[2]] - x[tr[0]];
-    const Eigen::Matrix2d j = xm * rest_[t].s;
+    return xm * rest_[t].s;
+  }
+
+  double triangle_energy(int t, const std::vector<Vec2>& x) const {
+    const Eigen::Matrix2d j = jacobian(t, x);
     const double d = j.determinant();
     if (!(d > 0)) return std::numeric_limits<double>::infinity();
     return rest_[t].area * j.squaredNorm() * (1 + 1 / (d * d));

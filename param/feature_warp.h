@@ -76,11 +76,16 @@ struct FeatureWarpOptions {
   /// nothing flips) over the free vertices within 24 rings, the feature drawn to its target by a quadratic
   /// term of growing weight and placed exactly on it once its star is positive there. If some are still
   /// short, every feature walks that way from the input embedding instead, in up to 6 orders, and the order
-  /// that leaves the fewest short is kept when that is fewer than before. The embedding is then no longer the warp's PL map of the
+  /// that leaves the fewest short is kept when that is fewer than before. If some are short still, every
+  /// feature is placed on its target and the free vertices are untangled (Garanzha et al. 2021, "Foldover-free
+  /// maps in 50 lines of code": a regularized energy that is finite on folded triangles, so it can pass
+  /// through folded states that no walk through fold-free ones can cross), from the best embedding so far, then
+  /// from the input embedding, then from the Tutte embedding of the pinned vertices; the first start that the
+  /// exact predicate finds fold-free is kept. The embedding is then no longer the warp's PL map of the
   /// input, only fold-free with the same boundary. false: the passes' result as it is.
   bool relax_unreached = true;
   /// Upper bound on the relaxation's Newton iterations (each one sparse solve over at most the 24 rings
-  /// around a feature) over the whole call; when they are spent the features still short stay short. Bounds
+  /// around a feature, or over the whole patch when untangling) over the whole call; when they are spent the features still short stay short. Bounds
   /// the fallback's time on large patches (the stress test's far warps use up to 6,500; docs/measurements.md).
   std::size_t relax_iterations = 20000;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
@@ -120,9 +125,12 @@ struct FeatureWarpResult {
   /// result is the best pass's; `events`, `repaired_vertices`, `steps`, `detours` and
   /// `min_warp_triangle_area` are over all passes.
   int passes = 0;
-  /// Features the passes left short that the barrier relaxation (`FeatureWarpOptions::relax_unreached`)
-  /// brought to their targets.
+  /// Features the passes left short that the barrier relaxation or the untangling after it
+  /// (`FeatureWarpOptions::relax_unreached`) brought to their targets.
   std::size_t relaxed = 0;
+  /// Features that came in only by untangling (the walks left them short; see
+  /// `FeatureWarpOptions::relax_unreached`), counted in `relaxed` too when the passes had left them short.
+  std::size_t untangled = 0;
   /// Newton iterations the relaxation spent (at most `FeatureWarpOptions::relax_iterations`).
   std::size_t relax_iterations = 0;
   /// Base triangles with signed area <= 0 after the warp, checked with exact predicates: always 0 unless
@@ -148,8 +156,9 @@ struct FeatureWarpResult {
 /// incident to a moving feature move only when repaired (they are then within a few rings of a moving one).
 /// A pass that leaves targets unreached is followed by passes in other orders from the input uv
 /// (`FeatureWarpOptions::reorder_passes`); `uv` and the result are those of the pass with the fewest unreached
-/// features, and the features it left short then walk on with a barrier relaxation
-/// (`FeatureWarpOptions::relax_unreached`; boundary vertices stay bit-identical, nothing flips). A target may
+/// features, and the features it left short then walk on with a barrier relaxation, or are placed on their
+/// targets and the rest untangled (`FeatureWarpOptions::relax_unreached`; boundary vertices stay
+/// bit-identical, the result is checked fold-free with exact predicates). A target may
 /// still be left unreached (reported in `unreached`, never folded); how often that happens for near and far
 /// targets is in docs/measurements.md.
 ///

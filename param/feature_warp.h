@@ -75,13 +75,13 @@ struct FeatureWarpOptions {
   /// from the input embedding (infinite at a flat triangle, so the fans the warp squeezed open up again and
   /// nothing flips) over the free vertices within 24 rings, the feature drawn to its target by a quadratic
   /// term of growing weight and placed exactly on it once its star is positive there. If some are still
-  /// short, every feature walks that way from the input embedding instead, in up to 6 orders, and the order
-  /// that leaves the fewest short is kept when that is fewer than before. If some are short still, every
-  /// feature is placed on its target and the free vertices are untangled (Garanzha et al. 2021, "Foldover-free
-  /// maps in 50 lines of code": a regularized energy that is finite on folded triangles, so it can pass
-  /// through folded states that no walk through fold-free ones can cross), from the best embedding so far, then
-  /// from the input embedding, then from the Tutte embedding of the pinned vertices; the first start that the
-  /// exact predicate finds fold-free is kept. The embedding is then no longer the warp's PL map of the
+  /// short, every feature is placed on its target and the free vertices are untangled (Garanzha et al. 2021,
+  /// "Foldover-free maps in 50 lines of code": a regularized energy that is finite on folded triangles, so it
+  /// passes through folded states that no walk through fold-free ones can cross), from the embedding so far,
+  /// then from the input embedding, then from the Tutte embedding of the pinned vertices; the first start that
+  /// the exact predicate finds fold-free is kept. If that fails, every feature walks with the relaxation from
+  /// the input embedding, in up to 6 orders; the order that leaves the fewest short is kept when that is fewer
+  /// than before, and untangled once more from there. The embedding is then no longer the warp's PL map of the
   /// input, only fold-free with the same boundary. false: the passes' result as it is.
   bool relax_unreached = true;
   /// Upper bound on the relaxation's Newton iterations (each one sparse solve over at most the 24 rings

@@ -1295,7 +1295,8 @@ void tutte(const std::vector<Tri>& triangles, const std::vector<char>& fixed, st
   std::vector<Eigen::Triplet<double>> entries;
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 2);
   for (const Tri& t : triangles) {
-    for (int i = 0; i < 3; ++i) {  // each directed edge once per side: the interior edges' weights add to 1 + 1
+    for (int i = 0; i < 3;
+         ++i) {  // each directed edge once per side: the interior edges' weights add to 1 + 1
       const int a = t[i], b = t[(i + 1) % 3];
       for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, a}}) {
         if (dof[p] < 0) continue;
@@ -1366,7 +1367,7 @@ bool untangle(const std::vector<Tri>& triangles, const std::vector<Vec2>& rest, 
     m.col(1) = y[triangles[t][2]] - y[triangles[t][0]];
     return Eigen::Matrix2d(m * rt[t].s);
   };
-  // χ and its first two derivatives in D, in forms without cancellation for D < 0.
+  // χ in a form without cancellation for D < 0 (its derivatives in D below likewise).
   const auto chi = [](double eps, double d) {
     const double r = std::sqrt(eps * eps + d * d);
     return d > 0 ? 0.5 * (d + r) : 0.5 * eps * eps / (r - d);
@@ -1402,18 +1403,21 @@ bool untangle(const std::vector<Tri>& triangles, const std::vector<Vec2>& rest, 
         const Eigen::Matrix2d j = jac(t, x);
         const double d = j.determinant(), tj = j.squaredNorm(), a = rt[t].area;
         const double r = std::sqrt(eps * eps + d * d), c = chi(eps, d);
-        const double c1 = d > 0 ? 0.5 * (1 + d / r) : 0.5 * eps * eps / (r * (r - d)), c2 = 0.5 * eps * eps / (r * r * r);
+        const double c1 = d > 0 ? 0.5 * (1 + d / r) : 0.5 * eps * eps / (r * (r - d)),
+                     c2 = 0.5 * eps * eps / (r * r * r);
         const double h = 1 / c, h1 = -c1 / (c * c), h2 = -c2 / (c * c) + 2 * c1 * c1 / (c * c * c);
-        const Eigen::Vector4d vj(j(0, 0), j(0, 1), j(1, 0), j(1, 1)), dd(j(1, 1), -j(1, 0), -j(0, 1), j(0, 0));
+        const Eigen::Vector4d vj(j(0, 0), j(0, 1), j(1, 0), j(1, 1)),
+            dd(j(1, 1), -j(1, 0), -j(0, 1), j(0, 0));
         const double nn = (1 - kTheta) * tj + kTheta * (d * d + 1);
         const Eigen::Vector4d gn = 2 * (1 - kTheta) * vj + 2 * kTheta * d * dd;
         const Eigen::Matrix4d hn =
             2 * (1 - kTheta) * Eigen::Matrix4d::Identity() + kTheta * (2 * dd * dd.transpose() + 2 * d * d2d);
         const Eigen::Vector4d gj = a * (h * gn + nn * h1 * dd);
-        Eigen::Matrix4d hj =
-            a * (h * hn + h1 * (gn * dd.transpose() + dd * gn.transpose()) + nn * h2 * dd * dd.transpose() + nn * h1 * d2d);
+        Eigen::Matrix4d hj = a * (h * hn + h1 * (gn * dd.transpose() + dd * gn.transpose()) +
+                                  nn * h2 * dd * dd.transpose() + nn * h1 * d2d);
         const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(hj);
-        hj = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+        hj = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
+             eig.eigenvectors().transpose();
         const Eigen::Matrix<double, 6, 1> gt = dj[t].transpose() * gj;
         const Eigen::Matrix<double, 6, 6> ht = dj[t].transpose() * hj * dj[t];
         for (int p = 0; p < 3; ++p) {
@@ -1424,7 +1428,8 @@ bool untangle(const std::vector<Tri>& triangles, const std::vector<Vec2>& rest, 
             const int vq = dof[tr[q]];
             if (vq < 0) continue;
             for (int rr = 0; rr < 2; ++rr) {
-              for (int cc = 0; cc < 2; ++cc) entries.emplace_back(2 * vp + rr, 2 * vq + cc, ht(2 * p + rr, 2 * q + cc));
+              for (int cc = 0; cc < 2; ++cc)
+                entries.emplace_back(2 * vp + rr, 2 * vq + cc, ht(2 * p + rr, 2 * q + cc));
             }
           }
         }
@@ -1551,8 +1556,8 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
     }
     walk_all(triangles, best_uv, relaxer, features, targets, left);
     // Features still short: every feature is placed on its target (the provably unreachable ones stay where
-    // they are) and the free vertices are untangled, from the best embedding so far, then (`starts` 3) from
-    // the input embedding and from the Tutte embedding of the pinned vertices; the first fold-free result is
+    // they are) and the free vertices are untangled, from the best embedding so far, then (with `starts` = 3)
+    // from the input embedding and from the Tutte embedding of the pinned vertices; the first fold-free result is
     // kept and relaxed around the features it brought in. (Stress test, seeds 77 / 78 / 79: 1 / 5 / 4 short →
     // 0 / 2 / 0; each start succeeds where the others fail. Untangling before the walks from the input, which
     // then run only when it fails, leaves the same features short in 0.6× / 0.8× / 0.4× the time.)
@@ -1563,8 +1568,8 @@ FeatureWarpResult warp_features(const std::vector<std::array<int, 3>>& triangles
       for (int from = 0; from < starts && !left.empty(); ++from) {
         std::vector<Vec2> x = from == 0 ? best_uv : uv;
         for (std::size_t k = 0; k < features.size(); ++k) {
-          const bool stays = best_uv[features[k]] != targets[k] &&
-                             std::find(left.begin(), left.end(), int(k)) == left.end();
+          const bool stays =
+              best_uv[features[k]] != targets[k] && std::find(left.begin(), left.end(), int(k)) == left.end();
           x[features[k]] = stays ? best_uv[features[k]] : targets[k];
         }
         if (from == 2) tutte(triangles, fixed, x);

@@ -85,8 +85,9 @@ struct FeatureWarpOptions {
   /// input, only fold-free with the same boundary. false: the passes' result as it is.
   bool relax_unreached = true;
   /// Upper bound on the relaxation's Newton iterations (each one sparse solve over at most the 24 rings
-  /// around a feature, or over the whole patch when untangling) over the whole call; when they are spent the features still short stay short. Bounds
-  /// the fallback's time on large patches (the stress test's far warps use up to 6,500; docs/measurements.md).
+  /// around a feature, or over the whole patch when untangling) over the whole call; when they are spent the
+  /// features still short stay short. Bounds the fallback's time on large patches (the stress test's far
+  /// warps use up to 10,600; docs/measurements.md).
   std::size_t relax_iterations = 20000;
   /// Called with the warp mesh (points: 4 corners (0,0),(1,0),(1,1),(0,1) then the features in `features`
   /// order; counter-clockwise triangles) after it is built, after every move, after every event flip and after

@@ -1295,8 +1295,8 @@ void tutte(const std::vector<Tri>& triangles, const std::vector<char>& fixed, st
   std::vector<Eigen::Triplet<double>> entries;
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 2);
   for (const Tri& t : triangles) {
-    for (int i = 0; i < 3;
-         ++i) {  // each directed edge once per side: the interior edges' weights add to 1 + 1
+    // Each edge once per side (both directions): an interior edge's weight adds up to 2, a boundary one's to 1.
+    for (int i = 0; i < 3; ++i) {
       const int a = t[i], b = t[(i + 1) % 3];
       for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, a}}) {
         if (dof[p] < 0) continue;

@@ -1295,7 +1295,8 @@ void tutte(const std::vector<Tri>& triangles, const std::vector<char>& fixed, st
   std::vector<Eigen::Triplet<double>> entries;
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 2);
   for (const Tri& t : triangles) {
-    // Each edge once per side (both directions): an interior edge's weight adds up to 2, a boundary one's to 1.
+    // Each triangle adds its edges in both directions; a free vertex's edges are all interior (two triangles),
+    // so each gets weight 2: uniform weights.
     for (int i = 0; i < 3; ++i) {
       const int a = t[i], b = t[(i + 1) % 3];
       for (const auto& [p, q] : {std::pair{a, b}, std::pair{b, a}}) {

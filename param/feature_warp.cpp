@@ -956,6 +956,63 @@ Eigen::Matrix<double, 4, 6> jacobian_derivative(const Eigen::Matrix2d& s) {
   return dj;
 }
 
+/// The rest shape of triangle `tr` at positions `rest`.
+RestTriangle rest_triangle(const Tri& tr, const std::vector<Vec2>& rest) {
+  Eigen::Matrix2d r;
+  r.col(0) = rest[tr[1]] - rest[tr[0]];
+  r.col(1) = rest[tr[2]] - rest[tr[0]];
+  return {r.inverse(), 0.5 * r.determinant()};
+}
+
+/// J of a triangle at positions x: [x1 − x0, x2 − x0]·S.
+Eigen::Matrix2d jacobian(const Tri& tr, const RestTriangle& rt, const std::vector<Vec2>& x) {
+  Eigen::Matrix2d xm;
+  xm.col(0) = x[tr[1]] - x[tr[0]];
+  xm.col(1) = x[tr[2]] - x[tr[0]];
+  return xm * rt.s;
+}
+
+/// One triangle's share of a projected Newton system: its gradient `gj` and Hessian `hj` in vec(J), the
+/// Hessian's negative eigenvalues clamped to 0, chained to the triangle's vertices by `dj`
+/// (jacobian_derivative) and added at the variables `dof` gives them (-1: held).
+void add_triangle_terms(const Tri& tr, const Eigen::Vector4d& gj, const Eigen::Matrix4d& hj,
+                        const Eigen::Matrix<double, 4, 6>& dj, const std::vector<int>& dof,
+                        Eigen::VectorXd& grad, std::vector<Eigen::Triplet<double>>& entries) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(hj);
+  const Eigen::Matrix4d psd =
+      eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+  const Eigen::Matrix<double, 6, 1> gt = dj.transpose() * gj;
+  const Eigen::Matrix<double, 6, 6> ht = dj.transpose() * psd * dj;
+  for (int p = 0; p < 3; ++p) {
+    const int vp = dof[tr[p]];
+    if (vp < 0) continue;
+    grad.segment<2>(2 * vp) += gt.segment<2>(2 * p);
+    for (int q = 0; q < 3; ++q) {
+      const int vq = dof[tr[q]];
+      if (vq < 0) continue;
+      for (int r = 0; r < 2; ++r) {
+        for (int c = 0; c < 2; ++c) entries.emplace_back(2 * vp + r, 2 * vq + c, ht(2 * p + r, 2 * q + c));
+      }
+    }
+  }
+}
+
+/// Solves H·step = −grad for the Newton system of `entries` (n variables, 2 coordinates each), its diagonal
+/// raised by 10⁻⁹ of its largest entry so that a singular (projected) Hessian still factors. False when the
+/// factorization or the solve fails or the step is not finite.
+bool newton_step(const std::vector<Eigen::Triplet<double>>& entries, int n, const Eigen::VectorXd& grad,
+                 Eigen::VectorXd& step) {
+  Eigen::SparseMatrix<double> h(2 * n, 2 * n);
+  h.setFromTriplets(entries.begin(), entries.end());
+  double scale = 0;
+  for (int k = 0; k < 2 * n; ++k) scale = std::max(scale, h.coeff(k, k));
+  for (int k = 0; k < 2 * n; ++k) h.coeffRef(k, k) += 1e-9 * scale + 1e-300;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(h);
+  if (solver.info() != Eigen::Success) return false;
+  step = -solver.solve(grad);
+  return solver.info() == Eigen::Success && step.allFinite();
+}
+
 class BarrierRelaxer {
  public:
   /// `budget`: Newton iterations left for all relaxers of one warp_features call (shared, decremented; at 0
@@ -967,15 +1024,10 @@ class BarrierRelaxer {
     for (std::size_t v = 0; v < uv.size(); ++v) {
       if (on_boundary(uv[v])) free_[v] = 0;
     }
-    rest_.resize(triangles.size());
+    rest_.reserve(triangles.size());
     for (std::size_t t = 0; t < triangles.size(); ++t) {
-      const Tri& tr = triangles[t];
-      Eigen::Matrix2d r;
-      r.col(0) = rest[tr[1]] - rest[tr[0]];
-      r.col(1) = rest[tr[2]] - rest[tr[0]];
-      rest_[t].area = 0.5 * r.determinant();
-      rest_[t].s = r.inverse();
-      for (int v : tr) star_[v].push_back(int(t));
+      rest_.push_back(rest_triangle(triangles[t], rest));
+      for (int v : triangles[t]) star_[v].push_back(int(t));
     }
   }
 
@@ -1050,27 +1102,10 @@ class BarrierRelaxer {
         d2d(1, 2) = d2d(2, 1) = -1;
         const double id = 1 / d, id2 = id * id;
         const Eigen::Vector4d gj = a * (df * (1 + id2) - 2 * f * id2 * id * dd);
-        Eigen::Matrix4d hj = a * (2 * (1 + id2) * Eigen::Matrix4d::Identity() -
-                                  2 * id2 * id * (df * dd.transpose() + dd * df.transpose()) +
-                                  6 * f * id2 * id2 * dd * dd.transpose() - 2 * f * id2 * id * d2d);
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(hj);
-        hj = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
-        const Eigen::Matrix<double, 4, 6> dj = jacobian_derivative(rest_[t].s);
-        const Eigen::Matrix<double, 6, 1> gt = dj.transpose() * gj;
-        const Eigen::Matrix<double, 6, 6> ht = dj.transpose() * hj * dj;
-        for (int p = 0; p < 3; ++p) {
-          const int vp = dof[tr[p]];
-          if (vp < 0) continue;
-          grad[2 * vp] += gt[2 * p];
-          grad[2 * vp + 1] += gt[2 * p + 1];
-          for (int q = 0; q < 3; ++q) {
-            const int vq = dof[tr[q]];
-            if (vq < 0) continue;
-            for (int r = 0; r < 2; ++r) {
-              for (int c = 0; c < 2; ++c) entries.emplace_back(2 * vp + r, 2 * vq + c, ht(2 * p + r, 2 * q + c));
-            }
-          }
-        }
+        const Eigen::Matrix4d hj = a * (2 * (1 + id2) * Eigen::Matrix4d::Identity() -
+                                        2 * id2 * id * (df * dd.transpose() + dd * df.transpose()) +
+                                        6 * f * id2 * id2 * dd * dd.transpose() - 2 * f * id2 * id * d2d);
+        add_triangle_terms(tr, gj, hj, jacobian_derivative(rest_[t].s), dof, grad, entries);
       }
       for (const Pull& pl : pulls) {
         const int p = dof[pl.v];
@@ -1078,19 +1113,8 @@ class BarrierRelaxer {
         entries.emplace_back(2 * p, 2 * p, 2 * pl.weight);
         entries.emplace_back(2 * p + 1, 2 * p + 1, 2 * pl.weight);
       }
-      Eigen::SparseMatrix<double> h(2 * n, 2 * n);
-      h.setFromTriplets(entries.begin(), entries.end());
-      double scale = 0;
-      for (int k = 0; k < h.outerSize(); ++k) {
-        for (Eigen::SparseMatrix<double>::InnerIterator e(h, k); e; ++e) {
-          if (e.row() == e.col()) scale = std::max(scale, e.value());
-        }
-      }
-      for (int k = 0; k < 2 * n; ++k) h.coeffRef(k, k) += 1e-9 * scale + 1e-300;
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(h);
-      if (solver.info() != Eigen::Success) return;
-      const Eigen::VectorXd step = -solver.solve(grad);
-      if (solver.info() != Eigen::Success || !step.allFinite()) return;
+      Eigen::VectorXd step;
+      if (!newton_step(entries, n, grad, step)) return;
       // Largest α keeping every triangle positive: its doubled area is a quadratic in α.
       double alpha_max = 1e300;
       for (int t : tris) {
@@ -1184,13 +1208,9 @@ class BarrierRelaxer {
     return region;
   }
 
-  /// J of triangle t at positions x: [x1 − x0, x2 − x0]·S.
+  /// J of triangle t at positions x.
   Eigen::Matrix2d jacobian(int t, const std::vector<Vec2>& x) const {
-    const Tri& tr = triangles_[t];
-    Eigen::Matrix2d xm;
-    xm.col(0) = x[tr[1]] - x[tr[0]];
-    xm.col(1) = x[tr[2]] - x[tr[0]];
-    return xm * rest_[t].s;
+    return geomip::jacobian(triangles_[t], rest_[t], x);
   }
 
   double triangle_energy(int t, const std::vector<Vec2>& x) const {
@@ -1349,11 +1369,7 @@ bool untangle(const std::vector<Tri>& triangles, const std::vector<Vec2>& rest, 
   std::vector<RestTriangle> rt(nt);
   std::vector<Eigen::Matrix<double, 4, 6>> dj(nt);
   for (std::size_t t = 0; t < nt; ++t) {
-    Eigen::Matrix2d r;
-    r.col(0) = rest[triangles[t][1]] - rest[triangles[t][0]];
-    r.col(1) = rest[triangles[t][2]] - rest[triangles[t][0]];
-    rt[t].area = 0.5 * r.determinant();
-    rt[t].s = r.inverse();
+    rt[t] = rest_triangle(triangles[t], rest);
     dj[t] = jacobian_derivative(rt[t].s);
   }
   std::vector<int> dof(x.size(), -1);
@@ -1363,10 +1379,7 @@ bool untangle(const std::vector<Tri>& triangles, const std::vector<Vec2>& rest, 
   }
   if (n == 0) return false;
   const auto jac = [&](std::size_t t, const std::vector<Vec2>& y) {
-    Eigen::Matrix2d m;
-    m.col(0) = y[triangles[t][1]] - y[triangles[t][0]];
-    m.col(1) = y[triangles[t][2]] - y[triangles[t][0]];
-    return Eigen::Matrix2d(m * rt[t].s);
+    return jacobian(triangles[t], rt[t], y);
   };
   // χ in a form without cancellation for D < 0 (its derivatives in D below likewise).
   const auto chi = [](double eps, double d) {
@@ -1414,36 +1427,12 @@ bool untangle(const std::vector<Tri>& triangles, const std::vector<Vec2>& rest, 
         const Eigen::Matrix4d hn =
             2 * (1 - kTheta) * Eigen::Matrix4d::Identity() + kTheta * (2 * dd * dd.transpose() + 2 * d * d2d);
         const Eigen::Vector4d gj = a * (h * gn + nn * h1 * dd);
-        Eigen::Matrix4d hj = a * (h * hn + h1 * (gn * dd.transpose() + dd * gn.transpose()) +
-                                  nn * h2 * dd * dd.transpose() + nn * h1 * d2d);
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(hj);
-        hj = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
-             eig.eigenvectors().transpose();
-        const Eigen::Matrix<double, 6, 1> gt = dj[t].transpose() * gj;
-        const Eigen::Matrix<double, 6, 6> ht = dj[t].transpose() * hj * dj[t];
-        for (int p = 0; p < 3; ++p) {
-          const int vp = dof[tr[p]];
-          if (vp < 0) continue;
-          grad.segment<2>(2 * vp) += gt.segment<2>(2 * p);
-          for (int q = 0; q < 3; ++q) {
-            const int vq = dof[tr[q]];
-            if (vq < 0) continue;
-            for (int rr = 0; rr < 2; ++rr) {
-              for (int cc = 0; cc < 2; ++cc)
-                entries.emplace_back(2 * vp + rr, 2 * vq + cc, ht(2 * p + rr, 2 * q + cc));
-            }
-          }
-        }
+        const Eigen::Matrix4d hj = a * (h * hn + h1 * (gn * dd.transpose() + dd * gn.transpose()) +
+                                        nn * h2 * dd * dd.transpose() + nn * h1 * d2d);
+        add_triangle_terms(tr, gj, hj, dj[t], dof, grad, entries);
       }
-      Eigen::SparseMatrix<double> hm(2 * n, 2 * n);
-      hm.setFromTriplets(entries.begin(), entries.end());
-      double scale = 0;
-      for (int k = 0; k < 2 * n; ++k) scale = std::max(scale, hm.coeff(k, k));
-      for (int k = 0; k < 2 * n; ++k) hm.coeffRef(k, k) += 1e-9 * scale + 1e-300;
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(hm);
-      if (solver.info() != Eigen::Success) break;
-      const Eigen::VectorXd step = -solver.solve(grad);
-      if (solver.info() != Eigen::Success || !step.allFinite()) break;
+      Eigen::VectorXd step;
+      if (!newton_step(entries, n, grad, step)) break;
       const double slope = grad.dot(step);
       if (!(slope < 0)) break;
       std::vector<Vec2> start = x;

@@ -33,8 +33,10 @@
 // Detail bands of step k (s = 2^(k−1)): positions (i, j), multiples of s, not both multiples of 2s —
 // (odd, even) multiples of s: row details; (even, odd): column details; (odd, odd): diagonal details.
 //
-// Arithmetic is done in 64 bits and stored back modulo 2^32, so arbitrary (even garbage) coefficients never
-// cause undefined behaviour; for quantized inputs of up to 2^24 no wrap-around can happen.
+// Arithmetic is defined in 64 bits and stored back modulo 2^32, so arbitrary (even garbage) coefficients never
+// cause undefined behaviour; for quantized inputs of up to 2^24 no wrap-around can happen. (The implementation
+// runs a step in vectorizable 32-bit lanes when its samples are small enough for that to be exact, and is
+// tested bit for bit against this definition.)
 #pragma once
 
 #include <cstdint>

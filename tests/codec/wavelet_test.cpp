@@ -197,6 +197,90 @@ TEST(Wavelet, CubicFieldsHaveZeroDetailsWithTheCubicFilter) {
   }
 }
 
+// The transform as the header defines it, one line and one sample at a time in 64-bit arithmetic, stored
+// modulo 2^32: what the fast implementation (contiguous 32-bit lanes, gathered sub-grids) must equal bit for
+// bit, so streams of every pack version decode to the same samples.
+std::int32_t wrap64(std::int64_t v) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(v));
+}
+
+std::int64_t defined_prediction(const std::vector<std::int64_t>& e, int t, bool cubic) {
+  const int n = static_cast<int>(e.size());
+  const auto at = [&](int k) { return e[static_cast<std::size_t>(k)]; };
+  if (!cubic || n < 4) return (at(t) + at(t + 1) + 1) >> 1;
+  if (t == 0) return (5 * at(0) + 15 * at(1) - 5 * at(2) + at(3) + 8) >> 4;
+  if (t == n - 2) return (5 * at(n - 1) + 15 * at(n - 2) - 5 * at(n - 3) + at(n - 4) + 8) >> 4;
+  return (-at(t - 1) + 9 * at(t) + 9 * at(t + 1) - at(t + 2) + 8) >> 4;
+}
+
+/// One line (its samples by pointer), forward (sign −1: predict, then update) or inverse (+1).
+void defined_line(const std::vector<std::int32_t*>& x, int sign, bool cubic, bool updated) {
+  const int m = static_cast<int>(x.size()) / 2;
+  const auto update = [&](int sg) {
+    for (int t = 1; t < m; ++t) {
+      const std::int64_t u = (std::int64_t{*x[2 * t - 1]} + *x[2 * t + 1] + 2) >> 2;
+      *x[2 * t] = wrap64(*x[2 * t] + sg * u);
+    }
+  };
+  if (updated && sign > 0) update(-1);
+  std::vector<std::int64_t> e;
+  for (int t = 0; t <= m; ++t) e.push_back(*x[2 * t]);
+  for (int t = 0; t < m; ++t) *x[2 * t + 1] = wrap64(*x[2 * t + 1] + sign * defined_prediction(e, t, cubic));
+  if (updated && sign < 0) update(+1);
+}
+
+void defined_transform(std::vector<std::int32_t>& g, int level, int steps, WaveletFilter filter, bool update,
+                       bool forward) {
+  const int size = (1 << level) + 1;
+  const bool cubic = filter == WaveletFilter::kCubic;
+  const auto pass = [&](int s, bool rows, int sign) {
+    for (int l = 0; l < size; l += s) {
+      std::vector<std::int32_t*> x;
+      for (int a = 0; a < size; a += s)
+        x.push_back(&g[static_cast<std::size_t>(rows ? l * size + a : a * size + l)]);
+      defined_line(x, sign, cubic, update && l > 0 && l + 1 < size);
+    }
+  };
+  if (forward) {
+    for (int k = 1; k <= steps; ++k) pass(1 << (k - 1), true, -1), pass(1 << (k - 1), false, -1);
+  } else {
+    for (int k = steps; k >= 1; --k) pass(1 << (k - 1), false, +1), pass(1 << (k - 1), true, +1);
+  }
+}
+
+TEST(Wavelet, EqualsTheDefinitionBitForBit) {
+  // Quantized-size values (the 32-bit lanes), then any int32 (garbage of a corrupt stream: the 64-bit
+  // fallback, wrap-around included), then a mix (lines of both kinds in one pass).
+  for (int range : {1 << 20, (1 << 26) - 1, 2147483647}) {
+    for (bool update : {false, true}) {
+      for (auto filter : kFilters) {
+        for (int level = 0; level <= 6; ++level) {
+          for (int steps = 0; steps <= level; ++steps) {
+            const auto seed = static_cast<std::uint32_t>(level * 131 + steps * 7 + update);
+            auto g = random_grid(level, seed, range);
+            if (range == 2147483647) {  // every other row small: 32-bit and 64-bit lines side by side
+              const int n = (1 << level) + 1;
+              for (int j = 0; j < n; j += 2)
+                for (int i = 0; i < n; ++i) g[static_cast<std::size_t>(j * n + i)] >>= 12;
+            }
+            for (bool forward : {true, false}) {
+              auto fast = g, defined = g;
+              if (forward) {
+                wavelet_forward(fast, level, steps, filter, update);
+              } else {
+                wavelet_inverse(fast, level, steps, filter, update);
+              }
+              defined_transform(defined, level, steps, filter, update, forward);
+              ASSERT_EQ(fast, defined) << "range " << range << " update " << update << " level " << level
+                                       << " steps " << steps << (forward ? " forward" : " inverse");
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(Wavelet, RejectsWrongSizes) {
   std::vector<std::int32_t> g(10);
   EXPECT_THROW(wavelet_forward(g, 2, 1, WaveletFilter::kCubic), std::invalid_argument);

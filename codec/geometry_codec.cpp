@@ -377,35 +377,45 @@ struct FrameField {
         }
         wavelet_inverse(g[c], sub_level, sub_steps, filter, update);
       }
-      const auto at = [&](int c, int i, int j) {
-        return static_cast<std::int64_t>(  // i, j ≥ 0 multiples of s = 2^(min_k − 1)
-            g[c][static_cast<std::size_t>(j >> (min_k - 1)) * sub + static_cast<std::size_t>(i >> (min_k - 1))]);
-      };
+      // Sub-grid coordinates: position (i, j) of the grid is (i >> sh, j >> sh) of g, whose last index is ms.
+      const int sh = min_k - 1, ms = m >> sh;
+      const std::uint8_t* coded = own->coded[p].data();
+      auto& out = normals[p];
       for (int k = min_k; k <= frame_steps; ++k) {
         if (start[static_cast<std::size_t>(k - 1)] != plane) continue;
-        const int d = 1 << (k - 1);
-        for_step(k, [&](int i, int j, int idx) {
-          if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
-          const int i0 = std::max(i - d, 0), i1 = std::min(i + d, m), j0 = std::max(j - d, 0),
-                    j1 = std::min(j + d, m);
-          std::int64_t a[3], b[3];
+        const int d = 1 << (k - 1), dd = d >> sh;  // the step's spacing in the grid and in g
+        for (int j = 0; j <= m; j += d) {
+          const bool odd_row = (j / d) & 1;
+          const int y = j >> sh, y0 = std::max(y - dd, 0), y1 = std::min(y + dd, ms);
+          const std::int32_t *row[3], *below[3], *above[3];
           for (int c = 0; c < 3; ++c) {
-            a[c] = at(c, i1, j) - at(c, i0, j);
-            b[c] = at(c, i, j1) - at(c, i, j0);
+            row[c] = g[c].data() + static_cast<std::size_t>(y) * sub;
+            below[c] = g[c].data() + static_cast<std::size_t>(y0) * sub;
+            above[c] = g[c].data() + static_cast<std::size_t>(y1) * sub;
           }
-          // Differences of garbage (a corrupt stream) can reach 2^33: keep the cross product below 2^63.
-          // Never active for streams of this encoder (quantized values < 2^25).
-          for (std::int64_t* v : {a, b}) {
-            const auto largest =
-                static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}));
-            if (largest >> 30) {  // more than 30 bits
-              const int bits = static_cast<int>(std::bit_width(largest));
-              v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
+          const std::size_t line = static_cast<std::size_t>(j) * size;
+          for (int i = odd_row ? 0 : d; i <= m; i += odd_row ? d : 2 * d) {
+            if (!coded[line + static_cast<std::size_t>(i)]) continue;
+            const int x = i >> sh, x0 = std::max(x - dd, 0), x1 = std::min(x + dd, ms);
+            std::int64_t a[3], b[3];
+            for (int c = 0; c < 3; ++c) {
+              a[c] = std::int64_t{row[c][x1]} - row[c][x0];
+              b[c] = std::int64_t{above[c][x]} - below[c][x];
             }
-          }
-          normals[p][static_cast<std::size_t>(idx)] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+            // Differences of garbage (a corrupt stream) can reach 2^33: keep the cross product below 2^63.
+            // Never active for streams of this encoder (quantized values < 2^25).
+            for (std::int64_t* v : {a, b}) {
+              const auto largest =
+                  static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}));
+              if (largest >> 30) {  // more than 30 bits
+                const int bits = static_cast<int>(std::bit_width(largest));
+                v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
+              }
+            }
+            out[line + static_cast<std::size_t>(i)] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
                                                        a[0] * b[1] - a[1] * b[0]};
-        });
+          }
+        }
       }
     });
     for (int k = min_k; k <= frame_steps; ++k) {

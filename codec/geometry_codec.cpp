@@ -314,27 +314,33 @@ struct FrameField {
 
   /// Framed coefficients (n, t1, t2) of the ready steps, at coded positions, back to xyz (steps ≥ min_k).
   void to_xyz(std::vector<PatchCoefficients>& coefs, int min_k = 1) const {
+    const int m = 1 << level;
+    const std::size_t size = static_cast<std::size_t>(m) + 1;
     parallel_for(static_cast<int>(coefs.size()), max_threads, [&](int pi) {
       const auto p = static_cast<std::size_t>(pi);
+      const std::uint8_t* coded = own->coded[p].data();
+      std::int32_t* const ch[3] = {coefs[p][0].data(), coefs[p][1].data(), coefs[p][2].data()};
       for (int k = std::max(min_k, 1); k <= frame_steps; ++k) {
         if (!ready[static_cast<std::size_t>(k - 1)]) continue;
-        for_step(k, [&](int, int, int idx) {
-          if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
-          std::int64_t w[3];
-          for (int r = 0; r < 3; ++r)
-            w[r] = coefs[p][static_cast<std::size_t>(r)][static_cast<std::size_t>(idx)];
-          if (w[0] == 0 && w[1] == 0 && w[2] == 0) return;
-          const Frame& f = frame(p, idx);
-          w[1] *= std::int64_t{1} << tangential_shift;
-          w[2] *= std::int64_t{1} << tangential_shift;
-          for (int c = 0; c < 3; ++c) {
-            const std::int64_t v = static_cast<std::int64_t>(f[static_cast<std::size_t>(c)]) * w[0] +
-                                   static_cast<std::int64_t>(f[static_cast<std::size_t>(3 + c)]) * w[1] +
-                                   static_cast<std::int64_t>(f[static_cast<std::size_t>(6 + c)]) * w[2];
-            coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)] =
-                static_cast<std::int32_t>(static_cast<std::uint32_t>(round_shift(v, kFrameBits)));
+        const int d = 1 << (k - 1);  // the detail positions of step k, row by row (as for_step())
+        for (int j = 0; j <= m; j += d) {
+          const bool odd_row = (j / d) & 1;
+          const std::size_t line = static_cast<std::size_t>(j) * size;
+          for (int i = odd_row ? 0 : d; i <= m; i += odd_row ? d : 2 * d) {
+            const std::size_t idx = line + static_cast<std::size_t>(i);
+            if (!coded[idx] || (ch[0][idx] | ch[1][idx] | ch[2][idx]) == 0) continue;
+            const Frame& f = frame(p, static_cast<int>(idx));
+            const std::int64_t w0 = ch[0][idx],
+                               w1 = std::int64_t{ch[1][idx]} * (std::int64_t{1} << tangential_shift),
+                               w2 = std::int64_t{ch[2][idx]} * (std::int64_t{1} << tangential_shift);
+            for (int c = 0; c < 3; ++c) {
+              const std::int64_t v = std::int64_t{f[static_cast<std::size_t>(c)]} * w0 +
+                                     std::int64_t{f[static_cast<std::size_t>(3 + c)]} * w1 +
+                                     std::int64_t{f[static_cast<std::size_t>(6 + c)]} * w2;
+              ch[c][idx] = static_cast<std::int32_t>(static_cast<std::uint32_t>(round_shift(v, kFrameBits)));
+            }
           }
-        });
+        }
       }
     });
   }

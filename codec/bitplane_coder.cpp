@@ -1088,6 +1088,7 @@ struct BitplaneDecoder::State {
   std::size_t planes = 0, joint_planes = 0;  // joint_planes: segments of the joint coder
   int max_threads = 0;
   DecodeHook before_plane;
+  std::vector<PatchCoefficients> hook_view;  // the hooks' reconstruction: one buffer for all of them
   std::vector<std::vector<std::uint8_t>> coded;
   std::vector<Band> bands;  // never resized after the coders point into it
   std::unique_ptr<PlaneCoder<true>> joint;
@@ -1190,9 +1191,8 @@ Status BitplaneDecoder::update(std::span<const std::span<const std::uint8_t>> se
       st.hooks_run = true;
       for (int h : st.hooks) {
         if (static_cast<std::size_t>(st.top - h) == a && st.before_plane) {
-          std::vector<PatchCoefficients> v;
-          reconstruct(v);
-          st.before_plane(h, v);
+          reconstruct(st.hook_view);
+          st.before_plane(h, st.hook_view);
           ++st.hook_version;
         }
       }

@@ -814,8 +814,26 @@ void GeometryDecoder::build_result(int drop_finest_steps) {
         }
       }
       wavelet_inverse(ch, level, steps, header.filter, header.lifting_update);
+    }
+    // Dequantize, the three channels of a sample together (contiguous stores).
+    const auto& pc = coefs[static_cast<std::size_t>(p)];
+    const std::int32_t *x = pc[0].data(), *y = pc[1].data(), *z = pc[2].data();
+    const double ox = header.origin[0], oy = header.origin[1], oz = header.origin[2], step = header.step;
+    float* v = g.values.data();
+    constexpr double kMaxFloat = std::numeric_limits<float>::max();
+    if (std::max({std::abs(ox), std::abs(oy), std::abs(oz)}) + step * 0x1p31 < 0.5 * kMaxFloat) {
+      // Every int32 lands well inside the float range (any real pack), where to_float() is the plain
+      // conversion: without its branches the loop vectorizes.
       for (std::size_t i = 0; i < samples; ++i) {
-        g.values[3 * i + c] = to_float(header.origin[c] + header.step * static_cast<double>(ch[i]));
+        v[3 * i] = static_cast<float>(ox + step * static_cast<double>(x[i]));
+        v[3 * i + 1] = static_cast<float>(oy + step * static_cast<double>(y[i]));
+        v[3 * i + 2] = static_cast<float>(oz + step * static_cast<double>(z[i]));
+      }
+    } else {
+      for (std::size_t i = 0; i < samples; ++i) {
+        v[3 * i] = to_float(ox + step * static_cast<double>(x[i]));
+        v[3 * i + 1] = to_float(oy + step * static_cast<double>(y[i]));
+        v[3 * i + 2] = to_float(oz + step * static_cast<double>(z[i]));
       }
     }
   });

@@ -34,7 +34,7 @@ Taps taps(int t, int num_evens, bool cubic) {
 // when it starts: then no intermediate value of the step exceeds 5.2·2^23 in magnitude (an update adds at
 // most half the largest detail, a prediction 26/16 of the largest even), so no weighted sum (at most 26 times
 // an even) and no update sum reaches 2^31. Otherwise (garbage coefficients of a corrupt stream) the step
-// takes 64-bit sums. The results are the same either way: the 64-bit definition above, stored modulo 2^32.
+// takes 64-bit sums. The results are the same either way: the header's 64-bit definition, stored modulo 2^32.
 
 /// True when every v[i] lies in [−2^23, 2^23).
 bool fits_32(const std::int32_t* v, std::size_t n) {

@@ -10,22 +10,21 @@ namespace {
 
 using I64 = std::int64_t;
 
-/// The prediction of odd sample t (between evens t and t+1) of a line whose evens are e(0..E−1), as taps:
-/// (Σ w_k · e(at_k) + round) >> shift (arithmetic shift: floor division). Linear: (e(t) + e(t+1) + 1) >> 1;
-/// cubic (E ≥ 4): (−e(t−1) + 9 e(t) + 9 e(t+1) − e(t+2) + 8) >> 4 inside, the one-sided cubic at the ends.
+/// The prediction of odd sample t (between evens t and t+1) of a line whose evens are e(0..E−1): which evens
+/// it reads (at) and with which weights (kind). Linear: (e(t) + e(t+1) + 1) >> 1; cubic (E ≥ 4):
+/// (−e(t−1) + 9 e(t) + 9 e(t+1) − e(t+2) + 8) >> 4 inside, the one-sided (5 e(0) + 15 e(1) − 5 e(2) + e(3) +
+/// 8) >> 4 at the ends (mirrored at the far end). Arithmetic shifts: floor division.
 struct Taps {
+  enum Kind { kLinear, kOneSided, kInterior } kind;
   int at[4];
-  int w[4];
-  int round;
-  int shift;
 };
 
 Taps taps(int t, int num_evens, bool cubic) {
-  if (!cubic || num_evens < 4) return {{t, t + 1, t, t}, {1, 1, 0, 0}, 1, 1};
-  if (t == 0) return {{0, 1, 2, 3}, {5, 15, -5, 1}, 8, 4};
+  if (!cubic || num_evens < 4) return {Taps::kLinear, {t, t + 1, t, t}};
+  if (t == 0) return {Taps::kOneSided, {0, 1, 2, 3}};
   if (t == num_evens - 2)
-    return {{num_evens - 1, num_evens - 2, num_evens - 3, num_evens - 4}, {5, 15, -5, 1}, 8, 4};
-  return {{t - 1, t, t + 1, t + 2}, {-1, 9, 9, -1}, 8, 4};
+    return {Taps::kOneSided, {num_evens - 1, num_evens - 2, num_evens - 3, num_evens - 4}};
+  return {Taps::kInterior, {t - 1, t, t + 1, t + 2}};
 }
 
 // Speed (issue #16): every pass runs on contiguous memory (a row's evens and odds split into two buffers; the
@@ -75,19 +74,19 @@ void predict_line(std::int32_t* __restrict o, const std::int32_t* __restrict e, 
       add_wrapped<kSign>(o[m - 1], static_cast<std::uint32_t>(one_sided(e[m], e[m - 1], e[m - 2], e[m - 3])));
 }
 
-/// The prediction of a whole odd row from the even rows r[0..3] with taps p, n columns.
+/// The prediction of a whole odd row from the even rows r[k] = row at[k] of taps p, n columns.
 template <typename T, int kSign>
 void predict_rows(std::int32_t* __restrict o, const std::int32_t* const r[4], const Taps& p, int n) {
   const std::int32_t* __restrict a = r[0];
   const std::int32_t* __restrict b = r[1];
   const std::int32_t* __restrict c = r[2];
   const std::int32_t* __restrict d = r[3];
-  if (p.w[0] == -1) {  // the cubic interior (−1, 9, 9, −1)
+  if (p.kind == Taps::kInterior) {  // (−1, 9, 9, −1)
     for (int i = 0; i < n; ++i) {
       const T sum = 9 * (T{b[i]} + T{c[i]}) - T{a[i]} - T{d[i]};
       o[i] = add_wrapped<kSign>(o[i], static_cast<std::uint32_t>((sum + 8) >> 4));
     }
-  } else if (p.shift == 1) {  // linear: (1, 1) / 2 of a and b
+  } else if (p.kind == Taps::kLinear) {  // (1, 1) / 2 of a and b
     for (int i = 0; i < n; ++i)
       o[i] = add_wrapped<kSign>(o[i], static_cast<std::uint32_t>((T{a[i]} + T{b[i]} + 1) >> 1));
   } else {  // the one-sided cubic (5, 15, −5, 1)

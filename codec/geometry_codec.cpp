@@ -22,8 +22,8 @@ namespace {
 
 // Version 1: one joint bit-plane stream for all patches; version 2: a stream per patch (parallel decoding);
 // version 3: version 2 plus local frames and orientation weights; version 4: version 3 plus the lifting
-// update flag (bit 1 of the flags byte).
-constexpr std::uint8_t kHeaderVersion = 4;
+// update flag (bit 1 of the flags byte); version 5: version 4 plus the filter kCubicLong.
+constexpr std::uint8_t kHeaderVersion = 5;
 constexpr int kMaxTangentialShift = 8;
 constexpr int kMaxLevel = 12;
 constexpr int kMaxTopBitplane = 48;
@@ -134,7 +134,9 @@ bool header_ok(const GeometryCodecHeader& h) {
     return false;
   const std::uint64_t size = static_cast<std::uint64_t>(grid_size(h.level));
   if (static_cast<std::uint64_t>(h.num_patches) * size * size > kMaxTotalSamples) return false;
-  if (h.filter != WaveletFilter::kLinear && h.filter != WaveletFilter::kCubic) return false;
+  if (h.filter != WaveletFilter::kLinear && h.filter != WaveletFilter::kCubic &&
+      !(h.filter == WaveletFilter::kCubicLong && h.version >= 5))
+    return false;
   for (double o : h.origin) {
     if (!std::isfinite(o)) return false;
   }
@@ -381,7 +383,7 @@ struct FrameField {
           }
           g[c] = gathered[c];
         }
-        wavelet_inverse(g[c], sub_level, sub_steps, filter, update);
+        wavelet_inverse(g[c], sub_level, sub_steps, filter, update, min_k);
       }
       // Sub-grid coordinates: position (i, j) of the grid is (i >> sh, j >> sh) of g, whose last index is ms.
       const int sh = min_k - 1, ms = m >> sh;
@@ -521,7 +523,7 @@ Status GeometryCodecHeader::parse(std::span<const std::uint8_t> bytes, GeometryC
   if (!r.byte(version) || version < 1 || version > kHeaderVersion) return Status::kCorrupt;
   h.version = version;
   if (!r.small_int(h.level, kMaxLevel) || !r.small_int(h.num_patches, 1 << 20) ||
-      !r.small_int(h.steps, kMaxLevel) || !r.byte(filter) || filter > 1) {
+      !r.small_int(h.steps, kMaxLevel) || !r.byte(filter) || filter > (h.version >= 5 ? 2 : 1)) {
     return Status::kCorrupt;
   }
   h.filter = static_cast<WaveletFilter>(filter);

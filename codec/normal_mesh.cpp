@@ -32,7 +32,7 @@ double norm(const Point3d& a) {
 class StepView {
  public:
   StepView(Grid3& grid, int k, const Point3d& lo, double unit, WaveletFilter filter)
-      : grid_(grid), s_(1 << (k - 1)), level_(grid.level - k + 1), m_((1 << level_) + 1), lo_(lo),
+      : grid_(grid), k_(k), s_(1 << (k - 1)), level_(grid.level - k + 1), m_((1 << level_) + 1), lo_(lo),
         unit_(unit), filter_(filter), p_(3 * cells()), q_(3 * cells()) {}
 
   int m() const { return m_; }
@@ -46,14 +46,14 @@ class StepView {
         }
       }
       b = a;
-      wavelet_forward(b, level_, 1, filter_);
+      wavelet_forward(b, level_, 1, filter_, false, k_);
       for (std::size_t i = 0; i < cells(); ++i) {
         // Evens keep their value (no update step): P = a there; odd positions hold the detail a − P.
         p_[3 * i + c] = lo_[c] + static_cast<double>(static_cast<std::int64_t>(a[i]) - (odd(i) ? b[i] : 0)) * unit_;
         if (odd(i)) b[i] = 0;
       }
       if (!subdivide) continue;
-      wavelet_inverse(b, level_, 1, filter_);
+      wavelet_inverse(b, level_, 1, filter_, false, k_);
       for (std::size_t i = 0; i < cells(); ++i) q_[3 * i + c] = lo_[c] + static_cast<double>(b[i]) * unit_;
     }
   }
@@ -74,7 +74,7 @@ class StepView {
   }
 
   Grid3& grid_;
-  int s_, level_, m_;
+  int k_, s_, level_, m_;  // k_: the wavelet step this view predicts (kCubicLong differs by step)
   Point3d lo_;
   double unit_;
   WaveletFilter filter_;

@@ -51,7 +51,7 @@ struct NormalMeshOptions {
   double max_shift = 0.5;
   /// The prediction filter; must be the codec's (GeometryCodecOptions::filter) for the details to come out
   /// normal.
-  WaveletFilter filter = WaveletFilter::kCubic;
+  WaveletFilter filter = WaveletFilter::kCubicLong;
   /// Worker threads (0 = one per hardware thread).
   int threads = 0;
 };

@@ -386,10 +386,13 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
         !read_codec_header(r, model.geometry, out.version) || !r.u8(has_normals) || has_normals > 1)
       return Status::kCorrupt;
     // Pack version v ≤ 3 holds codec headers of version v (1: joint streams, 2: per-patch ones, 3: local
-    // frames); version 4 (a container change) those of version 3; version 5 those of version 3 or later
-    // (4: the lifting update).
+    // frames); version 4 (a container change) those of version 3; version 5 those of versions 3 and 4 (4:
+    // the lifting update); version 6 those of versions 3 to 5 (5: the filter kCubicLong).
     const auto codec_version_ok = [&](int v) {
-      return out.version >= 5 ? v >= 3 : out.version == 4 ? v == 3 : v == out.version;
+      return out.version >= 6   ? v >= 3
+             : out.version == 5 ? v == 3 || v == 4
+             : out.version == 4 ? v == 3
+                                : v == out.version;
     };
     if (!codec_version_ok(model.geometry.version)) return Status::kCorrupt;
     if (model.geometry.level > kMaxPackLevel || passes_of(model.geometry) < 1 ||

@@ -46,15 +46,17 @@ namespace geomip::codec {
 /// this many bytes of a pack (or all of a shorter source) can always read the fixed header, and the
 /// manifest always ends at or after it.
 inline constexpr std::size_t kPackHeaderSize = 20;
-/// Format version written. Version 5 (this one): version 4's container, codec headers of version 3 or later
-/// (the encoder writes 4: the wavelet's lifting update, docs/codec-v3.md "Lifting update"); an older reader
-/// says "unsupported version" instead of failing on the codec header. Version 4: the header diet — CRC32
+/// Format version written. Version 6 (this one): version 4's container, codec headers of versions 3 to 5 (the
+/// encoder writes 5: the geometry's wavelet filter kCubicLong, docs/codec-v3.md "Longer lifting filters").
+/// Version 5: the same container, codec headers of versions 3 and 4 (4: the wavelet's lifting update,
+/// docs/codec-v3.md "Lifting update"); each bump lets an older reader say "unsupported version" instead of
+/// failing on the codec header. Version 4: the header diet — CRC32
 /// trailers per chunk group instead of a CRC per chunk in the up-front table, a varint manifest size,
 /// compact doubles and codec headers (above); codec headers of version 3. Version 3: codec header version 3 (local frames,
 /// orientation weights; docs/codec-v3.md). Version 2: bit-plane segments hold one stream per patch (codec
-/// header version 2), decoded in parallel. Version 1: one joint stream per segment. Versions 1–4 are still
+/// header version 2), decoded in parallel. Version 1: one joint stream per segment. Versions 1–5 are still
 /// read. "Version 4" in the layout notes means versions 4 and later.
-inline constexpr std::uint16_t kPackVersion = 5;
+inline constexpr std::uint16_t kPackVersion = 6;
 inline constexpr std::uint16_t kOldestPackVersion = 1;
 
 enum class ChunkKind : std::uint8_t {

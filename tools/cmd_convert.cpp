@@ -37,6 +37,7 @@ struct ConvertArgs {
   int tangential_shift = ConvertOptions{}.tangential_shift;
   bool no_orientation_weights = false;
   bool no_lifting_update = false;
+  bool short_filter = false;
   bool fit = false;
   bool choose_loop = false;  ///< --choose-loop: the plain, tip or end loop, whichever prefixes are closest
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
@@ -160,6 +161,7 @@ int run_convert(const ConvertArgs& args) {
   options.tangential_shift = args.tangential_shift;
   options.orientation_weights = !args.no_orientation_weights;
   options.lifting_update = !args.no_lifting_update;
+  if (args.short_filter) options.filter = codec::WaveletFilter::kCubic;
   options.fit = args.fit;
   options.up = up;
   options.front = front;
@@ -297,7 +299,11 @@ CommandRunner add_convert_command(CLI::App& app) {
                 "Weigh row/column and diagonal detail bands alike (ablations)");
   cmd->add_flag("--no-lifting-update", args->no_lifting_update,
                 "Code the geometry with the plain interpolating wavelet, without the update step (ablations; "
-                "the pack is still format 5)");
+                "the pack is still format 6)");
+  cmd->add_flag("--short-filter", args->short_filter,
+                "Code the geometry with pack format 5's 4-point wavelet filter on every step and its 2-tap update, "
+                "not the 6-point prediction of the coarser steps and the 4-tap update (ablations; the pack is "
+                "still format 6)");
   cmd->add_flag("--choose-loop", args->choose_loop,
                 "One mesh, two squares: build the pack with the plain loop, with --tip-loop and with --end-loop "
                 "(each when the mesh has tips) and keep the one whose 2, 4, 8 and 16 KB prefixes are closest to "

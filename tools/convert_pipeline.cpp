@@ -38,6 +38,7 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
   codec::NormalMeshOptions normal;
   normal.steps = steps;
   normal.max_shift = options.normal_mesh_max_shift;
+  normal.filter = options.filter;  // the filter write_pack() codes with (below)
   double shift_sum = result.normal_mesh_mean_shift * static_cast<double>(result.normal_mesh_moved);
   for (GeometryImage& image : images.geometry) {
     codec::Grid3 grid{image.level, std::move(image.values)};
@@ -161,6 +162,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   write.geometry.tangential_shift = options.tangential_shift;
   write.geometry.orientation_weights = options.orientation_weights;
   write.geometry.lifting_update = options.lifting_update;
+  write.geometry.filter = options.filter;
   result.pack = codec::write_pack(inputs, write);
   result.encode_seconds = seconds_since(t0);
   if (options.keep_inputs) result.inputs = std::move(inputs);

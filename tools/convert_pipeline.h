@@ -31,6 +31,9 @@ struct ConvertOptions {
   int tangential_shift = codec::GeometryCodecOptions{}.tangential_shift;
   bool orientation_weights = codec::GeometryCodecOptions{}.orientation_weights;
   bool lifting_update = codec::GeometryCodecOptions{}.lifting_update;
+  /// The geometry's wavelet filter (kCubicLong by default; kCubic for ablations); the normal-mesh
+  /// resampling predicts with the same one.
+  codec::WaveletFilter filter = codec::GeometryCodecOptions{}.filter;
   /// Level of the hole-mask grid (repaired meshes); -1 = the geometry's level.
   int hole_mask_level = -1;
   /// Curvature sampling exponent of the parameterization (SamplingWeightOptions::exponent; 0 = off, the

@@ -1,15 +1,15 @@
 // Writes a golden pack of pack_test's GoldenPackDecodes: two pillows (level 5, scales 1 and 2) with normal
 // maps. Run by hand once per pack format version, to a new file (old ones stay: old packs must keep
 // decoding):
-//   ./build/tests/make_golden_pack tests/data/golden-pillow-v5.gip   (format version 5)
+//   ./build/tests/make_golden_pack tests/data/golden-pillow-v6.gip   (format version 6)
 // (tests/data/golden-pillow.gip was written by format version 1, golden-pillow-v2.gip by version 2,
-// golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4.)
+// golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by version 5.)
 // With --per-patch, a small fuzzer seed instead: one level-4 pillow with normal maps whose joint part ends
 // after 64 bytes, so most of its bytes are per-patch streams (the other seeds are smaller than the default
 // 2 KB joint part) — tests/fuzz/seeds/pack/pillow-l4-per-patch.gip (format 3),
 // pillow-l4-per-patch-v4.gip (format 4, its CRC groups and trailers), pillow-l4-per-patch-v5.gip (format 5,
-// the lifting update):
-//   ./build/tests/make_golden_pack --per-patch tests/fuzz/seeds/pack/pillow-l4-per-patch-v5.gip
+// the lifting update), pillow-l4-per-patch-v6.gip (format 6, the filter kCubicLong):
+//   ./build/tests/make_golden_pack --per-patch tests/fuzz/seeds/pack/pillow-l4-per-patch-v6.gip
 #include "codec/pack.h"
 #include "tests/codec/pillow.h"
 

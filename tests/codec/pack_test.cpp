@@ -527,7 +527,8 @@ TEST(PackPerPatch, EverySingleBitFlipIsRefusedOrACoarserModel) {
 
 // The committed golden packs (tests/data/golden-pillow.gip written by format version 1, golden-pillow-v2.gip
 // by version 2, golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by
-// version 5: codec header version 4, the lifting update) must keep decoding to
+// version 5: codec header version 4, the lifting update; golden-pillow-v6.gip by version 6: codec header
+// version 5, the filter kCubicLong) must keep decoding to
 // the pillow they were made from: decoders of old streams do not silently change.
 class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
 
@@ -540,7 +541,8 @@ TEST_P(GoldenPack, Decodes) {
   PackInfo info;
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   EXPECT_EQ(info.version, version);
-  EXPECT_EQ(info.models.at(0).geometry.version, version >= 5 ? 4 : std::min(version, 3));
+  EXPECT_EQ(info.models.at(0).geometry.version, version >= 6 ? 5 : version >= 5 ? 4 : std::min(version, 3));
+  EXPECT_EQ(info.models.at(0).geometry.filter, version >= 6 ? WaveletFilter::kCubicLong : WaveletFilter::kCubic);
   EXPECT_EQ(info.models.at(0).geometry.lifting_update, version >= 5);
   const PackDecodeResult r = decode_pack(pack);
   ASSERT_EQ(r.status, Status::kOk);
@@ -569,7 +571,8 @@ INSTANTIATE_TEST_SUITE_P(Versions, GoldenPack,
                                            std::pair<const char*, int>{"golden-pillow-v2.gip", 2},
                                            std::pair<const char*, int>{"golden-pillow-v3.gip", 3},
                                            std::pair<const char*, int>{"golden-pillow-v4.gip", 4},
-                                           std::pair<const char*, int>{"golden-pillow-v5.gip", 5}));
+                                           std::pair<const char*, int>{"golden-pillow-v5.gip", 5},
+                                           std::pair<const char*, int>{"golden-pillow-v6.gip", 6}));
 
 }  // namespace
 }  // namespace geomip::codec

@@ -97,11 +97,11 @@ void predict_line(std::int32_t* __restrict o, const std::int32_t* __restrict e, 
   }
   const auto one_sided = [](T a, T b, T c, T d) { return (5 * a + 15 * b - 5 * c + d + 8) >> 4; };
   o[0] = add_wrapped<kSign>(o[0], static_cast<std::uint32_t>(one_sided(e[0], e[1], e[2], e[3])));
+  const auto four = [&](int t) {  // (−1, 9, 9, −1)
+    const T sum = 9 * (T{e[t]} + T{e[t + 1]}) - T{e[t - 1]} - T{e[t + 2]};
+    o[t] = add_wrapped<kSign>(o[t], static_cast<std::uint32_t>((sum + 8) >> 4));
+  };
   if (kind.six && m + 1 >= 6) {  // the 4-point prediction at t = 1 and m − 2, the 6-point one between
-    const auto four = [&](int t) {
-      const T sum = 9 * (T{e[t]} + T{e[t + 1]}) - T{e[t - 1]} - T{e[t + 2]};
-      o[t] = add_wrapped<kSign>(o[t], static_cast<std::uint32_t>((sum + 8) >> 4));
-    };
     four(1);
     for (int t = 2; t + 3 <= m; ++t) {
       const T sum =
@@ -110,10 +110,7 @@ void predict_line(std::int32_t* __restrict o, const std::int32_t* __restrict e, 
     }
     four(m - 2);
   } else {
-    for (int t = 1; t + 1 < m; ++t) {
-      const T sum = 9 * (T{e[t]} + T{e[t + 1]}) - T{e[t - 1]} - T{e[t + 2]};
-      o[t] = add_wrapped<kSign>(o[t], static_cast<std::uint32_t>((sum + 8) >> 4));
-    }
+    for (int t = 1; t + 1 < m; ++t) four(t);
   }
   o[m - 1] =
       add_wrapped<kSign>(o[m - 1], static_cast<std::uint32_t>(one_sided(e[m], e[m - 1], e[m - 2], e[m - 3])));

@@ -7,6 +7,7 @@
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/convert_pipeline.h"
+#include "tools/convert_search.h"
 #include "tools/model_inputs.h"
 #include "tools/pack_models.h"
 #include "tools/progress.h"
@@ -40,6 +41,7 @@ struct ConvertArgs {
   bool short_filter = false;
   bool fit = false;
   bool choose_loop = false;  ///< --choose-loop: the plain, tip or end loop, whichever prefixes are closest
+  bool search = false;       ///< --search: the loops, the 8-patch layout and the fit (tools/convert_search.h)
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
   std::string front;  ///< +x, -x, +y, -y, +z, -z; empty: from the shape
 };
@@ -67,21 +69,6 @@ std::string format_db(double db) {
   char text[32];
   std::snprintf(text, sizeof text, "%.2f dB", db);
   return text;
-}
-
-/// Mean PSNR (dB) of `pack`'s geometry decoded from each prefix in `sizes`, against `reference`.
-double mean_prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
-                        const TriMesh& reference) {
-  double sum = 0.0;
-  for (std::size_t size : sizes) {
-    codec::PackDecodeOptions decode;
-    decode.max_bytes = size;
-    decode.normals = false;
-    const codec::PackDecodeResult result = codec::decode_pack(pack, decode);
-    if (result.models.empty()) throw SolverFailure("convert --choose-loop: a prefix of the pack does not decode");
-    sum += measure_surface_distance(reference, decoded_mesh(result.models.front())).psnr_db;
-  }
-  return sum / static_cast<double>(sizes.size());
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -112,36 +99,30 @@ int run_convert(const ConvertArgs& args) {
                            args.common.patches != 2 || loop_asked != LoopKind::kPlain))
     throw InvalidInput("--choose-loop compares the automatic two-square loops of one mesh: give one MESH, "
                        "without --points, --patches, --tip-loop or --end-loop");
+  if (args.search && (args.choose_loop || args.common.meshes.size() != 1 || !args.common.points.empty() ||
+                      args.common.patches != 2 || loop_asked != LoopKind::kPlain || args.fit))
+    throw InvalidInput("--search chooses the layout and the fit of one mesh itself: give one MESH, without "
+                       "--points, --patches, --tip-loop, --end-loop, --fit or --choose-loop");
   const bool report = !args.common.quiet && !args.common.json;
   const auto t_start = std::chrono::steady_clock::now();
-  PreparedModels models =
-      prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches, loop_asked);
   auto slide_rounds = [&](LoopKind kind) {
     return args.common.slide_seams >= 0 ? args.common.slide_seams : default_seam_slide_rounds(kind);
   };
-  // --choose-loop: the tip loop and the end loop as further candidates, each when the mesh has tips for it
-  // and it differs from the ones before (otherwise it would build the same pack again).
-  std::vector<std::pair<LoopKind, PreparedModels>> candidates;
-  if (args.choose_loop) {
-    for (LoopKind kind : {LoopKind::kTips, LoopKind::kEnds}) {
-      PreparedModels m = prepare_models(args.common.meshes, "", "geomip convert", true, 2, kind);
-      const ParameterizationInput& in = m.inputs.front();
-      if (in.side_guides.empty()) continue;
-      bool seen = false;
-      for (const auto& [k, other] : candidates) {
-        const ParameterizationInput& o = other.inputs.front();
-        seen = seen || (o.partition_points == in.partition_points && o.side_guides == in.side_guides &&
-                        slide_rounds(k) == slide_rounds(kind));
-      }
-      if (!seen) candidates.emplace_back(kind, std::move(m));
-    }
-  }
+  const bool searching = args.choose_loop || args.search;
+  // Without a search: the models now, so that bad input fails before the frame checks below.
+  PreparedModels models;
+  if (!searching)
+    models = prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches,
+                            loop_asked);
 
   const std::optional<UpAxis> up = up_axis(args);
   const Eigen::Vector3d front = front_axis(args);
-  if (!front.isZero() && !models.inputs.empty()) {
+  if (!front.isZero()) {
     if (!up) throw InvalidInput("--front " + args.front + " needs a stored frame: --up x, y, z or auto");
-    if (!upright_rotation(view_frame_mesh(models), *up, front).row(0).transpose().isApprox(front))
+    const PreparedModels frame_models =
+        searching ? prepare_models(args.common.meshes, "", "geomip convert", true) : PreparedModels{};
+    const PreparedModels& m = searching ? frame_models : models;
+    if (!m.inputs.empty() && !upright_rotation(view_frame_mesh(m), *up, front).row(0).transpose().isApprox(front))
       throw InvalidInput("--front " + args.front + " is along the up axis; name one of the other two axes");
   }
 
@@ -166,43 +147,43 @@ int run_convert(const ConvertArgs& args) {
   options.up = up;
   options.front = front;
   options.progress = bar.callback();
-  ConvertResult converted = convert_models(models, options);
-  std::string loop = args.choose_loop ? "plain" : "";
-  // Mean PSNR of each loop's 2–16 KB prefixes (NaN: not built, e.g. a mesh without tips).
+  ConvertResult converted;
+  std::optional<SearchResult> searched;
+  int level = args.level;
+  if (searching) {
+    SearchOptions search;
+    search.loops = true;
+    search.layout_patches = args.search ? 8 : 0;
+    search.fit = args.search;  // --choose-loop --fit: every loop fitted (options.fit)
+    if (args.search) {
+      search.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));
+    } else {
+      search.sizes.assign(std::begin(kChooseLoopSizes), std::end(kChooseLoopSizes));
+    }
+    search.slide_seams = args.common.slide_seams;
+    if (report && args.search)
+      search.log = [&bar](const std::string& line) {
+        bar.finish();
+        std::fprintf(stderr, "%s\n", line.c_str());
+      };
+    searched = search_conversion(args.common.meshes.front(), options, search, !report);
+    converted = std::move(searched->converted);
+    models = std::move(searched->models);
+    level = searched->chosen.level;
+  } else {
+    converted = convert_models(models, options);
+  }
+  // --choose-loop's report: the mean PSNR of each loop (NaN: not built, e.g. a mesh without tips).
+  std::string loop = searched ? std::string(searched->chosen.patches == 2 ? "" : "none") : "";
   double plain_psnr = NAN, tip_psnr = NAN, end_psnr = NAN;
-  if (!candidates.empty()) {
-    std::vector<ConvertResult> built;
-    std::size_t smallest = converted.pack.size();
-    for (auto& [kind, m] : candidates) {
-      ConvertOptions o = options;
-      o.seam_slide_rounds = slide_rounds(kind);
-      built.push_back(convert_models(m, o));
-      smallest = std::min(smallest, built.back().pack.size());
+  if (searched) {
+    for (const CandidateScore& s : searched->scores) {
+      if (s.candidate.patches != 2 || s.candidate.fit != searched->chosen.fit) continue;
+      (s.candidate.loop == LoopKind::kTips ? tip_psnr : s.candidate.loop == LoopKind::kEnds ? end_psnr : plain_psnr) =
+          s.mean_psnr_db;
     }
-    const TriMesh& reference =
-        models.originals.front().positions.empty() ? models.inputs.front().mesh : models.originals.front();
-    std::vector<std::size_t> sizes;
-    for (std::size_t size : kChooseLoopSizes) {
-      if (size < smallest) sizes.push_back(size);
-    }
-    if (sizes.empty()) sizes.push_back(smallest);
-    plain_psnr = mean_prefix_psnr(converted.pack, sizes, reference);
-    double best = plain_psnr;
-    std::size_t chosen = candidates.size();  // none: the plain loop
-    for (std::size_t c = 0; c < candidates.size(); ++c) {
-      const double psnr = mean_prefix_psnr(built[c].pack, sizes, reference);
-      (candidates[c].first == LoopKind::kTips ? tip_psnr : end_psnr) = psnr;
-      if (psnr > best) {
-        best = psnr;
-        chosen = c;
-      }
-    }
-    // Only now: `reference` may be a mesh of `models`.
-    if (chosen < candidates.size()) {
-      converted = std::move(built[chosen]);
-      models = std::move(candidates[chosen].second);
-      loop = candidates[chosen].first == LoopKind::kTips ? "tips" : "ends";
-    }
+    if (searched->chosen.patches == 2)
+      loop = searched->chosen.loop == LoopKind::kTips ? "tips" : searched->chosen.loop == LoopKind::kEnds ? "ends" : "plain";
   }
   const std::vector<std::uint8_t>& pack = converted.pack;
   write_file_atomically(args.common.output, [&](std::ostream& out) {
@@ -212,6 +193,25 @@ int run_convert(const ConvertArgs& args) {
 
   codec::PackInfo info;
   codec::read_pack_info(pack, info);
+  nlohmann::json search_json = nullptr;  // --search / --choose-loop: every candidate and the choice
+  if (searched) {
+    nlohmann::json candidates = nlohmann::json::array();
+    for (const CandidateScore& c : searched->scores) {
+      nlohmann::json psnr = nlohmann::json::array();
+      for (double p : c.psnr_db) psnr.push_back(std::isfinite(p) ? nlohmann::json(p) : nlohmann::json(nullptr));
+      candidates.push_back({{"name", c.candidate.name(args.level)},
+                            {"switches", c.candidate.switches(args.level)},
+                            {"mean_psnr_db", std::isfinite(c.mean_psnr_db) ? nlohmann::json(c.mean_psnr_db)
+                                                                           : nlohmann::json(nullptr)},
+                            {"psnr_db", psnr},
+                            {"geometry_bytes", c.pack_bytes},
+                            {"seconds", c.seconds}});
+    }
+    search_json = {{"chosen", searched->chosen.name(args.level)},
+                   {"switches", searched->chosen.switches(args.level)},
+                   {"sizes", searched->sizes},
+                   {"candidates", candidates}};
+  }
   if (args.common.json) {
     nlohmann::json j_models = nlohmann::json::array();
     for (std::size_t m = 0; m < models.inputs.size(); ++m)
@@ -222,7 +222,7 @@ int run_convert(const ConvertArgs& args) {
                                 {"bytes", pack.size()},
                                 {"manifest_bytes", info.manifest_end},
                                 {"chunks", info.chunks.size()},
-                                {"level", args.level},
+                                {"level", level},
                                 {"normals", !args.no_normals},
                                 {"models", j_models},
                                 {"normal_mesh", {{"steps", converted.normal_mesh_steps},
@@ -233,6 +233,7 @@ int run_convert(const ConvertArgs& args) {
                                 {"loop_psnr_db", {{"plain", std::isfinite(plain_psnr) ? nlohmann::json(plain_psnr) : nlohmann::json(nullptr)},
                                                   {"tips", std::isfinite(tip_psnr) ? nlohmann::json(tip_psnr) : nlohmann::json(nullptr)},
                                                   {"ends", std::isfinite(end_psnr) ? nlohmann::json(end_psnr) : nlohmann::json(nullptr)}}},
+                                {"search", search_json},
                                 {"param_seconds", converted.param_seconds},
                                 {"resample_seconds", converted.resample_seconds},
                                 {"encode_seconds", converted.encode_seconds},
@@ -241,7 +242,7 @@ int run_convert(const ConvertArgs& args) {
               << "\n";
   } else if (report) {
     std::printf("convert %zu model(s) → %s: %zu bytes (manifest %zu, %zu chunks), level %d%s\n", models.inputs.size(),
-                args.common.output.c_str(), pack.size(), info.manifest_end, info.chunks.size(), args.level,
+                args.common.output.c_str(), pack.size(), info.manifest_end, info.chunks.size(), level,
                 args.no_normals ? ", geometry only" : ", with normal maps");
     std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
                 converted.resample_seconds, converted.encode_seconds);
@@ -254,6 +255,14 @@ int run_convert(const ConvertArgs& args) {
       } else {
         std::printf("loop: plain (no protrusion tips found)\n");
       }
+    }
+    if (args.search) {
+      std::string sizes;
+      for (std::size_t n : searched->sizes) sizes += (sizes.empty() ? "" : ", ") + std::to_string(n);
+      const std::string switches = searched->chosen.switches(args.level);
+      std::printf("search: %s (%s; the highest mean PSNR of the prefixes of %s bytes)\n",
+                  searched->chosen.name(args.level).c_str(),
+                  switches.empty() ? "the defaults" : switches.c_str(), sizes.c_str());
     }
   }
   return kExitOk;
@@ -308,6 +317,11 @@ CommandRunner add_convert_command(CLI::App& app) {
                 "One mesh, two squares: build the pack with the plain loop, with --tip-loop and with --end-loop "
                 "(each when the mesh has tips) and keep the one whose 2, 4, 8 and 16 KB prefixes are closest to "
                 "the mesh (mean PSNR); up to three times the time");
+  cmd->add_flag("--search", args->search,
+                "One mesh: build the pack with each two-square loop (plain, --tip-loop, --end-loop) and the "
+                "automatic 8-patch layout one level coarser (the same samples), then the best of them with --fit, "
+                "and keep the one whose 1.5, 2, 4.7, 8.8, 16 and 32 KB geometry prefixes are closest to the mesh "
+                "(mean PSNR; tools/convert_search.h); several pipelines: about a minute for the horse");
   cmd->add_option(
          "--up", args->up,
          "The models' up axis, stored with the front in each model's normalization (the viewer's frame; "

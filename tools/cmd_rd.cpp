@@ -19,6 +19,7 @@
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/convert_pipeline.h"
+#include "tools/convert_search.h"
 #include "tools/model_inputs.h"
 #include "tools/pack_models.h"
 #include "tools/progress.h"
@@ -36,6 +37,7 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -60,6 +62,7 @@ struct RdArgs {
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
   bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)
   bool end_loop = false;    // geomip: the loop through the ends (--end-loop, as `geomip convert`)
+  bool search = false;      // geomip: the best of the loops, the 8-patch layout and the fit (--search)
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -196,9 +199,10 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
 
 /// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only pack),
 /// then one job per prefix size: decode the first N bytes and build the level-N mesh.
+/// `search`: the pack of search_conversion() (the loops, the 8-patch layout, the fit), its choice in `chosen`.
 Series geomip_series(const std::string& mesh_path, int level, int patches, LoopKind loop, int normal_mesh_steps,
-                     bool fit, bool quick, std::vector<std::uint8_t>& pack_out, ProgressBar& progress) {
-  const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches, loop);
+                     bool fit, bool search, bool quick, std::vector<std::uint8_t>& pack_out,
+                     std::optional<SearchResult>& chosen, ProgressBar& progress) {
   ConvertOptions options;
   options.seam_slide_rounds = default_seam_slide_rounds(loop);
   options.level = level;
@@ -206,7 +210,18 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, LoopK
   options.normal_mesh_steps = normal_mesh_steps;
   options.fit = fit;
   options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
-  auto pack = std::make_shared<const std::vector<std::uint8_t>>(convert_models(models, options).pack);
+  std::shared_ptr<const std::vector<std::uint8_t>> pack;
+  if (search) {
+    SearchOptions s;
+    s.layout_patches = 8;
+    s.fit = true;
+    s.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));
+    chosen = search_conversion(mesh_path, options, s, true);
+    pack = std::make_shared<const std::vector<std::uint8_t>>(chosen->converted.pack);
+  } else {
+    const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches, loop);
+    pack = std::make_shared<const std::vector<std::uint8_t>>(convert_models(models, options).pack);
+  }
   pack_out = *pack;
   codec::PackInfo info;
   codec::read_pack_info(*pack, info);
@@ -284,6 +299,9 @@ int run_rd(const RdArgs& args) {
   // Before the baselines' work: bad loop options fail at once.
   const LoopKind loop = loop_kind(args.tip_loop, args.end_loop);
   check_loop_patches(loop, args.patches);
+  if (args.search && (args.patches != 2 || loop != LoopKind::kPlain || args.fit))
+    throw InvalidInput("--search chooses the layout and the fit itself: not with --patches, --tip-loop, "
+                       "--end-loop or --fit");
   const auto start = std::chrono::steady_clock::now();
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
   const unsigned threads =
@@ -293,9 +311,10 @@ int run_rd(const RdArgs& args) {
   ProgressBar progress("rd", !args.json);
   std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
+  std::optional<SearchResult> searched;
   if (!args.no_geomip)
-    plan.push_back(geomip_series(args.mesh, args.level, args.patches, loop, args.normal_mesh_steps, args.fit, args.quick,
-                                 pack, progress));
+    plan.push_back(geomip_series(args.mesh, args.level, args.patches, loop, args.normal_mesh_steps, args.fit,
+                                 args.search, args.quick, pack, searched, progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -368,21 +387,33 @@ int run_rd(const RdArgs& args) {
     });
   }
 
-  // geomip against the Draco envelope at the sizes issue 5 names (staircase readings of both curves).
-  std::vector<RdPoint> geomip_points, envelope_points;
+  // geomip against the Draco envelopes at the sizes issues 5 and 14 name (staircase readings of the curves):
+  // draco_envelope (meshoptimizer's decimation) always, draco_lt_envelope (Lindstrom–Turk, the stronger
+  // baseline) with --lindstrom-turk.
+  std::vector<RdPoint> geomip_points, envelope_points, lt_points;
   for (const RdPoint& p : all) {
     if (p.method == "geomip") geomip_points.push_back(p);
     if (p.method == "draco_envelope") envelope_points.push_back(p);
+    if (p.method == "draco_lt_envelope") lt_points.push_back(p);
   }
   const std::vector<RdPoint> geomip_front = upper_envelope(geomip_points);
-  nlohmann::json comparison = nlohmann::json::array();
+  nlohmann::json comparison = nlohmann::json::array(), lt_comparison = nlohmann::json::array();
   std::string comparison_text;
   if (!geomip_front.empty() && !envelope_points.empty()) {
-    comparison_text = format("%-9s %12s %16s %8s\n", "bytes", "geomip dB", "draco_envelope dB", "margin");
-    for (std::size_t size : {1500, 2000, 4700, 8800, 12000, 16000, 21100, 32800, 42800}) {
+    comparison_text = format("%-9s %12s %16s %8s", "bytes", "geomip dB", "draco_envelope dB", "margin");
+    if (!lt_points.empty()) comparison_text += format(" %19s %8s", "draco_lt_envelope dB", "margin");
+    comparison_text += "\n";
+    for (std::size_t size : {1500, 2000, 4700, 8800, 12000, 16000, 21100, 32000, 32800, 42800}) {
       const double g = envelope_at(geomip_front, size), d = envelope_at(envelope_points, size);
       comparison.push_back({{"bytes", size}, {"geomip_db", g}, {"draco_envelope_db", d}, {"margin_db", g - d}});
-      comparison_text += format("%-9zu %12.2f %16.2f %+8.2f\n", size, g, d, g - d);
+      comparison_text += format("%-9zu %12.2f %16.2f %+8.2f", size, g, d, g - d);
+      if (!lt_points.empty()) {
+        const double l = envelope_at(lt_points, size);
+        lt_comparison.push_back(
+            {{"bytes", size}, {"geomip_db", g}, {"draco_lt_envelope_db", l}, {"margin_db", g - l}});
+        comparison_text += format(" %19.2f %+8.2f", l, g - l);
+      }
+      comparison_text += "\n";
     }
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -397,6 +428,19 @@ int run_rd(const RdArgs& args) {
     j["seconds"] = seconds;
     if (!pack.empty()) j["pack"] = pack_path;
     j["geomip_vs_draco_envelope"] = comparison;
+    if (!lt_points.empty()) j["geomip_vs_draco_lt_envelope"] = lt_comparison;
+    if (searched) {
+      nlohmann::json candidates = nlohmann::json::array();
+      for (const CandidateScore& c : searched->scores)
+        candidates.push_back({{"name", c.candidate.name(args.level)},
+                              {"switches", c.candidate.switches(args.level)},
+                              {"mean_psnr_db", std::isfinite(c.mean_psnr_db) ? nlohmann::json(c.mean_psnr_db)
+                                                                             : nlohmann::json(nullptr)}});
+      j["search"] = {{"chosen", searched->chosen.name(args.level)},
+                     {"switches", searched->chosen.switches(args.level)},
+                     {"sizes", searched->sizes},
+                     {"candidates", candidates}};
+    }
     j["points"] = nlohmann::json::array();
     for (const RdPoint& p : all) j["points"].push_back(point_to_json(p));
     std::cout << j.dump(2) << "\n";
@@ -413,6 +457,13 @@ int run_rd(const RdArgs& args) {
       continue;
     }
     std::cout << point_row(p);
+  }
+  if (searched) {
+    std::string scores;
+    for (const CandidateScore& c : searched->scores)
+      scores += (scores.empty() ? "" : ", ") + c.candidate.name(args.level) + format(" %.2f dB", c.mean_psnr_db);
+    std::cout << "geomip pack: " << searched->chosen.name(args.level) << " (--search; mean PSNR of its "
+              << searched->sizes.size() << " scored prefixes: " << scores << ")\n";
   }
   std::cout << "(" << candidates << " decimate-then-Draco points, the envelopes' candidates, are in rd.csv)\n"
             << comparison_text
@@ -454,6 +505,9 @@ CommandRunner add_rd_command(CLI::App& app) {
   add_patches_option(cmd, args->patches);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");
   cmd->add_flag("--end-loop", args->end_loop, "geomip: the two-square loop through the ends (as `geomip convert --end-loop`)");
+  cmd->add_flag("--search", args->search,
+                "geomip: the pack `geomip convert --search` keeps (the loops, the 8-patch layout one level "
+                "coarser, then the best with --fit; scored on 1.5-32 KB prefixes)");
   return [args] { return run_rd(*args); };
 }
 

@@ -118,7 +118,7 @@ void normalize_grid(Grid3& g) {
 }
 
 /// The normal stream alone (model 0), five codings at normal-byte budgets: xyz (the packs' coding: 3
-/// channels, seams shared), xyz with the wavelet's lifting update, octahedral in one global frame (2 channels; a flat grid's frames are the xyz
+/// channels, seams shared), xyz with the geometry's longer filter kCubicLong, octahedral in one global frame (2 channels; a flat grid's frames are the xyz
 /// axes), the residual against the fully decoded geometry, and two layers — the first `base_bytes` of the
 /// xyz stream, then the residual against their normals (bytes: both layers; normal_codings.h).
 void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes) {
@@ -148,11 +148,11 @@ void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes) {
   const EncodedGeometry base = encode_geometry(in.normals, in.seams, codec);
   std::vector<Grid3> axes = decode_budget(base, base_bytes);
   for (Grid3& g : axes) normalize_grid(g);
-  GeometryCodecOptions updated = options;
-  updated.lifting_update = true;
+  GeometryCodecOptions long_filter = options;  // the geometry's 6-point / 4-tap filter (pack format 6)
+  long_filter.filter = WaveletFilter::kCubicLong;
   const Variant variants[] = {
       {"xyz", encode_geometry(in.normals, in.seams, options), nullptr, {}},
-      {"xyz+update", encode_geometry(in.normals, in.seams, updated), nullptr, {}},
+      {"xyz+long", encode_geometry(in.normals, in.seams, long_filter), nullptr, {}},
       {"octahedral", encode_geometry(normal_residual(in.normals, flat, {}), {}, options), &flat, {}},
       {"residual", encode_geometry(normal_residual(in.normals, decoded_geometry, along), {}, options),
        &decoded_geometry, along},

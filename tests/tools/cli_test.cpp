@@ -32,6 +32,14 @@ struct Outcome {
   std::string out, err;
 };
 
+/// A spiked ellipsoid (protrusion tips for the tip and end loops) written as DIR/spiked.obj; its path.
+std::string write_spiked_ellipsoid(const std::string& dir) {
+  const std::string mesh = dir + "/spiked.obj";
+  std::ofstream out(mesh);
+  write_mesh(test::spiked_ellipsoid(4, 0.15), out, MeshFormat::kObj);
+  return mesh;
+}
+
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), {});
@@ -960,12 +968,7 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
 // prefixes are closest to the mesh: the pack written is byte for byte the candidate with the highest score,
 // which the same convert with that loop alone writes.
 TEST_F(CliPack, ChooseLoopKeepsTheBestOfTheLoops) {
-  const TriMesh m = test::spiked_ellipsoid(4, 0.15);
-  const std::string mesh = dir_ + "/spiked.obj";
-  {
-    std::ofstream out(mesh);
-    write_mesh(m, out, MeshFormat::kObj);
-  }
+  const std::string mesh = write_spiked_ellipsoid(dir_);
   const std::string common = " --no-normals --level 5 '" + mesh + "' -o '" + dir_;
   const Outcome r = geomip("convert --json --choose-loop" + common + "/chosen.gip'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -1011,6 +1014,68 @@ TEST_F(CliPack, ChooseLoopKeepsTheBestOfTheLoops) {
     EXPECT_NE(b.err.find("--end-loop"), std::string::npos) << b.err;
     EXPECT_FALSE(fs::exists(dir_ + "/bad.gip")) << args;
   }
+}
+
+// --search builds the loops, the 8-patch layout one level coarser and the best of them fitted, scores each on
+// the same prefix sizes, and keeps the highest mean: the pack written is byte for byte what convert writes
+// with the chosen switches, and the scores it reports are the decoded prefixes' PSNR (rechecked here with
+// decode --bytes and eval for the chosen pack). Mixed with the switches it chooses itself: exit 2, no pack.
+TEST_F(CliPack, SearchKeepsTheBestCandidate) {
+  const std::string mesh = write_spiked_ellipsoid(dir_);
+  const std::string common = " --no-normals --level 5 '" + mesh + "' -o '" + dir_;
+  const Outcome r = geomip("convert --json --search" + common + "/chosen.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& search = j["search"];
+  ASSERT_TRUE(search.is_object()) << j.dump();
+  const std::vector<std::size_t> sizes = search["sizes"];
+  ASSERT_FALSE(sizes.empty());
+  std::string best;
+  double best_psnr = -1;
+  bool fitted = false, layout = false;
+  for (const auto& c : search["candidates"]) {
+    const std::string name = c["name"];
+    ASSERT_EQ(c["psnr_db"].size(), sizes.size()) << name;
+    fitted = fitted || name.find("+ fit") != std::string::npos;
+    layout = layout || name.find("8 patches level 4") != std::string::npos;
+    const double mean = c["mean_psnr_db"];
+    EXPECT_TRUE(std::isfinite(mean) && mean > 30) << c.dump();
+    if (mean > best_psnr) best_psnr = mean, best = name;
+  }
+  EXPECT_TRUE(fitted) << "the best layout is tried with --fit: " << search.dump();
+  EXPECT_TRUE(layout) << "the 8-patch layout one level coarser is a candidate: " << search.dump();
+  EXPECT_EQ(search["chosen"], best) << search.dump();
+  const std::string switches = search["switches"];
+  EXPECT_EQ(j["level"], switches.find("--level 4") != std::string::npos ? 4 : 5);
+  // The same pack as convert with the chosen switches.
+  ASSERT_EQ(geomip("convert -q " + switches + common + "/direct.gip'").exit_code, 0);
+  EXPECT_EQ(slurp(dir_ + "/chosen.gip"), slurp(dir_ + "/direct.gip")) << switches;
+  // Its score is the PSNR of its decoded prefixes.
+  double sum = 0;
+  for (std::size_t n : sizes) {
+    ASSERT_EQ(geomip("decode -q '" + dir_ + "/chosen.gip' --bytes " + std::to_string(n) + " -o '" + dir_ +
+                     "/prefix.obj'")
+                  .exit_code,
+              0);
+    const Outcome e = geomip("eval --json '" + mesh + "' '" + dir_ + "/prefix.obj'");
+    ASSERT_EQ(e.exit_code, 0) << e.err;
+    sum += nlohmann::json::parse(e.out)["psnr_db"].get<double>();
+  }
+  EXPECT_NEAR(sum / static_cast<double>(sizes.size()), best_psnr, 1e-6);
+
+  for (const std::string& args : {"convert -q --search --fit" + common + "/bad.gip'",
+                                  "convert -q --search --tip-loop" + common + "/bad.gip'",
+                                  "convert -q --search --patches 8" + common + "/bad.gip'",
+                                  "convert -q --search --choose-loop" + common + "/bad.gip'"}) {
+    const Outcome b = geomip(args);
+    EXPECT_EQ(b.exit_code, 2) << args << "\n" << b.err;
+    EXPECT_NE(b.err.find("--search"), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(dir_ + "/bad.gip")) << args;
+  }
+  const Outcome b = geomip("rd --search --fit '" + mesh + "' -o '" + dir_ + "/rd'");
+  EXPECT_EQ(b.exit_code, 2) << b.err;
+  EXPECT_NE(b.err.find("--search"), std::string::npos) << b.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/rd/rd.csv"));
 }
 
 TEST_F(CliPack, NormalMeshRefusedForSeveralMeshes) {

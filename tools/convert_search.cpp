@@ -1,0 +1,194 @@
+#include "tools/convert_search.h"
+
+#include "codec/pack.h"
+#include "gimage/surface_distance.h"
+#include "mesh/errors.h"
+#include "tools/pack_models.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <utility>
+
+namespace geomip::tools {
+namespace {
+
+const char* loop_name(LoopKind kind) {
+  switch (kind) {
+    case LoopKind::kTips:
+      return "tips";
+    case LoopKind::kEnds:
+      return "ends";
+    case LoopKind::kPlain:
+      break;
+  }
+  return "plain";
+}
+
+/// PSNR of `pack`'s geometry decoded from each prefix in `sizes` against `reference`; NaN where a prefix
+/// decodes to no model.
+std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
+                                const TriMesh& reference) {
+  std::vector<double> out;
+  for (std::size_t size : sizes) {
+    codec::PackDecodeOptions decode;
+    decode.max_bytes = size;
+    decode.normals = false;
+    const codec::PackDecodeResult result = codec::decode_pack(pack, decode);
+    out.push_back(result.models.empty()
+                      ? NAN
+                      : measure_surface_distance(reference, decoded_mesh(result.models.front())).psnr_db);
+  }
+  return out;
+}
+
+struct Built {
+  SearchCandidate candidate;
+  PreparedModels models;
+  ConvertResult geometry;  ///< geometry-only conversion
+  double seconds = 0;
+};
+
+}  // namespace
+
+std::string SearchCandidate::name(int default_level) const {
+  std::string s = patches == 2 ? loop_name(loop) : std::to_string(patches) + " patches";
+  if (level != default_level) s += " level " + std::to_string(level);
+  if (fit) s += " + fit";
+  return s;
+}
+
+std::string SearchCandidate::switches(int default_level) const {
+  std::string s;
+  auto add = [&](const std::string& w) { s += (s.empty() ? "" : " ") + w; };
+  if (loop == LoopKind::kTips) add("--tip-loop");
+  if (loop == LoopKind::kEnds) add("--end-loop");
+  if (patches != 2) add("--patches " + std::to_string(patches));
+  if (level != default_level) add("--level " + std::to_string(level));
+  if (fit) add("--fit");
+  return s;
+}
+
+SearchResult search_conversion(const std::string& mesh, const ConvertOptions& options,
+                               const SearchOptions& search, bool quiet) {
+  using Clock = std::chrono::steady_clock;
+  auto slide_rounds = [&](LoopKind kind) {
+    return search.slide_seams >= 0 ? search.slide_seams : default_seam_slide_rounds(kind);
+  };
+  ConvertOptions geometry_options = options;
+  geometry_options.normals = false;
+  geometry_options.keep_inputs = false;
+
+  std::vector<Built> built;
+  auto build = [&](const SearchCandidate& c, PreparedModels models) {
+    const auto t0 = Clock::now();
+    ConvertOptions o = geometry_options;
+    o.level = c.level;
+    o.fit = c.fit;
+    o.seam_slide_rounds = c.patches == 2 ? slide_rounds(c.loop) : 0;
+    ConvertResult r = convert_models(models, o);
+    built.push_back(
+        {c, std::move(models), std::move(r), std::chrono::duration<double>(Clock::now() - t0).count()});
+  };
+
+  // The plain loop first: its errors (unreadable mesh, genus the two squares cannot hold) are the user's.
+  build({LoopKind::kPlain, 2, options.level, options.fit},
+        prepare_models({mesh}, "", "geomip convert", quiet, 2, LoopKind::kPlain));
+  const PreparedModels& first = built.front().models;
+  const TriMesh reference =
+      first.originals.front().positions.empty() ? first.inputs.front().mesh : first.originals.front();
+
+  if (search.loops) {
+    for (LoopKind kind : {LoopKind::kTips, LoopKind::kEnds}) {
+      PreparedModels m = prepare_models({mesh}, "", "geomip convert", true, 2, kind);
+      const ParameterizationInput& in = m.inputs.front();
+      if (in.side_guides.empty()) continue;  // no tips: the plain loop again
+      bool seen = false;
+      for (const Built& b : built) {
+        const ParameterizationInput& o = b.models.inputs.front();
+        seen =
+            seen || (b.candidate.patches == 2 && o.partition_points == in.partition_points &&
+                     o.side_guides == in.side_guides && slide_rounds(b.candidate.loop) == slide_rounds(kind));
+      }
+      if (!seen) build({kind, 2, options.level, options.fit}, std::move(m));
+    }
+  }
+  if (search.layout_patches > 2 && options.level > 1) {
+    std::optional<PreparedModels> m;
+    try {
+      m = prepare_models({mesh}, "", "geomip convert", true, search.layout_patches, LoopKind::kPlain);
+    } catch (const InvalidInput& e) {  // no such layout on this mesh: not a candidate
+      if (search.log)
+        search.log(std::string("search: no ") + std::to_string(search.layout_patches) + "-patch layout (" +
+                   e.what() + ")");
+    }
+    if (m) build({LoopKind::kPlain, search.layout_patches, options.level - 1, options.fit}, std::move(*m));
+  }
+
+  // The sizes: below every pack (a fit changes a pack's size by a few percent, so its pack is scored at
+  // the same sizes; one that ends below them is still scored there, its whole pack standing in).
+  SearchResult result;
+  std::size_t smallest = std::numeric_limits<std::size_t>::max();
+  for (const Built& b : built) smallest = std::min(smallest, b.geometry.pack.size());
+  for (std::size_t s : search.sizes)
+    if (s < smallest) result.sizes.push_back(s);
+  if (result.sizes.empty()) result.sizes.push_back(smallest);
+
+  auto score = [&](const Built& b) {
+    const auto t0 = Clock::now();
+    CandidateScore s;
+    s.candidate = b.candidate;
+    s.pack_bytes = b.geometry.pack.size();
+    s.psnr_db = prefix_psnr(b.geometry.pack, result.sizes, reference);
+    double sum = 0;
+    for (double p : s.psnr_db) sum += p;  // NaN stays NaN: not eligible
+    s.mean_psnr_db = sum / static_cast<double>(s.psnr_db.size());
+    s.seconds = b.seconds + std::chrono::duration<double>(Clock::now() - t0).count();
+    if (search.log) {
+      char line[160];
+      std::snprintf(line, sizeof line, "search: %s: %.2f dB (%zu B, %.1f s)",
+                    s.candidate.name(options.level).c_str(), s.mean_psnr_db, s.pack_bytes, s.seconds);
+      search.log(line);
+    }
+    result.scores.push_back(s);
+  };
+  auto best_index = [&] {
+    std::size_t best = result.scores.size();
+    for (std::size_t i = 0; i < result.scores.size(); ++i) {
+      const double p = result.scores[i].mean_psnr_db;
+      if (std::isfinite(p) && (best == result.scores.size() || p > result.scores[best].mean_psnr_db))
+        best = i;
+    }
+    return best;
+  };
+  for (const Built& b : built) score(b);
+  std::size_t best = best_index();
+  if (best == result.scores.size())
+    throw SolverFailure("convert search: no candidate's prefixes decode at every scored size");
+
+  if (search.fit && !options.fit) {
+    SearchCandidate c = built[best].candidate;
+    c.fit = true;
+    build(c, built[best].models);  // a copy: the unfitted candidate may still win
+    score(built.back());
+    best = best_index();
+  }
+
+  Built& winner = built[best];
+  result.chosen = winner.candidate;
+  if (options.normals || options.keep_inputs) {
+    ConvertOptions o = options;
+    o.level = winner.candidate.level;
+    o.fit = winner.candidate.fit;
+    o.seam_slide_rounds = winner.candidate.patches == 2 ? slide_rounds(winner.candidate.loop) : 0;
+    result.converted = convert_models(winner.models, o);
+  } else {
+    result.converted = std::move(winner.geometry);
+  }
+  result.models = std::move(winner.models);
+  return result;
+}
+
+}  // namespace geomip::tools

@@ -1,0 +1,99 @@
+// An encoder that tries several configurations of one mesh's pack and keeps the one whose prefixes are
+// closest to the mesh: `geomip convert --choose-loop` (the automatic two-square loops), `geomip convert
+// --search` and `geomip rd --search` (the loops, an automatic 8-patch layout, and fitted samples).
+//
+// Which configuration is best depends on the mesh (docs/measurements.md, "A loop through the tips" and "Where
+// the horse's error is"; docs/codec-v3.md): the horse prefers the loop through its ends, the bunny, cow and
+// armadillo the loop through the tips; fitted samples gain up to +1.7 dB above 16 KB on the horse and nothing
+// on the bunny. So the search measures instead of guessing: each candidate is converted (geometry only), its
+// prefixes at the scored sizes are decoded and measured against the mesh as `geomip rd` measures them (PSNR
+// of the symmetric RMS surface distance), and the candidate with the highest mean PSNR over the sizes wins.
+//
+// Guarantees:
+// - The winner's pack is byte for byte what `geomip convert` writes with the winner's switches (the
+//   conversion is deterministic); with normal maps the winner alone is converted again with them.
+// - Every candidate is scored at the same sizes: those of SearchOptions::sizes below every candidate's
+//   geometry-only pack (at least one: the smallest pack's size when all are larger).
+// - A candidate whose layout does not exist for the mesh (no protrusion tips, no 8-quad layout) or that
+// repeats
+//   an earlier one is not built; one whose prefix at a scored size decodes to nothing (it ends inside a
+//   larger manifest) is not chosen.
+// - Deterministic: the same mesh and options choose the same candidate.
+//
+// Cost: one pipeline per candidate (the 8-patch layout's parameterization is the slowest, the fit adds about
+// 15 s at level 8), then one decode and one distance measurement per candidate and size.
+#pragma once
+
+#include "tools/convert_pipeline.h"
+#include "tools/model_inputs.h"
+
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace geomip::tools {
+
+/// One configuration: a layout (a two-square loop, or an automatic K-patch layout at its own level) and
+/// whether the samples are fitted (ConvertOptions::fit).
+struct SearchCandidate {
+  LoopKind loop = LoopKind::kPlain;
+  int patches = 2;
+  int level = 8;
+  bool fit = false;
+  /// "plain", "tips", "ends" or "8 patches", then " level N" when the level is not `default_level`, then
+  /// " + fit" when fitted.
+  std::string name(int default_level) const;
+  /// The switches of `geomip convert` that build this candidate ("--end-loop --fit", "--patches 8 --level
+  /// 7").
+  std::string switches(int default_level) const;
+};
+
+/// The prefix sizes `--search` scores (issue #14's range, 1.5 to 32 KB).
+inline constexpr std::size_t kSearchSizes[] = {1500, 2000, 4700, 8800, 16000, 32000};
+
+struct SearchOptions {
+  /// The two-square loops: plain, through the tips (`--tip-loop`) and through the ends (`--end-loop`), each
+  /// when the mesh has tips for it and its loop differs from the earlier ones.
+  bool loops = true;
+  /// Also the automatic `layout_patches`-patch layout one level coarser than ConvertOptions::level when
+  /// layout_patches = 8 (8·4^(N−1) = 2·4^N: the same number of samples as two squares at level N); 0 = none.
+  int layout_patches = 0;
+  /// Also the best layout with fitted samples (ConvertOptions::fit, when that is not already set for every
+  /// candidate); tried on the best layout only (it costs a pipeline of its own, and what it gains depends on
+  /// the mesh more than on the layout).
+  bool fit = false;
+  /// Prefix sizes in bytes whose PSNR is averaged (see the guarantees above).
+  std::vector<std::size_t> sizes;
+  /// --slide-seams N for every candidate; -1 = each loop's default (default_seam_slide_rounds()).
+  int slide_seams = -1;
+  /// Called with a line per candidate scored ("search: ends: 67.32 dB (98,839 B, 6.2 s)"); may be empty.
+  std::function<void(const std::string&)> log;
+};
+
+struct CandidateScore {
+  SearchCandidate candidate;
+  double mean_psnr_db = NAN;    ///< NaN: a scored prefix decoded to nothing (not eligible)
+  std::vector<double> psnr_db;  ///< per scored size
+  std::size_t pack_bytes = 0;   ///< its geometry-only pack
+  double seconds = 0;           ///< conversion and scoring
+};
+
+struct SearchResult {
+  PreparedModels models;  ///< the chosen candidate's
+  SearchCandidate chosen;
+  std::vector<CandidateScore> scores;  ///< every candidate built, in build order
+  std::vector<std::size_t> sizes;      ///< the sizes scored
+  ConvertResult converted;             ///< the chosen candidate converted with the caller's options
+};
+
+/// Builds `mesh`'s candidates (the plain loop at ConvertOptions::level always; the others as `search` asks;
+/// each fitted when ConvertOptions::fit is set) and returns the best with `options` (normals, up, progress,
+/// ...; level, fit and seam_slide_rounds are the candidate's). `quiet` silences the repair note. \throw as
+/// prepare_models() and convert_models() for the plain loop; SolverFailure when no candidate decodes at every
+/// scored size.
+SearchResult search_conversion(const std::string& mesh, const ConvertOptions& options,
+                               const SearchOptions& search, bool quiet);
+
+}  // namespace geomip::tools

@@ -156,6 +156,7 @@ int run_convert(const ConvertArgs& args) {
     search.layout_patches = args.search ? 8 : 0;
     search.fit = args.search;  // --choose-loop --fit: every loop fitted (options.fit)
     if (args.search) {
+      search.frame_steps_choices.assign(std::begin(kSearchFrameSteps), std::end(kSearchFrameSteps));
       search.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));
     } else {
       search.sizes.assign(std::begin(kChooseLoopSizes), std::end(kChooseLoopSizes));

@@ -216,6 +216,7 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, LoopK
     s.layout_patches = 8;
     s.fit = true;
     s.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));
+    s.frame_steps_choices.assign(std::begin(kSearchFrameSteps), std::end(kSearchFrameSteps));
     chosen = search_conversion(mesh_path, options, s, true);
     pack = std::make_shared<const std::vector<std::uint8_t>>(chosen->converted.pack);
   } else {

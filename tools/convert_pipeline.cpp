@@ -103,6 +103,18 @@ const TriMesh& view_frame_mesh(const PreparedModels& models) {
   return repaired ? models.originals[0] : models.inputs.at(0).mesh;
 }
 
+codec::PackWriteOptions pack_write_options(const ConvertOptions& options) {
+  codec::PackWriteOptions write;
+  write.normals = options.normals;
+  write.geometry.quantization_bits = options.quantization_bits;
+  write.geometry.frame_steps = options.frame_steps;
+  write.geometry.tangential_shift = options.tangential_shift;
+  write.geometry.orientation_weights = options.orientation_weights;
+  write.geometry.lifting_update = options.lifting_update;
+  write.geometry.filter = options.filter;
+  return write;
+}
+
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options) {
   auto progress = [&](const char* stage, double fraction) {
     if (options.progress) options.progress(stage, fraction);
@@ -155,15 +167,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
 
   progress("encode", 0.9);
   t0 = std::chrono::steady_clock::now();
-  codec::PackWriteOptions write;
-  write.normals = options.normals;
-  write.geometry.quantization_bits = options.quantization_bits;
-  write.geometry.frame_steps = options.frame_steps;
-  write.geometry.tangential_shift = options.tangential_shift;
-  write.geometry.orientation_weights = options.orientation_weights;
-  write.geometry.lifting_update = options.lifting_update;
-  write.geometry.filter = options.filter;
-  result.pack = codec::write_pack(inputs, write);
+  result.pack = codec::write_pack(inputs, pack_write_options(options));
   result.encode_seconds = seconds_since(t0);
   if (options.keep_inputs) result.inputs = std::move(inputs);
   progress("encode", 1.0);

@@ -87,6 +87,9 @@ struct ConvertResult {
 /// a neck from a crown), else the first model. Requires !models.inputs.empty().
 const TriMesh& view_frame_mesh(const PreparedModels& models);
 
+/// The options convert_models() encodes its pack with (codec tools, quantization, normals).
+codec::PackWriteOptions pack_write_options(const ConvertOptions& options);
+
 /// \throw InvalidInput / SolverFailure from the parameterization; std::invalid_argument never escapes (the
 /// images come from resample_geometry()).
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options);

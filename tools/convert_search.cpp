@@ -1,6 +1,7 @@
 #include "tools/convert_search.h"
 
 #include "codec/pack.h"
+#include "codec/parallel.h"
 #include "gimage/surface_distance.h"
 #include "mesh/errors.h"
 #include "tools/pack_models.h"
@@ -27,20 +28,24 @@ const char* loop_name(LoopKind kind) {
   return "plain";
 }
 
-/// PSNR of `pack`'s geometry decoded from each prefix in `sizes` against `reference`; NaN where a prefix
-/// decodes to no model.
+/// PSNR of `pack`'s geometry decoded from each prefix in `sizes` against `reference` (as `geomip eval`
+/// measures it: the default SurfaceDistanceOptions, whose results do not depend on the thread count); NaN
+/// where a prefix decodes to no model. One size per thread: a measurement is mostly serial (its trees and
+/// samples).
 std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
                                 const TriMesh& reference) {
-  std::vector<double> out;
-  for (std::size_t size : sizes) {
+  std::vector<double> out(sizes.size(), NAN);
+  codec::parallel_for(static_cast<int>(sizes.size()), 0, [&](int i) {
     codec::PackDecodeOptions decode;
-    decode.max_bytes = size;
+    decode.max_bytes = sizes[i];
     decode.normals = false;
+    decode.max_threads = 1;
     const codec::PackDecodeResult result = codec::decode_pack(pack, decode);
-    out.push_back(result.models.empty()
-                      ? NAN
-                      : measure_surface_distance(reference, decoded_mesh(result.models.front())).psnr_db);
-  }
+    if (result.models.empty()) return;
+    SurfaceDistanceOptions distance;
+    distance.threads = 1;
+    out[i] = measure_surface_distance(reference, decoded_mesh(result.models.front()), distance).psnr_db;
+  });
   return out;
 }
 
@@ -57,6 +62,8 @@ std::string SearchCandidate::name(int default_level) const {
   std::string s = patches == 2 ? loop_name(loop) : std::to_string(patches) + " patches";
   if (level != default_level) s += " level " + std::to_string(level);
   if (fit) s += " + fit";
+  if (frame_steps >= 0 && frame_steps != ConvertOptions{}.frame_steps)
+    s += " + frame steps " + std::to_string(frame_steps);
   return s;
 }
 
@@ -68,6 +75,8 @@ std::string SearchCandidate::switches(int default_level) const {
   if (patches != 2) add("--patches " + std::to_string(patches));
   if (level != default_level) add("--level " + std::to_string(level));
   if (fit) add("--fit");
+  if (frame_steps >= 0 && frame_steps != ConvertOptions{}.frame_steps)
+    add("--frame-steps " + std::to_string(frame_steps));
   return s;
 }
 
@@ -79,16 +88,20 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
   };
   ConvertOptions geometry_options = options;
   geometry_options.normals = false;
-  geometry_options.keep_inputs = false;
+  geometry_options.keep_inputs = true;  // the codec stage re-encodes them
 
   std::vector<Built> built;
-  auto build = [&](const SearchCandidate& c, PreparedModels models) {
-    const auto t0 = Clock::now();
-    ConvertOptions o = geometry_options;
+  // The ConvertOptions of candidate `c` on top of `base`.
+  auto candidate_options = [&](const SearchCandidate& c, ConvertOptions o) {
     o.level = c.level;
     o.fit = c.fit;
     o.seam_slide_rounds = c.patches == 2 ? slide_rounds(c.loop) : 0;
-    ConvertResult r = convert_models(models, o);
+    if (c.frame_steps >= 0) o.frame_steps = c.frame_steps;
+    return o;
+  };
+  auto build = [&](const SearchCandidate& c, PreparedModels models) {
+    const auto t0 = Clock::now();
+    ConvertResult r = convert_models(models, candidate_options(c, geometry_options));
     built.push_back(
         {c, std::move(models), std::move(r), std::chrono::duration<double>(Clock::now() - t0).count()});
   };
@@ -176,18 +189,37 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
     best = best_index();
   }
 
+  // Codec tools on the best so far: the same geometry images encoded again (convert_models() would write
+  // these bytes from the same switches: it encodes its images with pack_write_options()).
+  const std::size_t layout_best = best;
+  for (int fs : search.frame_steps_choices) {
+    SearchCandidate c = built[layout_best].candidate;
+    c.frame_steps = fs;
+    const ConvertOptions o = candidate_options(c, geometry_options);
+    if (o.frame_steps == candidate_options(built[layout_best].candidate, geometry_options).frame_steps ||
+        o.frame_steps > o.level)
+      continue;
+    const auto t0 = Clock::now();
+    Built b{c, {}, {}, 0};
+    b.geometry = built[layout_best].geometry;
+    b.geometry.pack = codec::write_pack(b.geometry.inputs, pack_write_options(o));
+    b.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    built.push_back(std::move(b));
+    score(built.back());
+  }
+  best = best_index();
+
   Built& winner = built[best];
   result.chosen = winner.candidate;
+  // A codec variant shares its layout's models.
+  PreparedModels& winner_models = winner.models.inputs.empty() ? built[layout_best].models : winner.models;
   if (options.normals || options.keep_inputs) {
-    ConvertOptions o = options;
-    o.level = winner.candidate.level;
-    o.fit = winner.candidate.fit;
-    o.seam_slide_rounds = winner.candidate.patches == 2 ? slide_rounds(winner.candidate.loop) : 0;
-    result.converted = convert_models(winner.models, o);
+    result.converted = convert_models(winner_models, candidate_options(winner.candidate, options));
   } else {
     result.converted = std::move(winner.geometry);
+    result.converted.inputs.clear();
   }
-  result.models = std::move(winner.models);
+  result.models = std::move(winner_models);
   return result;
 }
 

@@ -42,8 +42,10 @@ struct SearchCandidate {
   int patches = 2;
   int level = 8;
   bool fit = false;
+  /// Local frames on this many wavelet steps (ConvertOptions::frame_steps); -1 = ConvertOptions' default.
+  int frame_steps = -1;
   /// "plain", "tips", "ends" or "8 patches", then " level N" when the level is not `default_level`, then
-  /// " + fit" when fitted.
+  /// " + fit" when fitted, then " + frame steps N" when not the default.
   std::string name(int default_level) const;
   /// The switches of `geomip convert` that build this candidate ("--end-loop --fit", "--patches 8 --level
   /// 7").
@@ -52,6 +54,10 @@ struct SearchCandidate {
 
 /// The prefix sizes `--search` scores (issue #14's range, 1.5 to 32 KB).
 inline constexpr std::size_t kSearchSizes[] = {1500, 2000, 4700, 8800, 16000, 32000};
+/// The framed steps `--search` tries on its best layout: 3 (the default), 4 or 5 (docs/codec-v3.md, "More
+/// framed steps": each helps some meshes at some sizes and costs others). Tangential components 4× coarser
+/// instead of 2× lost 0.6…1.7 dB in the mean on the horse with every framing, so they are not tried.
+inline constexpr int kSearchFrameSteps[] = {3, 4, 5};
 
 struct SearchOptions {
   /// The two-square loops: plain, through the tips (`--tip-loop`) and through the ends (`--end-loop`), each
@@ -64,6 +70,9 @@ struct SearchOptions {
   /// candidate); tried on the best layout only (it costs a pipeline of its own, and what it gains depends on
   /// the mesh more than on the layout).
   bool fit = false;
+  /// Then the best of those with local frames on each of these numbers of wavelet steps (the pack re-encoded
+  /// from the same geometry images: seconds each). Empty = the default only.
+  std::vector<int> frame_steps_choices;
   /// Prefix sizes in bytes whose PSNR is averaged (see the guarantees above).
   std::vector<std::size_t> sizes;
   /// --slide-seams N for every candidate; -1 = each loop's default (default_seam_slide_rounds()).

@@ -62,7 +62,7 @@ Eigen::Vector3d front_axis(const ConvertArgs& args) {
   return Eigen::Vector3d::Unit(args.front[1] - 'x') * (args.front[0] == '-' ? -1.0 : 1.0);
 }
 
-/// Prefix sizes --choose-loop compares the packs at (those smaller than every pack).
+/// Prefix sizes --choose-loop compares the packs at (those below the largest pack).
 constexpr std::size_t kChooseLoopSizes[] = {2000, 4000, 8000, 16000};
 
 std::string format_db(double db) {

@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <limits>
 #include <optional>
 #include <utility>
 
@@ -140,14 +139,16 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
     if (m) build({LoopKind::kPlain, search.layout_patches, options.level - 1, options.fit}, std::move(*m));
   }
 
-  // The sizes: below every pack (a fit changes a pack's size by a few percent, so its pack is scored at
-  // the same sizes; one that ends below them is still scored there, its whole pack standing in).
+  // The sizes: those below the largest pack. A candidate whose whole pack is smaller than a size is scored
+  // there with its whole pack (what a reader with that many bytes gets from it), so a small pack of a
+  // coarse candidate does not take the larger sizes away from the others; the fit and the framings, built
+  // later, are scored at the same sizes.
   SearchResult result;
-  std::size_t smallest = std::numeric_limits<std::size_t>::max();
-  for (const Built& b : built) smallest = std::min(smallest, b.geometry.pack.size());
+  std::size_t largest = 0;
+  for (const Built& b : built) largest = std::max(largest, b.geometry.pack.size());
   for (std::size_t s : search.sizes)
-    if (s < smallest) result.sizes.push_back(s);
-  if (result.sizes.empty()) result.sizes.push_back(smallest);
+    if (s < largest) result.sizes.push_back(s);
+  if (result.sizes.empty()) result.sizes.push_back(largest);
 
   auto score = [&](const Built& b) {
     const auto t0 = Clock::now();

@@ -12,8 +12,9 @@
 // Guarantees:
 // - The winner's pack is byte for byte what `geomip convert` writes with the winner's switches (the
 //   conversion is deterministic); with normal maps the winner alone is converted again with them.
-// - Every candidate is scored at the same sizes: those of SearchOptions::sizes below every candidate's
-//   geometry-only pack (at least one: the smallest pack's size when all are larger).
+// - Every candidate is scored at the same sizes: those of SearchOptions::sizes below the largest candidate's
+//   geometry-only pack (at least one: that pack's size when all are larger); a pack smaller than a size is
+//   scored there whole (what a reader of that many bytes gets).
 // - A candidate whose layout does not exist for the mesh (no protrusion tips, no 8-quad layout) or that
 // repeats
 //   an earlier one is not built; one whose prefix at a scored size decodes to nothing (it ends inside a

@@ -151,16 +151,9 @@ int run_convert(const ConvertArgs& args) {
   std::optional<SearchResult> searched;
   int level = args.level;
   if (searching) {
-    SearchOptions search;
-    search.loops = true;
-    search.layout_patches = args.search ? 8 : 0;
-    search.fit = args.search;  // --choose-loop --fit: every loop fitted (options.fit)
-    if (args.search) {
-      search.frame_steps_choices.assign(std::begin(kSearchFrameSteps), std::end(kSearchFrameSteps));
-      search.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));
-    } else {
-      search.sizes.assign(std::begin(kChooseLoopSizes), std::end(kChooseLoopSizes));
-    }
+    // --choose-loop: the loops only (with --fit every loop fitted: options.fit).
+    SearchOptions search = args.search ? full_search_options() : SearchOptions{};
+    if (!args.search) search.sizes.assign(std::begin(kChooseLoopSizes), std::end(kChooseLoopSizes));
     search.slide_seams = args.common.slide_seams;
     if (report && args.search)
       search.log = [&bar](const std::string& line) {
@@ -194,25 +187,7 @@ int run_convert(const ConvertArgs& args) {
 
   codec::PackInfo info;
   codec::read_pack_info(pack, info);
-  nlohmann::json search_json = nullptr;  // --search / --choose-loop: every candidate and the choice
-  if (searched) {
-    nlohmann::json candidates = nlohmann::json::array();
-    for (const CandidateScore& c : searched->scores) {
-      nlohmann::json psnr = nlohmann::json::array();
-      for (double p : c.psnr_db) psnr.push_back(std::isfinite(p) ? nlohmann::json(p) : nlohmann::json(nullptr));
-      candidates.push_back({{"name", c.candidate.name(args.level)},
-                            {"switches", c.candidate.switches(args.level)},
-                            {"mean_psnr_db", std::isfinite(c.mean_psnr_db) ? nlohmann::json(c.mean_psnr_db)
-                                                                           : nlohmann::json(nullptr)},
-                            {"psnr_db", psnr},
-                            {"geometry_bytes", c.pack_bytes},
-                            {"seconds", c.seconds}});
-    }
-    search_json = {{"chosen", searched->chosen.name(args.level)},
-                   {"switches", searched->chosen.switches(args.level)},
-                   {"sizes", searched->sizes},
-                   {"candidates", candidates}};
-  }
+  const nlohmann::json search_report = searched ? search_json(*searched, args.level) : nlohmann::json(nullptr);
   if (args.common.json) {
     nlohmann::json j_models = nlohmann::json::array();
     for (std::size_t m = 0; m < models.inputs.size(); ++m)
@@ -234,7 +209,7 @@ int run_convert(const ConvertArgs& args) {
                                 {"loop_psnr_db", {{"plain", std::isfinite(plain_psnr) ? nlohmann::json(plain_psnr) : nlohmann::json(nullptr)},
                                                   {"tips", std::isfinite(tip_psnr) ? nlohmann::json(tip_psnr) : nlohmann::json(nullptr)},
                                                   {"ends", std::isfinite(end_psnr) ? nlohmann::json(end_psnr) : nlohmann::json(nullptr)}}},
-                                {"search", search_json},
+                                {"search", search_report},
                                 {"param_seconds", converted.param_seconds},
                                 {"resample_seconds", converted.resample_seconds},
                                 {"encode_seconds", converted.encode_seconds},

@@ -212,12 +212,7 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, LoopK
   options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
   std::shared_ptr<const std::vector<std::uint8_t>> pack;
   if (search) {
-    SearchOptions s;
-    s.layout_patches = 8;
-    s.fit = true;
-    s.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));
-    s.frame_steps_choices.assign(std::begin(kSearchFrameSteps), std::end(kSearchFrameSteps));
-    chosen = search_conversion(mesh_path, options, s, true);
+    chosen = search_conversion(mesh_path, options, full_search_options(), true);
     pack = std::make_shared<const std::vector<std::uint8_t>>(chosen->converted.pack);
   } else {
     const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches, loop);
@@ -430,18 +425,7 @@ int run_rd(const RdArgs& args) {
     if (!pack.empty()) j["pack"] = pack_path;
     j["geomip_vs_draco_envelope"] = comparison;
     if (!lt_points.empty()) j["geomip_vs_draco_lt_envelope"] = lt_comparison;
-    if (searched) {
-      nlohmann::json candidates = nlohmann::json::array();
-      for (const CandidateScore& c : searched->scores)
-        candidates.push_back({{"name", c.candidate.name(args.level)},
-                              {"switches", c.candidate.switches(args.level)},
-                              {"mean_psnr_db", std::isfinite(c.mean_psnr_db) ? nlohmann::json(c.mean_psnr_db)
-                                                                             : nlohmann::json(nullptr)}});
-      j["search"] = {{"chosen", searched->chosen.name(args.level)},
-                     {"switches", searched->chosen.switches(args.level)},
-                     {"sizes", searched->sizes},
-                     {"candidates", candidates}};
-    }
+    if (searched) j["search"] = search_json(*searched, args.level);
     j["points"] = nlohmann::json::array();
     for (const RdPoint& p : all) j["points"].push_back(point_to_json(p));
     std::cout << j.dump(2) << "\n";

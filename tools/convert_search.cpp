@@ -224,4 +224,32 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
   return result;
 }
 
+SearchOptions full_search_options() {
+  SearchOptions s;
+  s.layout_patches = 8;
+  s.fit = true;
+  s.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));
+  s.frame_steps_choices.assign(std::begin(kSearchFrameSteps), std::end(kSearchFrameSteps));
+  return s;
+}
+
+nlohmann::json search_json(const SearchResult& result, int default_level) {
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json candidates = nlohmann::json::array();
+  for (const CandidateScore& c : result.scores) {
+    nlohmann::json psnr = nlohmann::json::array();
+    for (double p : c.psnr_db) psnr.push_back(number(p));
+    candidates.push_back({{"name", c.candidate.name(default_level)},
+                          {"switches", c.candidate.switches(default_level)},
+                          {"mean_psnr_db", number(c.mean_psnr_db)},
+                          {"psnr_db", psnr},
+                          {"geometry_bytes", c.pack_bytes},
+                          {"seconds", c.seconds}});
+  }
+  return {{"chosen", result.chosen.name(default_level)},
+          {"switches", result.chosen.switches(default_level)},
+          {"sizes", result.sizes},
+          {"candidates", candidates}};
+}
+
 }  // namespace geomip::tools

@@ -28,6 +28,8 @@
 #include "tools/convert_pipeline.h"
 #include "tools/model_inputs.h"
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstddef>
 #include <functional>
@@ -98,6 +100,10 @@ struct SearchResult {
   ConvertResult converted;             ///< the chosen candidate converted with the caller's options
 };
 
+/// What `--search` (convert and rd) tries: the loops, the 8-patch layout, the fit and kSearchFrameSteps,
+/// scored at kSearchSizes.
+SearchOptions full_search_options();
+
 /// Builds `mesh`'s candidates (the plain loop at ConvertOptions::level always; the others as `search` asks;
 /// each fitted when ConvertOptions::fit is set) and returns the best with `options` (normals, up, progress,
 /// ...; level, fit and seam_slide_rounds are the candidate's). `quiet` silences the repair note. \throw as
@@ -105,5 +111,10 @@ struct SearchResult {
 /// scored size.
 SearchResult search_conversion(const std::string& mesh, const ConvertOptions& options,
                                const SearchOptions& search, bool quiet);
+
+/// The search as JSON (`convert --json` and `rd --json`): "chosen", "switches", "sizes" and per candidate its
+/// "name", "switches", "mean_psnr_db" (null: not eligible), "psnr_db" per size (null: decoded to nothing),
+/// "geometry_bytes" and "seconds". Names and switches are relative to `default_level`.
+nlohmann::json search_json(const SearchResult& result, int default_level);
 
 }  // namespace geomip::tools

@@ -3,6 +3,7 @@
 #include "codec/parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -32,8 +33,16 @@ double norm(const Point3d& a) {
 class StepView {
  public:
   StepView(Grid3& grid, int k, const Point3d& lo, double unit, WaveletFilter filter)
-      : grid_(grid), k_(k), s_(1 << (k - 1)), level_(grid.level - k + 1), m_((1 << level_) + 1), lo_(lo),
-        unit_(unit), filter_(filter), p_(3 * cells()), q_(3 * cells()) {}
+      : grid_(grid),
+        k_(k),
+        s_(1 << (k - 1)),
+        level_(grid.level - k + 1),
+        m_((1 << level_) + 1),
+        lo_(lo),
+        unit_(unit),
+        filter_(filter),
+        p_(3 * cells()),
+        q_(3 * cells()) {}
 
   int m() const { return m_; }
   /// Recomputes P (and, with `subdivide`, Q) from the grid's current samples.
@@ -49,7 +58,8 @@ class StepView {
       wavelet_forward(b, level_, 1, filter_, false, k_);
       for (std::size_t i = 0; i < cells(); ++i) {
         // Evens keep their value (no update step): P = a there; odd positions hold the detail a − P.
-        p_[3 * i + c] = lo_[c] + static_cast<double>(static_cast<std::int64_t>(a[i]) - (odd(i) ? b[i] : 0)) * unit_;
+        p_[3 * i + c] =
+            lo_[c] + static_cast<double>(static_cast<std::int64_t>(a[i]) - (odd(i) ? b[i] : 0)) * unit_;
         if (odd(i)) b[i] = 0;
       }
       if (!subdivide) continue;
@@ -61,7 +71,8 @@ class StepView {
   Point3d q(int I, int J) const { return get(q_, I, J); }
   float* sample(int I, int J) {
     const std::size_t size = static_cast<std::size_t>(grid_.size());
-    return grid_.values.data() + 3 * (static_cast<std::size_t>(J) * s_ * size + static_cast<std::size_t>(I) * s_);
+    return grid_.values.data() +
+           3 * (static_cast<std::size_t>(J) * s_ * size + static_cast<std::size_t>(I) * s_);
   }
 
  private:
@@ -82,14 +93,36 @@ class StepView {
 };
 
 struct RowStats {
-  std::size_t candidates = 0, moved = 0, no_crossing = 0;
+  std::size_t candidates = 0, moved = 0, no_crossing = 0, would_fold = 0;
   double shift_sum = 0, shift_max = 0;
 };
 
-/// Moves the interior samples (I, J) of `view` for which `selected(I, J)` holds, one row per task.
+/// Whether moving the interior sample (I, J) of `view` from `from` to `to` leaves every triangle of its
+/// umbrella in the step's grid — (x, E, N), (x, N, W), (x, W, S), (x, S, E) with E = (I+1, J), N = (I, J+1) —
+/// that faces along `n` (∂u × ∂v of the predicted surface) facing along it. The four neighbours are samples
+/// of the coarser grid or of the step's other pass, so no task writes them while this pass runs.
+bool keeps_facing(StepView& view, int I, int J, const Point3d& n, const Point3d& from, const Point3d& to) {
+  constexpr int kDi[4] = {1, 0, -1, 0}, kDj[4] = {0, 1, 0, -1};
+  std::array<Point3d, 4> ring;
+  for (int k = 0; k < 4; ++k) {
+    const float* y = view.sample(I + kDi[k], J + kDj[k]);
+    ring[static_cast<std::size_t>(k)] = {y[0], y[1], y[2]};
+  }
+  const auto facing = [&](const Point3d& x, std::size_t k) {
+    const Point3d c = cross(sub(ring[k], x), sub(ring[(k + 1) % 4], x));
+    return c[0] * n[0] + c[1] * n[1] + c[2] * n[2] > 0;
+  };
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (facing(from, k) && !facing(to, k)) return false;
+  }
+  return true;
+}
+
+/// Moves the interior samples (I, J) of `view` for which `selected(I, J)` holds, one row per task; with
+/// `guard`, only where keeps_facing().
 template <typename Selected>
 void move_samples(StepView& view, const SurfaceCrossing& crossing, const NormalMeshOptions& options,
-                  Selected selected, std::vector<RowStats>& rows) {
+                  Selected selected, bool guard, std::vector<RowStats>& rows) {
   const int m = view.m();
   parallel_for(m - 2, options.threads, [&](int row) {
     const int J = row + 1;
@@ -118,6 +151,10 @@ void move_samples(StepView& view, const SurfaceCrossing& crossing, const NormalM
         ++stats.no_crossing;
         continue;
       }
+      if (guard && !keeps_facing(view, I, J, n, here, *hit)) {
+        ++stats.would_fold;
+        continue;
+      }
       const double shift = norm(sub(*hit, here)) / spacing;
       for (int c = 0; c < 3; ++c) x[c] = static_cast<float>((*hit)[c]);
       ++stats.moved;
@@ -132,9 +169,10 @@ void move_samples(StepView& view, const SurfaceCrossing& crossing, const NormalM
 NormalMeshStats normal_mesh_resample(Grid3& grid, const SurfaceCrossing& crossing,
                                      const NormalMeshOptions& options) {
   if (grid.level < 0 || grid.level > 15 ||
-      grid.values.size() != 3 * static_cast<std::size_t>(grid.size()) * static_cast<std::size_t>(grid.size())) {
-    throw std::invalid_argument("normal_mesh_resample: grid of level " + std::to_string(grid.level) + " has " +
-                                std::to_string(grid.values.size()) + " values");
+      grid.values.size() !=
+          3 * static_cast<std::size_t>(grid.size()) * static_cast<std::size_t>(grid.size())) {
+    throw std::invalid_argument("normal_mesh_resample: grid of level " + std::to_string(grid.level) +
+                                " has " + std::to_string(grid.values.size()) + " values");
   }
   Point3d lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
   for (std::size_t i = 0; i < grid.values.size(); ++i) {
@@ -151,19 +189,23 @@ NormalMeshStats normal_mesh_resample(Grid3& grid, const SurfaceCrossing& crossin
 
   std::vector<RowStats> rows(static_cast<std::size_t>(grid.size()));
   for (int k = steps; k >= 1; --k) {
+    const bool guard = options.fold_guard_from_step > 0 && k >= options.fold_guard_from_step;
     StepView view(grid, k, lo, unit, options.filter);
     view.predict(/*subdivide=*/true);
     // Row and column details: predicted from the coarser grid only.
-    move_samples(view, crossing, options, [](int I, int J) { return (I % 2) != (J % 2); }, rows);
+    move_samples(
+        view, crossing, options, [](int I, int J) { return (I % 2) != (J % 2); }, guard, rows);
     // Diagonal details: their prediction uses the row and column samples just placed.
     view.predict(/*subdivide=*/false);
-    move_samples(view, crossing, options, [](int I, int J) { return I % 2 == 1 && J % 2 == 1; }, rows);
+    move_samples(
+        view, crossing, options, [](int I, int J) { return I % 2 == 1 && J % 2 == 1; }, guard, rows);
   }
   double shift_sum = 0;
   for (const RowStats& r : rows) {
     stats.candidates += r.candidates;
     stats.moved += r.moved;
     stats.no_crossing += r.no_crossing;
+    stats.would_fold += r.would_fold;
     shift_sum += r.shift_sum;
     stats.max_shift = std::max(stats.max_shift, r.shift_max);
   }

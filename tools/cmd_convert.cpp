@@ -34,6 +34,7 @@ struct ConvertArgs {
   bool no_normals = false;
   int normal_mesh_steps = ConvertOptions{}.normal_mesh_steps;
   double normal_mesh_reach = ConvertOptions{}.normal_mesh_max_shift;
+  int normal_mesh_guard = ConvertOptions{}.normal_mesh_fold_guard;
   int frame_steps = ConvertOptions{}.frame_steps;
   int tangential_shift = ConvertOptions{}.tangential_shift;
   bool no_orientation_weights = false;
@@ -138,6 +139,7 @@ int run_convert(const ConvertArgs& args) {
   options.seam_slide_rounds = slide_rounds(loop_asked);
   options.normal_mesh_steps = args.normal_mesh_steps;
   options.normal_mesh_max_shift = args.normal_mesh_reach;
+  options.normal_mesh_fold_guard = args.normal_mesh_guard;
   options.frame_steps = args.frame_steps;
   options.tangential_shift = args.tangential_shift;
   options.orientation_weights = !args.no_orientation_weights;
@@ -204,6 +206,7 @@ int run_convert(const ConvertArgs& args) {
                                 {"normal_mesh", {{"steps", converted.normal_mesh_steps},
                                                  {"samples", converted.normal_mesh_candidates},
                                                  {"moved", converted.normal_mesh_moved},
+                                                 {"refused_folds", converted.normal_mesh_would_fold},
                                                  {"mean_shift", converted.normal_mesh_mean_shift}}},
                                 {"loop", loop.empty() ? nlohmann::json(nullptr) : nlohmann::json(loop)},
                                 {"loop_psnr_db", {{"plain", std::isfinite(plain_psnr) ? nlohmann::json(plain_psnr) : nlohmann::json(nullptr)},
@@ -269,6 +272,10 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_option("--normal-mesh-reach", args->normal_mesh_reach,
                   "Largest move of a normal-mesh sample, in sample spacings of its level")
       ->check(CLI::Range(0.0, 4.0));
+  cmd->add_option("--normal-mesh-guard", args->normal_mesh_guard,
+                  "Normal-mesh steps from STEP up (the coarser ones) refuse a move that would fold their grid "
+                  "around the sample (default 3; 0 = none, 1 = every step)")
+      ->check(CLI::Range(0, 10));
   cmd->add_flag("--fit,!--no-fit", args->fit,
                 "Move every level-N sample along its normal so that the level-N remesh is a least-squares fit of "
                 "the surface, not its interpolant (gimage/fit.h, after the normal-mesh resampling; hole-mask "

@@ -38,6 +38,7 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
   codec::NormalMeshOptions normal;
   normal.steps = steps;
   normal.max_shift = options.normal_mesh_max_shift;
+  normal.fold_guard_from_step = options.normal_mesh_fold_guard;
   normal.filter = options.filter;  // the filter write_pack() codes with (below)
   double shift_sum = result.normal_mesh_mean_shift * static_cast<double>(result.normal_mesh_moved);
   for (GeometryImage& image : images.geometry) {
@@ -46,6 +47,7 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
     image.values = std::move(grid.values);
     result.normal_mesh_candidates += stats.candidates;
     result.normal_mesh_moved += stats.moved;
+    result.normal_mesh_would_fold += stats.would_fold;
     shift_sum += stats.mean_shift * static_cast<double>(stats.moved);
   }
   if (result.normal_mesh_moved > 0)

@@ -2,6 +2,7 @@
 // parameterization → geometry images (+ normal maps, + hole masks of repaired meshes) → a .gip pack in memory.
 #pragma once
 
+#include "codec/normal_mesh.h"
 #include "codec/pack.h"
 #include "mesh/mesh.h"
 #include "mesh/view_frame.h"
@@ -51,6 +52,9 @@ struct ConvertOptions {
   int normal_mesh_steps = -1;
   /// Largest move of a normal-mesh sample, in local sample spacings (NormalMeshOptions::max_shift).
   double normal_mesh_max_shift = 0.5;
+  /// Normal-mesh steps from this one up refuse moves that fold their grid
+  /// (NormalMeshOptions::fold_guard_from_step; 0 = none).
+  int normal_mesh_fold_guard = codec::NormalMeshOptions{}.fold_guard_from_step;
   /// Least-squares fitted samples (gimage/fit.h), after the normal-mesh resampling: the level-N remesh fits the
   /// surface (the mesh before repair, the hole mask's quads left out) instead of interpolating it. Any number of
   /// models (offsets along the normals keep the correspondences).
@@ -77,7 +81,7 @@ struct ConvertResult {
   std::vector<std::size_t> masked_quads;  ///< per model: grid quads left out as filled holes
   /// Normal-mesh resampling: the steps applied (0 = off) and figures over all patches.
   int normal_mesh_steps = 0;
-  std::size_t normal_mesh_candidates = 0, normal_mesh_moved = 0;
+  std::size_t normal_mesh_candidates = 0, normal_mesh_moved = 0, normal_mesh_would_fold = 0;
   double normal_mesh_mean_shift = 0;  ///< mean move of the moved samples, in local sample spacings
   double param_seconds = 0, resample_seconds = 0, encode_seconds = 0;
 };

@@ -51,7 +51,8 @@ double off_surface(const float* p) {
 
 /// Crossing of a line with the height field nearest `hint` (within `radius`): sign changes of
 /// z − height(x, y) along the line, scanned finely around the hint's foot and refined by bisection.
-std::optional<Point3d> field_crossing(const Point3d& o, const Point3d& d, const Point3d& hint, double radius) {
+std::optional<Point3d> field_crossing(const Point3d& o, const Point3d& d, const Point3d& hint,
+                                      double radius) {
   const double length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   if (!(length > 0)) return std::nullopt;
   const Point3d u{d[0] / length, d[1] / length, d[2] / length};
@@ -90,7 +91,8 @@ double tangential_share(const Grid3& g, int steps) {
   std::vector<std::vector<std::int32_t>> channels(3, std::vector<std::int32_t>(cells));
   const double unit = 4.0 / (1 << 20);
   for (int c = 0; c < 3; ++c) {
-    for (std::size_t i = 0; i < cells; ++i) channels[c][i] = static_cast<std::int32_t>(std::lround(g.values[3 * i + c] / unit));
+    for (std::size_t i = 0; i < cells; ++i)
+      channels[c][i] = static_cast<std::int32_t>(std::lround(g.values[3 * i + c] / unit));
     wavelet_forward(channels[c], g.level, steps, WaveletFilter::kCubic);
   }
   const int coarse = 1 << steps;
@@ -118,7 +120,7 @@ TEST(NormalMesh, SamplesLandOnTheSurfaceAndBordersStay) {
   const int n = after.size();
   EXPECT_GT(stats.candidates, 0u);
   EXPECT_GE(stats.moved, stats.candidates * 95 / 100);
-  EXPECT_EQ(stats.moved + stats.no_crossing, stats.candidates);
+  EXPECT_EQ(stats.moved + stats.no_crossing + stats.would_fold, stats.candidates);
   EXPECT_LE(stats.max_shift, 4.0);  // the foot's reach (0.5 spacings) plus the wobble (about 1 spacing)
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
@@ -161,6 +163,87 @@ TEST(NormalMesh, NoCrossingOrNoStepsLeavesTheGridAlone) {
   EXPECT_EQ(g.values, before.values);
   EXPECT_EQ(normal_mesh_resample(g, field_crossing, {.steps = 0}).candidates, 0u);
   EXPECT_EQ(g.values, before.values);
+}
+
+/// The plane z = 0 sampled regularly over [−1, 1]²: every prediction is exact and every normal is +z.
+Grid3 flat_patch(int level) {
+  Grid3 g{level, {}};
+  const int n = g.size();
+  g.values.resize(3 * static_cast<std::size_t>(n) * n);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      float* p = g.values.data() + 3 * (static_cast<std::size_t>(j) * n + i);
+      p[0] = static_cast<float>(2.0 * i / (n - 1) - 1);
+      p[1] = static_cast<float>(2.0 * j / (n - 1) - 1);
+      p[2] = 0;
+    }
+  }
+  return g;
+}
+
+/// A stand-in for the surface crossing that answers a point on the plane `factor` reaches (radius = half a
+/// sample spacing) along +x from the hint: 6 = three spacings, past the sample's neighbour, as a crossing on
+/// the far side of a thin part would be.
+SurfaceCrossing shifted_crossing(double factor) {
+  return [factor](const Point3d&, const Point3d&, const Point3d& hint, double radius) {
+    return std::optional<Point3d>(Point3d{hint[0] + factor * radius, hint[1], 0});
+  };
+}
+
+/// Triangles of the grid's quads (split along the (i,j)–(i+1,j+1) diagonal) that face −z.
+int triangles_facing_down(const Grid3& g) {
+  const int n = g.size();
+  auto at = [&](int i, int j) {
+    const float* p = g.values.data() + 3 * (static_cast<std::size_t>(j) * n + i);
+    return Point3d{p[0], p[1], p[2]};
+  };
+  auto down = [](const Point3d& a, const Point3d& b, const Point3d& c) {
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) < 0;
+  };
+  int count = 0;
+  for (int j = 0; j + 1 < n; ++j) {
+    for (int i = 0; i + 1 < n; ++i) {
+      count += down(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      count += down(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  }
+  return count;
+}
+
+TEST(NormalMesh, GuardedStepsRefuseMovesThatFold) {
+  const Grid3 before = flat_patch(5);
+  ASSERT_EQ(triangles_facing_down(before), 0);
+
+  // Every step guarded: a crossing three spacings away would fold every umbrella, so nothing moves.
+  Grid3 g = before;
+  NormalMeshStats stats =
+      normal_mesh_resample(g, shifted_crossing(6), {.steps = 3, .fold_guard_from_step = 1});
+  EXPECT_GT(stats.candidates, 0u);
+  EXPECT_EQ(stats.would_fold, stats.candidates);
+  EXPECT_EQ(stats.moved, 0u);
+  EXPECT_EQ(g.values, before.values);
+
+  // A crossing a tenth of a spacing away folds nothing: every sample moves. (One step: over several, the
+  // moved coarser samples make the cubic prediction overshoot near the fixed border.)
+  g = before;
+  stats = normal_mesh_resample(g, shifted_crossing(0.2), {.steps = 1, .fold_guard_from_step = 1});
+  EXPECT_EQ(stats.would_fold, 0u);
+  EXPECT_EQ(stats.moved, stats.candidates);
+  EXPECT_EQ(triangles_facing_down(g), 0);
+
+  // Unguarded, the far crossing is taken and the grid folds.
+  g = before;
+  stats = normal_mesh_resample(g, shifted_crossing(6), {.steps = 3, .fold_guard_from_step = 0});
+  EXPECT_EQ(stats.moved, stats.candidates);
+  EXPECT_GT(triangles_facing_down(g), 0);
+
+  // The default guards the coarsest of the three steps only: its interior samples (the level-3 grid's 7²
+  // less the level-2 grid's 3²: 40) stay, the finer steps' move.
+  g = before;
+  stats = normal_mesh_resample(g, shifted_crossing(6), {.steps = 3});
+  EXPECT_EQ(NormalMeshOptions{}.fold_guard_from_step, 3);
+  EXPECT_EQ(stats.would_fold, 40u);
+  EXPECT_EQ(stats.moved, stats.candidates - 40u);
 }
 
 TEST(NormalMesh, RejectsBadGrids) {

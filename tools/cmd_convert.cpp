@@ -174,7 +174,10 @@ int run_convert(const ConvertArgs& args) {
   double plain_psnr = NAN, tip_psnr = NAN, end_psnr = NAN;
   if (searched) {
     for (const CandidateScore& s : searched->scores) {
-      if (s.candidate.patches != 2 || s.candidate.fit != searched->chosen.fit) continue;
+      // Each loop's own score: not its codec variants (framed steps), the fit and L∞ pass as chosen.
+      if (s.candidate.patches != 2 || s.candidate.fit != searched->chosen.fit ||
+          s.candidate.linf_sweeps != searched->chosen.linf_sweeps || s.candidate.frame_steps >= 0)
+        continue;
       (s.candidate.loop == LoopKind::kTips ? tip_psnr : s.candidate.loop == LoopKind::kEnds ? end_psnr : plain_psnr) =
           s.mean_psnr_db;
     }
@@ -300,11 +303,13 @@ CommandRunner add_convert_command(CLI::App& app) {
                 "One mesh, two squares: build the pack with the plain loop, with --tip-loop and with --end-loop "
                 "(each when the mesh has tips) and keep the one whose 2, 4, 8 and 16 KB prefixes are closest to "
                 "the mesh (mean PSNR); up to three times the time");
-  cmd->add_flag("--search", args->search,
-                "One mesh: build the pack with each two-square loop (plain, --tip-loop, --end-loop) and the "
-                "automatic 8-patch layout one level coarser (the same samples), then the best of them with --fit, "
-                "and keep the one whose 1.5, 2, 4.7, 8.8, 16 and 32 KB geometry prefixes are closest to the mesh "
-                "(mean PSNR; tools/convert_search.h); several pipelines: about a minute for the horse");
+  cmd->add_flag(
+      "--search", args->search,
+      "One mesh: build the pack with each two-square loop (plain, --tip-loop, --end-loop) and the "
+      "automatic 8-patch layout one level coarser (the same samples), then the best of them with --fit, "
+      "then with the L-infinity pass (--linf-sweeps 1000), then with 4 and 5 framed steps, and keep the "
+      "one whose 1.5, 2, 4.7, 8.8, 16 and 32 KB geometry prefixes are closest to the mesh (mean PSNR; "
+      "tools/convert_search.h); several pipelines: several minutes for the horse");
   cmd->add_option(
          "--up", args->up,
          "The models' up axis, stored with the front in each model's normalization (the viewer's frame; "

@@ -490,9 +490,11 @@ CommandRunner add_rd_command(CLI::App& app) {
   add_patches_option(cmd, args->patches);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");
   cmd->add_flag("--end-loop", args->end_loop, "geomip: the two-square loop through the ends (as `geomip convert --end-loop`)");
-  cmd->add_flag("--search", args->search,
-                "geomip: the pack `geomip convert --search` keeps (the loops, the 8-patch layout one level "
-                "coarser, then the best with --fit; scored on 1.5-32 KB prefixes)");
+  cmd->add_flag(
+      "--search", args->search,
+      "geomip: the pack `geomip convert --search` keeps (the loops, the 8-patch layout one level "
+      "coarser, then the best with --fit, the L-infinity pass and more framed steps; scored on 1.5-32 KB "
+      "prefixes)");
   return [args] { return run_rd(*args); };
 }
 

@@ -61,6 +61,7 @@ std::string SearchCandidate::name(int default_level) const {
   std::string s = patches == 2 ? loop_name(loop) : std::to_string(patches) + " patches";
   if (level != default_level) s += " level " + std::to_string(level);
   if (fit) s += " + fit";
+  if (linf_sweeps > 0) s += " + L∞ pass";
   if (frame_steps >= 0 && frame_steps != ConvertOptions{}.frame_steps)
     s += " + frame steps " + std::to_string(frame_steps);
   return s;
@@ -74,6 +75,7 @@ std::string SearchCandidate::switches(int default_level) const {
   if (patches != 2) add("--patches " + std::to_string(patches));
   if (level != default_level) add("--level " + std::to_string(level));
   if (fit) add("--fit");
+  if (linf_sweeps > 0) add("--linf-sweeps " + std::to_string(linf_sweeps));
   if (frame_steps >= 0 && frame_steps != ConvertOptions{}.frame_steps)
     add("--frame-steps " + std::to_string(frame_steps));
   return s;
@@ -94,6 +96,7 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
   auto candidate_options = [&](const SearchCandidate& c, ConvertOptions o) {
     o.level = c.level;
     o.fit = c.fit;
+    if (c.linf_sweeps > 0) o.linf_sweeps = c.linf_sweeps;
     o.seam_slide_rounds = c.patches == 2 ? slide_rounds(c.loop) : 0;
     if (c.frame_steps >= 0) o.frame_steps = c.frame_steps;
     return o;
@@ -189,6 +192,13 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
     score(built.back());
     best = best_index();
   }
+  if (search.linf_sweeps > 0 && options.linf_sweeps == 0) {
+    SearchCandidate c = built[best].candidate;
+    c.linf_sweeps = search.linf_sweeps;
+    build(c, built[best].models);
+    score(built.back());
+    best = best_index();
+  }
 
   // Codec tools on the best so far: the same geometry images encoded again (convert_models() would write
   // these bytes from the same switches: it encodes its images with pack_write_options()).
@@ -228,6 +238,7 @@ SearchOptions full_search_options() {
   SearchOptions s;
   s.layout_patches = 8;
   s.fit = true;
+  s.linf_sweeps = kSearchLinfSweeps;
   s.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));
   s.frame_steps_choices.assign(std::begin(kSearchFrameSteps), std::end(kSearchFrameSteps));
   return s;

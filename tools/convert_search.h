@@ -1,6 +1,7 @@
 // An encoder that tries several configurations of one mesh's pack and keeps the one whose prefixes are
 // closest to the mesh: `geomip convert --choose-loop` (the automatic two-square loops), `geomip convert
-// --search` and `geomip rd --search` (the loops, an automatic 8-patch layout, and fitted samples).
+// --search` and `geomip rd --search` (the loops, an automatic 8-patch layout, fitted samples, the
+// parameterization's L∞ pass and more framed steps).
 //
 // Which configuration is best depends on the mesh (docs/measurements.md, "A loop through the tips" and "Where
 // the horse's error is"; docs/codec-v3.md): the horse prefers the loop through its ends, the bunny, cow and
@@ -38,20 +39,22 @@
 
 namespace geomip::tools {
 
-/// One configuration: a layout (a two-square loop, or an automatic K-patch layout at its own level) and
-/// whether the samples are fitted (ConvertOptions::fit).
+/// One configuration: a layout (a two-square loop, or an automatic K-patch layout at its own level),
+/// whether the samples are fitted (ConvertOptions::fit), the parameterization's L∞ pass and the framed steps.
 struct SearchCandidate {
   LoopKind loop = LoopKind::kPlain;
   int patches = 2;
   int level = 8;
   bool fit = false;
+  /// Sweeps of the parameterization's L∞ pass (ConvertOptions::linf_sweeps); 0 = the caller's setting.
+  std::size_t linf_sweeps = 0;
   /// Local frames on this many wavelet steps (ConvertOptions::frame_steps); -1 = ConvertOptions' default.
   int frame_steps = -1;
   /// "plain", "tips", "ends" or "8 patches", then " level N" when the level is not `default_level`, then
-  /// " + fit" when fitted, then " + frame steps N" when not the default.
+  /// " + fit" when fitted, then " + L∞ pass" with linf_sweeps, then " + frame steps N" when not the default.
   std::string name(int default_level) const;
   /// The switches of `geomip convert` that build this candidate ("--end-loop --fit", "--patches 8 --level
-  /// 7").
+  /// 7", "--tip-loop --fit --linf-sweeps 1000").
   std::string switches(int default_level) const;
 };
 
@@ -61,6 +64,10 @@ inline constexpr std::size_t kSearchSizes[] = {1500, 2000, 4700, 8800, 16000, 32
 /// framed steps": each helps some meshes at some sizes and costs others). Tangential components 4× coarser
 /// instead of 2× lost 0.6…1.7 dB in the mean on the horse with every framing, so they are not tried.
 inline constexpr int kSearchFrameSteps[] = {3, 4, 5};
+/// The L∞ pass `--search` tries on its best layout (after the fit): it moves samples towards the most
+/// stretched triangles (protrusions); on the horse +0.15 / +0.41 dB on the mean of 18 prefix sizes up to /
+/// above 16 KB (docs/measurements.md, "The L∞ pass in the search").
+inline constexpr std::size_t kSearchLinfSweeps = 1000;
 
 struct SearchOptions {
   /// The two-square loops: plain, through the tips (`--tip-loop`) and through the ends (`--end-loop`), each
@@ -73,6 +80,9 @@ struct SearchOptions {
   /// candidate); tried on the best layout only (it costs a pipeline of its own, and what it gains depends on
   /// the mesh more than on the layout).
   bool fit = false;
+  /// Then the best so far with the parameterization's L∞ pass of this many sweeps (a pipeline of its own,
+  /// when ConvertOptions::linf_sweeps is 0); 0 = not tried.
+  std::size_t linf_sweeps = 0;
   /// Then the best of those with local frames on each of these numbers of wavelet steps (the pack re-encoded
   /// from the same geometry images: seconds each). Empty = the default only.
   std::vector<int> frame_steps_choices;
@@ -100,8 +110,8 @@ struct SearchResult {
   ConvertResult converted;             ///< the chosen candidate converted with the caller's options
 };
 
-/// What `--search` (convert and rd) tries: the loops, the 8-patch layout, the fit and kSearchFrameSteps,
-/// scored at kSearchSizes.
+/// What `--search` (convert and rd) tries: the loops, the 8-patch layout, the fit, kSearchLinfSweeps and
+/// kSearchFrameSteps, scored at kSearchSizes.
 SearchOptions full_search_options();
 
 /// Builds `mesh`'s candidates (the plain loop at ConvertOptions::level always; the others as `search` asks;

@@ -1016,10 +1016,11 @@ TEST_F(CliPack, ChooseLoopKeepsTheBestOfTheLoops) {
   }
 }
 
-// --search builds the loops, the 8-patch layout one level coarser, the best of them fitted and the best with
-// more framed steps, scores each on the same prefix sizes, and keeps the highest mean: the pack written is byte for byte what convert writes
-// with the chosen switches, and the scores it reports are the decoded prefixes' PSNR (rechecked here with
-// decode --bytes and eval for the chosen pack). Mixed with the switches it chooses itself: exit 2, no pack.
+// --search builds the loops, the 8-patch layout one level coarser, the best of them fitted, the best with
+// the L∞ pass and the best with more framed steps, scores each on the same prefix sizes, and keeps the
+// highest mean: the pack written is byte for byte what convert writes with the chosen switches, and the
+// scores it reports are the decoded prefixes' PSNR (rechecked here with decode --bytes and eval for the
+// chosen pack). Mixed with the switches it chooses itself: exit 2, no pack.
 TEST_F(CliPack, SearchKeepsTheBestCandidate) {
   const std::string mesh = write_spiked_ellipsoid(dir_);
   const std::string common = " --no-normals --level 5 '" + mesh + "' -o '" + dir_;
@@ -1032,12 +1033,13 @@ TEST_F(CliPack, SearchKeepsTheBestCandidate) {
   ASSERT_FALSE(sizes.empty());
   std::string best;
   double best_psnr = -1;
-  bool fitted = false, layout = false, framed = false;
+  bool fitted = false, layout = false, framed = false, linf = false;
   for (const auto& c : search["candidates"]) {
     const std::string name = c["name"];
     ASSERT_EQ(c["psnr_db"].size(), sizes.size()) << name;
     fitted = fitted || name.find("+ fit") != std::string::npos;
     framed = framed || name.find("frame steps 5") != std::string::npos;
+    linf = linf || name.find("+ L∞ pass") != std::string::npos;
     layout = layout || name.find("8 patches level 4") != std::string::npos;
     const double mean = c["mean_psnr_db"];
     EXPECT_TRUE(std::isfinite(mean) && mean > 30) << c.dump();
@@ -1046,6 +1048,7 @@ TEST_F(CliPack, SearchKeepsTheBestCandidate) {
   EXPECT_TRUE(fitted) << "the best layout is tried with --fit: " << search.dump();
   EXPECT_TRUE(layout) << "the 8-patch layout one level coarser is a candidate: " << search.dump();
   EXPECT_TRUE(framed) << "the best is tried with 4 and 5 framed steps: " << search.dump();
+  EXPECT_TRUE(linf) << "the best is tried with the L∞ pass: " << search.dump();
   EXPECT_EQ(search["chosen"], best) << search.dump();
   const std::string switches = search["switches"];
   EXPECT_EQ(j["level"], switches.find("--level 4") != std::string::npos ? 4 : 5);

@@ -130,7 +130,159 @@ bool read_normalization(ByteReader& r, std::array<double, 16>& m, std::uint16_t 
 // bytes were cut, the rest — followed by origin and step as compact doubles. The reader puts the 32 bytes
 // back and parses; the origin and step it then reads must be the compact ones. Older versions store
 // serialize()'s bytes as they are (varint size + bytes).
-void write_codec_header(ByteWriter& w, const GeometryCodecHeader& h, std::uint16_t version) {
+// Seam tables of format version 7. GeometryCodecHeader::serialize() lists every seam as patch, other patch
+// (varints) and a byte of sides and orientation, and a layout lists each shared side from both of its
+// patches: 768 bytes per codec header for a 64-quad layout, twice per model with normal maps, once more per
+// model of a consistent set — 3,456 of the 3,554 bytes before the first level of detail of the four animals
+// with their 64-quad layout (docs/codec-v3.md, "Seam tables"). From version 7 the codec header's bytes carry
+// no seams (its seam count is 0) and the table follows the header's doubles:
+//   u8 form
+//   form 0 (kSeamsListed): varint count, then per seam as serialize() writes it;
+//   form 1 (kSeamsAsBefore): the same list as the codec header read just before in this manifest (a model's
+//          normal maps, the next model of a consistent set);
+//   form 2 (kSeamsMirrored): the table every quad layout and two-square partition gives — one seam per side,
+//          (patch, side) in order, each the mirror of its partner's (p, s, q, t, r) ↔ (q, t, p, s, r) —
+//          stored once per pair, bit-packed LSB first: for each side in order whose partner is not known yet,
+//          the partner's patch minus this patch in bit_width(num_patches − 1 − patch) bits (the partner
+//          comes later, so the difference is ≥ 0), its side in 2 bits and `reversed` in 1; zero bits pad to
+//          a byte.
+enum SeamForm : std::uint8_t { kSeamsListed = 0, kSeamsAsBefore = 1, kSeamsMirrored = 2 };
+
+bool same_seams(const std::vector<PatchSeam>& a, const std::vector<PatchSeam>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const PatchSeam& x, const PatchSeam& y) {
+    return x.patch == y.patch && x.side == y.side && x.other_patch == y.other_patch &&
+           x.other_side == y.other_side && x.reversed == y.reversed;
+  });
+}
+
+bool mirrored_seams(const std::vector<PatchSeam>& seams, int num_patches) {
+  if (seams.size() != 4 * static_cast<std::size_t>(num_patches)) return false;
+  for (std::size_t i = 0; i < seams.size(); ++i) {
+    const PatchSeam& s = seams[i];
+    if (s.patch != static_cast<int>(i / 4) || s.side != static_cast<int>(i % 4) || s.other_patch < 0 ||
+        s.other_patch >= num_patches || s.other_side < 0 || s.other_side > 3)
+      return false;
+    const std::size_t j =
+        4 * static_cast<std::size_t>(s.other_patch) + static_cast<std::size_t>(s.other_side);
+    const PatchSeam& o = seams[j];
+    if (j == i || o.other_patch != s.patch || o.other_side != s.side || o.reversed != s.reversed)
+      return false;
+  }
+  return true;
+}
+
+void write_seams(ByteWriter& w, const std::vector<PatchSeam>& seams, int num_patches,
+                 const std::vector<PatchSeam>* before) {
+  if (before != nullptr && same_seams(seams, *before)) {
+    w.u8(kSeamsAsBefore);
+    return;
+  }
+  if (!mirrored_seams(seams, num_patches)) {
+    w.u8(kSeamsListed);
+    w.varint(seams.size());
+    for (const PatchSeam& s : seams) {
+      w.varint(static_cast<std::uint64_t>(s.patch));
+      w.varint(static_cast<std::uint64_t>(s.other_patch));
+      w.u8(static_cast<std::uint8_t>((s.side & 3) | (s.other_side & 3) << 2 | (s.reversed ? 16 : 0)));
+    }
+    return;
+  }
+  w.u8(kSeamsMirrored);
+  std::uint64_t acc = 0;
+  int filled = 0;
+  auto put = [&](std::uint64_t v, int bits) {
+    for (int b = 0; b < bits; ++b) {
+      acc |= (v >> b & 1) << filled;
+      if (++filled == 8) w.u8(static_cast<std::uint8_t>(acc)), acc = 0, filled = 0;
+    }
+  };
+  for (std::size_t i = 0; i < seams.size(); ++i) {
+    const PatchSeam& s = seams[i];
+    const std::size_t j =
+        4 * static_cast<std::size_t>(s.other_patch) + static_cast<std::size_t>(s.other_side);
+    if (j < i) continue;  // written with its partner
+    put(static_cast<std::uint64_t>(s.other_patch - s.patch),
+        std::bit_width(static_cast<unsigned>(num_patches - 1 - s.patch)));
+    put(static_cast<std::uint64_t>(s.other_side), 2);
+    put(s.reversed ? 1 : 0, 1);
+  }
+  if (filled > 0) w.u8(static_cast<std::uint8_t>(acc));
+}
+
+/// Reads what write_seams() wrote into `seams` (for a header of `num_patches` patches). Bounds: a table
+/// never holds more than 4 seams per patch, and a mirrored one is only allocated when the bytes left can
+/// hold it (3 bits per pair at least).
+bool read_seams(ByteReader& r, std::vector<PatchSeam>& seams, int num_patches,
+                const std::vector<PatchSeam>* before) {
+  std::uint8_t form;
+  if (!r.u8(form)) return false;
+  if (form == kSeamsAsBefore) {
+    if (before == nullptr) return false;
+    seams = *before;
+    return true;
+  }
+  if (form == kSeamsListed) {
+    std::uint64_t count;
+    if (!r.bounded(count, 4 * static_cast<std::uint64_t>(num_patches)) || count > r.remaining() / 3)
+      return false;
+    seams.resize(static_cast<std::size_t>(count));
+    for (PatchSeam& s : seams) {
+      std::uint64_t patch, other;
+      std::uint8_t packed;
+      if (!r.bounded(patch, static_cast<std::uint64_t>(num_patches - 1)) ||
+          !r.bounded(other, static_cast<std::uint64_t>(num_patches - 1)) || !r.u8(packed) ||
+          (packed & ~0x1F) != 0)
+        return false;
+      s = {static_cast<int>(patch), packed & 3, static_cast<int>(other), (packed >> 2) & 3,
+           (packed & 16) != 0};
+    }
+    return true;
+  }
+  if (form != kSeamsMirrored) return false;
+  const std::uint64_t pairs = 2 * static_cast<std::uint64_t>(num_patches);
+  if (r.remaining() * 8 < pairs * 3) return false;
+  seams.assign(4 * static_cast<std::size_t>(num_patches), PatchSeam{-1, 0, -1, 0, true});
+  std::uint8_t byte = 0;
+  int left = 0;
+  auto get = [&](int bits, std::uint64_t& v) {
+    v = 0;
+    for (int b = 0; b < bits; ++b) {
+      if (left == 0) {
+        if (!r.u8(byte)) return false;
+        left = 8;
+      }
+      v |= static_cast<std::uint64_t>(byte & 1) << b;
+      byte = static_cast<std::uint8_t>(byte >> 1);
+      --left;
+    }
+    return true;
+  };
+  for (std::size_t i = 0; i < seams.size(); ++i) {
+    PatchSeam& s = seams[i];
+    if (s.patch >= 0) continue;  // its partner's mirror
+    const int patch = static_cast<int>(i / 4);
+    std::uint64_t delta, side, reversed;
+    if (!get(std::bit_width(static_cast<unsigned>(num_patches - 1 - patch)), delta) || !get(2, side) ||
+        !get(1, reversed) || delta > static_cast<std::uint64_t>(num_patches - 1 - patch))
+      return false;
+    const int other = patch + static_cast<int>(delta);
+    const std::size_t j = 4 * static_cast<std::size_t>(other) + static_cast<std::size_t>(side);
+    if (j <= i || seams[j].patch >= 0) return false;  // the partner must be a later side with no seam yet
+    s = {patch, static_cast<int>(i % 4), other, static_cast<int>(side), reversed == 1};
+    seams[j] = {other, static_cast<int>(side), patch, static_cast<int>(i % 4), reversed == 1};
+  }
+  return byte == 0;  // the padding is zero
+}
+
+void write_codec_header(ByteWriter& w, const GeometryCodecHeader& h, std::uint16_t version,
+                        const std::vector<PatchSeam>* seams_before = nullptr) {
+  if (version >= 7) {
+    GeometryCodecHeader without = h;
+    without.seams.clear();
+    write_codec_header(w, without, 6);
+    write_seams(w, h.seams, h.num_patches, seams_before);
+    return;
+  }
   std::vector<std::uint8_t> bytes = h.serialize();
   if (version < 4) {
     w.bytes(bytes);
@@ -148,7 +300,17 @@ void write_codec_header(ByteWriter& w, const GeometryCodecHeader& h, std::uint16
   write_doubles(w, values, version);
 }
 
-bool read_codec_header(ByteReader& r, GeometryCodecHeader& h, std::uint16_t version) {
+bool read_codec_header(ByteReader& r, GeometryCodecHeader& h, std::uint16_t version,
+                       const std::vector<PatchSeam>* seams_before = nullptr) {
+  if (version >= 7) {
+    // The header as version 6 stores it, with no seams, then the seam table; parse() checks the whole header
+    // again (seam bounds included).
+    if (!read_codec_header(r, h, 6) || !h.seams.empty() ||
+        !read_seams(r, h.seams, h.num_patches, seams_before))
+      return false;
+    GeometryCodecHeader checked;
+    return GeometryCodecHeader::parse(h.serialize(), checked) == Status::kOk;
+  }
   std::vector<std::uint8_t> bytes;
   if (version < 4) return r.bytes(bytes, 1 << 20) && GeometryCodecHeader::parse(bytes, h) == Status::kOk;
   std::uint64_t offset;
@@ -380,11 +542,14 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
   std::vector<int> geometry_passes, normal_passes;
   std::vector<bool> fine_mask;
   std::uint64_t samples = 0;
+  const std::vector<PatchSeam>* seams_before = nullptr;  // version 7: the seam table read last
   for (PackModelInfo& model : out.models) {
     std::uint8_t has_normals;
     if (!r.string(model.name, kMaxNameSize) || !read_normalization(r, model.normalization, out.version) ||
-        !read_codec_header(r, model.geometry, out.version) || !r.u8(has_normals) || has_normals > 1)
+        !read_codec_header(r, model.geometry, out.version, seams_before) || !r.u8(has_normals) ||
+        has_normals > 1)
       return Status::kCorrupt;
+    seams_before = &model.geometry.seams;
     // Pack version v ≤ 3 holds codec headers of version v (1: joint streams, 2: per-patch ones, 3: local
     // frames); version 4 (a container change) those of version 3; version 5 those of versions 3 and 4 (4:
     // the lifting update); version 6 those of versions 3 to 5 (5: the filter kCubicLong).
@@ -401,11 +566,13 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     samples += samples_of(model.geometry);
     model.has_normals = has_normals == 1;
     if (model.has_normals) {
-      if (!read_codec_header(r, model.normals, out.version) || !codec_version_ok(model.normals.version) ||
-          model.normals.level > kMaxPackLevel || model.normals.num_patches != model.geometry.num_patches ||
-          passes_of(model.normals) < 1 || passes_of(model.normals) > static_cast<int>(kMaxPasses))
+      if (!read_codec_header(r, model.normals, out.version, seams_before) ||
+          !codec_version_ok(model.normals.version) || model.normals.level > kMaxPackLevel ||
+          model.normals.num_patches != model.geometry.num_patches || passes_of(model.normals) < 1 ||
+          passes_of(model.normals) > static_cast<int>(kMaxPasses))
         return Status::kCorrupt;
       samples += samples_of(model.normals);
+      seams_before = &model.normals.seams;
     }
     if (samples > kMaxSamplesPerPack) return Status::kCorrupt;
     std::uint64_t mask_patches;
@@ -612,15 +779,20 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
   }
 
   ByteWriter manifest;
+  const std::vector<PatchSeam>* seams_before = nullptr;  // the seam table written last
   manifest.varint(models.size());
   manifest.varint(static_cast<std::uint64_t>(options.normals_delay));
   manifest.varint(static_cast<std::uint64_t>(mask_stage));
   for (std::size_t m = 0; m < models.size(); ++m) {
     manifest.string(models[m].name);
     write_normalization(manifest, models[m].normalization, kPackVersion);
-    write_codec_header(manifest, geometry[m].header, kPackVersion);
+    write_codec_header(manifest, geometry[m].header, kPackVersion, seams_before);
+    seams_before = &geometry[m].header.seams;
     manifest.u8(normal_passes[m] > 0 ? 1 : 0);
-    if (normal_passes[m] > 0) write_codec_header(manifest, normals[m].header, kPackVersion);
+    if (normal_passes[m] > 0) {
+      write_codec_header(manifest, normals[m].header, kPackVersion, seams_before);
+      seams_before = &normals[m].header.seams;
+    }
     manifest.varint(models[m].hole_mask.size());
     if (!models[m].hole_mask.empty()) {
       manifest.u8(static_cast<std::uint8_t>(mask_level[m]));

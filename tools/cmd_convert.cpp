@@ -294,11 +294,12 @@ CommandRunner add_convert_command(CLI::App& app) {
                 "Weigh row/column and diagonal detail bands alike (ablations)");
   cmd->add_flag("--no-lifting-update", args->no_lifting_update,
                 "Code the geometry with the plain interpolating wavelet, without the update step (ablations; "
-                "the pack is still format 6)");
-  cmd->add_flag("--short-filter", args->short_filter,
-                "Code the geometry with pack format 5's 4-point wavelet filter on every step and its 2-tap update, "
-                "not the 6-point prediction of the coarser steps and the 4-tap update (ablations; the pack is "
-                "still format 6)");
+                "the pack is still format 7)");
+  cmd->add_flag(
+      "--short-filter", args->short_filter,
+      "Code the geometry with pack format 5's 4-point wavelet filter on every step and its 2-tap update, "
+      "not the 6-point prediction of the coarser steps and the 4-tap update (ablations; the pack is "
+      "still format 7)");
   cmd->add_flag("--choose-loop", args->choose_loop,
                 "One mesh, two squares: build the pack with the plain loop, with --tip-loop and with --end-loop "
                 "(each when the mesh has tips) and keep the one whose 2, 4, 8 and 16 KB prefixes are closest to "

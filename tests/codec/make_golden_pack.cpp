@@ -1,34 +1,59 @@
 // Writes a golden pack of pack_test's GoldenPackDecodes: two pillows (level 5, scales 1 and 2) with normal
 // maps. Run by hand once per pack format version, to a new file (old ones stay: old packs must keep
 // decoding):
-//   ./build/tests/make_golden_pack tests/data/golden-pillow-v6.gip   (format version 6)
+//   ./build/tests/make_golden_pack tests/data/golden-pillow-v7.gip   (format version 7)
 // (tests/data/golden-pillow.gip was written by format version 1, golden-pillow-v2.gip by version 2,
-// golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by version 5.)
+// golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by version 5,
+// golden-pillow-v6.gip by version 6.)
 // With --per-patch, a small fuzzer seed instead: one level-4 pillow with normal maps whose joint part ends
 // after 64 bytes, so most of its bytes are per-patch streams (the other seeds are smaller than the default
 // 2 KB joint part) — tests/fuzz/seeds/pack/pillow-l4-per-patch.gip (format 3),
 // pillow-l4-per-patch-v4.gip (format 4, its CRC groups and trailers), pillow-l4-per-patch-v5.gip (format 5,
-// the lifting update), pillow-l4-per-patch-v6.gip (format 6, the filter kCubicLong):
-//   ./build/tests/make_golden_pack --per-patch tests/fuzz/seeds/pack/pillow-l4-per-patch-v6.gip
+// the lifting update), pillow-l4-per-patch-v6.gip (format 6, the filter kCubicLong),
+// pillow-l4-per-patch-v7.gip (format 7, compact seam tables):
+//   ./build/tests/make_golden_pack --per-patch tests/fuzz/seeds/pack/pillow-l4-per-patch-v7.gip
+// With --layout, a fuzzer seed whose seam tables are long: two models of 24 level-2 patches glued in random
+// side pairs (a quad layout's mirrored table, then a reference to it), normal maps on the first —
+// tests/fuzz/seeds/pack/layout-24-v7.gip (format 7):
+//   ./build/tests/make_golden_pack --layout tests/fuzz/seeds/pack/layout-24-v7.gip
 #include "codec/pack.h"
 #include "tests/codec/pillow.h"
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <random>
 #include <string>
 
 int main(int argc, char** argv) {
   const bool per_patch = argc == 3 && std::string(argv[1]) == "--per-patch";
-  if (argc != 2 && !per_patch) {
-    std::fprintf(stderr, "usage: make_golden_pack [--per-patch] OUT.gip\n");
+  const bool layout = argc == 3 && std::string(argv[1]) == "--layout";
+  if (argc != 2 && !per_patch && !layout) {
+    std::fprintf(stderr, "usage: make_golden_pack [--per-patch | --layout] OUT.gip\n");
     return 2;
   }
   const char* path = argv[argc - 1];
   geomip::codec::PackWriteOptions options;
   if (per_patch) options.geometry.joint_bytes = options.normal_codec.joint_bytes = 64;
   std::vector<geomip::codec::PackModelInput> models;
-  for (int m = 0; m < (per_patch ? 1 : 2); ++m) {
+  if (layout) {
+    std::mt19937 rng(24);
+    constexpr int kPatches = 24;
+    const std::vector<geomip::codec::PatchSeam> seams = geomip::test::random_layout_seams(kPatches, rng);
+    for (int m = 0; m < 2; ++m) {
+      geomip::codec::PackModelInput in;
+      in.name = m == 0 ? "a" : "b";
+      for (int p = 0; p < kPatches; ++p) {
+        geomip::codec::Grid3 g{2, std::vector<float>(75)};
+        for (float& v : g.values) v = static_cast<float>(rng() % 1000) / 1000.0f;
+        in.geometry.push_back(g);
+      }
+      in.seams = seams;
+      if (m == 0) in.normals = geomip::test::position_normals(in.geometry);
+      models.push_back(std::move(in));
+    }
+  }
+  for (int m = 0; m < (layout ? 0 : per_patch ? 1 : 2); ++m) {
     const geomip::test::Pillow p = geomip::test::make_pillow(per_patch ? 4 : 5, m == 0 ? 1.0 : 2.0);
     geomip::codec::PackModelInput in;
     in.name = m == 0 ? "a" : "b";

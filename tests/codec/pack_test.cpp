@@ -19,6 +19,7 @@ namespace geomip::codec {
 namespace {
 
 using test::make_pillow;
+using test::random_layout_seams;
 using test::seam_mismatches;
 
 PackModelInput pillow_model(int level, const std::string& name, double scale = 1.0, bool normals = false) {
@@ -525,10 +526,109 @@ TEST(PackPerPatch, EverySingleBitFlipIsRefusedOrACoarserModel) {
   }
 }
 
+bool same_seams(const std::vector<PatchSeam>& a, const std::vector<PatchSeam>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const PatchSeam& x, const PatchSeam& y) {
+    return x.patch == y.patch && x.side == y.side && x.other_patch == y.other_patch &&
+           x.other_side == y.other_side && x.reversed == y.reversed;
+  });
+}
+
+// Format 7's seam tables: a layout's mirrored table stored once per side pair, a table equal to the one just
+// before (the normal maps', the next model's) as a reference, any other table listed; each reads back to
+// the writer's table, and the prefixes stay watertight.
+TEST(Pack, SeamTablesRoundTripInTheirCompactForms) {
+  std::vector<PackModelInput> models = {pillow_model(3, "a", 1.0, true), pillow_model(3, "b", 2.0, true),
+                                        pillow_model(3, "c")};
+  models[2].seams.resize(4);  // patch 0's side of each seam only: not mirrored, listed
+  const std::vector<std::uint8_t> pack = write_pack(models);
+  PackInfo info;
+  ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
+  ASSERT_EQ(info.models.size(), 3u);
+  for (std::size_t m = 0; m < 3; ++m) {
+    EXPECT_TRUE(same_seams(info.models[m].geometry.seams, models[m].seams)) << m;
+    if (m < 2) {
+      EXPECT_TRUE(same_seams(info.models[m].normals.seams, models[m].seams)) << m;
+    }
+  }
+  for (std::size_t n = info.manifest_end; n <= pack.size(); n += 97) {
+    const PackDecodeResult r = decode_pack(pack, {.max_bytes = n});
+    for (const DecodedModel& model : r.models) EXPECT_EQ(seam_mismatches(model.geometry, model.seams), 0u);
+  }
+
+  // 40 patches glued at random: the mirrored form holds 80 pairs in about 8 bits each, where listing the 160
+  // seams takes 3 bytes each (format 6).
+  std::mt19937 rng(7);
+  PackModelInput many;
+  many.name = "k";
+  for (int p = 0; p < 40; ++p) {
+    Grid3 g{1, std::vector<float>(27)};
+    for (float& v : g.values) v = static_cast<float>(rng() % 1000) / 1000.0f;
+    many.geometry.push_back(g);
+  }
+  many.seams = random_layout_seams(40, rng);
+  const std::vector<std::uint8_t> packed = write_pack({many, many}, geometry_only());
+  ASSERT_EQ(read_pack_info(packed, info), Status::kOk);
+  for (const PackModelInfo& model : info.models) EXPECT_TRUE(same_seams(model.geometry.seams, many.seams));
+  EXPECT_LT(info.manifest_end, 160u * 3 / 2);
+  const PackDecodeResult r = decode_pack(packed);
+  ASSERT_EQ(r.status, Status::kOk);
+  for (const DecodedModel& model : r.models) EXPECT_EQ(seam_mismatches(model.geometry, model.seams), 0u);
+}
+
+// Every byte of a manifest changed (each bit flipped; set to 0, 1, 2, 255), the manifest CRC recomputed so
+// the change reaches the parser (seam tables included: a partner given twice, a reference with nothing before
+// it, a patch out of range, non-zero padding): refused, or read as a pack whose seams the decoder can use —
+// never a crash.
+TEST(Pack, ManifestByteChangesAreRefusedOrReadAsValid) {
+  const std::vector<std::uint8_t> pack = write_pack({pillow_model(2, "a", 1.0, true)});
+  PackInfo info;
+  ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
+  // Format 4 and later: magic (8), version (2), manifest size (varint), manifest CRC (4), manifest.
+  std::size_t crc_at = 10;
+  while (pack[crc_at] & 0x80) ++crc_at;
+  ++crc_at;
+  const std::size_t begin = crc_at + 4;
+  ASSERT_LT(begin, info.manifest_end);
+  int accepted = 0, refused = 0;
+  for (std::size_t at = begin; at < info.manifest_end; ++at) {
+    // Each single-bit flip, and the byte set to 0, 1, 2 and 255.
+    std::vector<std::uint8_t> values = {0, 1, 2, 255};
+    for (int b = 0; b < 8; ++b) values.push_back(static_cast<std::uint8_t>(pack[at] ^ (1 << b)));
+    for (std::uint8_t v : values) {
+      if (v == pack[at]) continue;
+      std::vector<std::uint8_t> bad = pack;
+      bad[at] = v;
+      const std::uint32_t crc = crc32(std::span(bad).subspan(begin, info.manifest_end - begin));
+      for (int k = 0; k < 4; ++k) bad[crc_at + k] = static_cast<std::uint8_t>(crc >> (8 * k));
+      PackInfo changed;
+      if (read_pack_info(bad, changed) != Status::kOk) {
+        ++refused;
+        continue;
+      }
+      ++accepted;
+      for (const PackModelInfo& model : changed.models)
+        for (const PatchSeam& s : model.geometry.seams)
+          ASSERT_TRUE(s.patch >= 0 && s.patch < model.geometry.num_patches && s.other_patch >= 0 &&
+                      s.other_patch < model.geometry.num_patches && s.side >= 0 && s.side < 4 &&
+                      s.other_side >= 0 && s.other_side < 4);
+      // Decoded only when small (a changed level or patch count may ask for large grids, which is allowed).
+      const bool small =
+          std::all_of(changed.models.begin(), changed.models.end(), [](const PackModelInfo& m) {
+            return m.geometry.num_patches <= 4 && m.geometry.level <= 3 &&
+                   (!m.has_normals || m.normals.level <= 3);
+          });
+      if (small) decode_pack(bad, {.max_bytes = changed.manifest_end + 64});
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(accepted, 0);
+}
+
 // The committed golden packs (tests/data/golden-pillow.gip written by format version 1, golden-pillow-v2.gip
 // by version 2, golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by
 // version 5: codec header version 4, the lifting update; golden-pillow-v6.gip by version 6: codec header
-// version 5, the filter kCubicLong) must keep decoding to
+// version 5, the filter kCubicLong; golden-pillow-v7.gip by version 7: compact seam tables) must keep
+// decoding to
 // the pillow they were made from: decoders of old streams do not silently change.
 class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
 
@@ -572,7 +672,8 @@ INSTANTIATE_TEST_SUITE_P(Versions, GoldenPack,
                                            std::pair<const char*, int>{"golden-pillow-v3.gip", 3},
                                            std::pair<const char*, int>{"golden-pillow-v4.gip", 4},
                                            std::pair<const char*, int>{"golden-pillow-v5.gip", 5},
-                                           std::pair<const char*, int>{"golden-pillow-v6.gip", 6}));
+                                           std::pair<const char*, int>{"golden-pillow-v6.gip", 6},
+                                           std::pair<const char*, int>{"golden-pillow-v7.gip", 7}));
 
 }  // namespace
 }  // namespace geomip::codec

@@ -5,8 +5,11 @@
 
 #include "codec/geometry_codec.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numeric>
+#include <random>
 #include <vector>
 
 namespace geomip::test {
@@ -20,6 +23,24 @@ struct Pillow {
   std::vector<codec::Grid3> patches;
   std::vector<codec::PatchSeam> seams;
 };
+
+/// A mirrored seam table (one seam per side, (patch, side) in order, each its partner's mirror) that glues
+/// the sides of `patches` patches in random pairs with random orientations: the form of a quad layout's
+/// table, for seam-table tests and fuzz seeds (the grids need not agree on the seams: the decoder copies
+/// each seam sample from its owner).
+inline std::vector<codec::PatchSeam> random_layout_seams(int patches, std::mt19937& rng) {
+  std::vector<int> sides(4 * static_cast<std::size_t>(patches));
+  std::iota(sides.begin(), sides.end(), 0);
+  std::shuffle(sides.begin(), sides.end(), rng);
+  std::vector<codec::PatchSeam> seams(sides.size());
+  for (std::size_t k = 0; k < sides.size(); k += 2) {
+    const int a = sides[k], b = sides[k + 1];
+    const bool reversed = rng() % 2 == 0;
+    seams[static_cast<std::size_t>(a)] = {a / 4, a % 4, b / 4, b % 4, reversed};
+    seams[static_cast<std::size_t>(b)] = {b / 4, b % 4, a / 4, a % 4, reversed};
+  }
+  return seams;
+}
 
 /// A smooth unit vector field for normal-map tests: each sample's normalized position ((0, 0, 1) at the
 /// origin). The normal maps of the golden packs are made this way.

@@ -28,6 +28,7 @@ namespace {
 struct ConvertArgs {
   ModelArgs common;
   int level = 8;
+  bool level_given = false;  ///< --level on the command line; else default_grid_level() of the layout
   int normal_level = -1;
   int quantization_bits = 14;
   int hole_mask_level = -1;
@@ -76,20 +77,28 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-int run_convert(const ConvertArgs& args) {
-  if (args.level < 1 || args.level > 10)
-    throw InvalidInput("--level " + std::to_string(args.level) + " is outside [1, 10]");
-  if (args.normal_level >= 0 && (args.normal_level < args.level || args.normal_level > 10))
+/// The options whose range depends on the grid level.
+void check_level_options(const ConvertArgs& args, int level) {
+  if (level < 1 || level > 10) throw InvalidInput("--level " + std::to_string(level) + " is outside [1, 10]");
+  if (args.normal_level >= 0 && (args.normal_level < level || args.normal_level > 10))
     throw InvalidInput("--normal-level " + std::to_string(args.normal_level) + " is outside [" +
-                       std::to_string(args.level) + ", 10]");
+                       std::to_string(level) + ", 10]");
+  if (args.normal_mesh_steps < -1 || args.normal_mesh_steps > level)
+    throw InvalidInput("--normal-mesh " + std::to_string(args.normal_mesh_steps) + " is outside [0, " +
+                       std::to_string(level) + "] (the level)");
+  if (args.frame_steps < 0 || args.frame_steps > level)
+    throw InvalidInput("--frame-steps " + std::to_string(args.frame_steps) + " is outside [0, " +
+                       std::to_string(level) + "] (the level)");
+}
+
+int run_convert(const ConvertArgs& args) {
+  // The level: --level, else default_grid_level() of --patches (a CORR.json's layout is counted once it is
+  // read).
+  int level =
+      args.level_given ? args.level : default_grid_level(static_cast<std::size_t>(args.common.patches));
+  check_level_options(args, level);
   if (args.quantization_bits < 8 || args.quantization_bits > 24)
     throw InvalidInput("--bits " + std::to_string(args.quantization_bits) + " is outside [8, 24]");
-  if (args.normal_mesh_steps < -1 || args.normal_mesh_steps > args.level)
-    throw InvalidInput("--normal-mesh " + std::to_string(args.normal_mesh_steps) + " is outside [0, " +
-                       std::to_string(args.level) + "] (the level)");
-  if (args.frame_steps < 0 || args.frame_steps > args.level)
-    throw InvalidInput("--frame-steps " + std::to_string(args.frame_steps) + " is outside [0, " +
-                       std::to_string(args.level) + "] (the level)");
   if (args.tangential_shift < 0 || args.tangential_shift > 8)
     throw InvalidInput("--tangential-shift " + std::to_string(args.tangential_shift) + " is outside [0, 8]");
   if (args.normal_mesh_steps > 0 && (args.common.meshes.size() > 1 || !args.common.points.empty()))
@@ -115,6 +124,10 @@ int run_convert(const ConvertArgs& args) {
   if (!searching)
     models = prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches,
                             loop_asked);
+  if (!args.level_given && !models.inputs.empty() && !models.inputs.front().layout_quads.empty()) {
+    level = default_grid_level(models.inputs.front().layout_quads.size());
+    check_level_options(args, level);
+  }
 
   const std::optional<UpAxis> up = up_axis(args);
   const Eigen::Vector3d front = front_axis(args);
@@ -129,7 +142,7 @@ int run_convert(const ConvertArgs& args) {
 
   ProgressBar bar("convert", report);
   ConvertOptions options;
-  options.level = args.level;
+  options.level = level;
   options.normal_level = args.normal_level;
   options.normals = !args.no_normals;
   options.quantization_bits = args.quantization_bits;
@@ -151,7 +164,7 @@ int run_convert(const ConvertArgs& args) {
   options.progress = bar.callback();
   ConvertResult converted;
   std::optional<SearchResult> searched;
-  int level = args.level;
+  const int named_level = level;  // the level the search names its candidates against
   if (searching) {
     // --choose-loop: the loops only (with --fit every loop fitted: options.fit).
     SearchOptions search = args.search ? full_search_options() : SearchOptions{};
@@ -192,7 +205,8 @@ int run_convert(const ConvertArgs& args) {
 
   codec::PackInfo info;
   codec::read_pack_info(pack, info);
-  const nlohmann::json search_report = searched ? search_json(*searched, args.level) : nlohmann::json(nullptr);
+  const nlohmann::json search_report =
+      searched ? search_json(*searched, named_level) : nlohmann::json(nullptr);
   if (args.common.json) {
     nlohmann::json j_models = nlohmann::json::array();
     for (std::size_t m = 0; m < models.inputs.size(); ++m)
@@ -241,9 +255,9 @@ int run_convert(const ConvertArgs& args) {
     if (args.search) {
       std::string sizes;
       for (std::size_t n : searched->sizes) sizes += (sizes.empty() ? "" : ", ") + std::to_string(n);
-      const std::string switches = searched->chosen.switches(args.level);
+      const std::string switches = searched->chosen.switches(named_level);
       std::printf("search: %s (%s; the highest mean PSNR of the prefixes of %s bytes)\n",
-                  searched->chosen.name(args.level).c_str(),
+                  searched->chosen.name(named_level).c_str(),
                   switches.empty() ? "the defaults" : switches.c_str(), sizes.c_str());
     }
   }
@@ -261,7 +275,10 @@ CommandRunner add_convert_command(CLI::App& app) {
   args->common.sampling_exponent = ConvertOptions{}.sampling_exponent;  // streaming: best at low rates
   add_model_options(cmd, args->common);
   cmd->get_option("--output")->description("Output pack file (.gip)");
-  cmd->add_option("--level", args->level, "Grid level N in [1, 10] (default 8: 257² samples per patch)");
+  CLI::Option* level = cmd->add_option(
+      "--level", args->level,
+      "Grid level N in [1, 10] (default 8: 257² samples per patch, for two squares; for a K-patch layout "
+      "the level whose K grids hold about as many samples: K = 8: 7, 32: 6, 64: 5)");
   cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
   cmd->add_option("--bits", args->quantization_bits,
                   "Position quantization bits over the largest bounding-box extent (default 14)");
@@ -323,7 +340,10 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "camera): +x, -x, +y, -y, +z or -z, across the up axis. Default: from the first model's "
                   "shape (docs/streaming.md, \"Upright and front\")")
       ->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
-  return [args] { return run_convert(*args); };
+  return [args, level] {
+    args->level_given = level->count() > 0;
+    return run_convert(*args);
+  };
 }
 
 }  // namespace geomip::tools

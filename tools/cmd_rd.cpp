@@ -55,7 +55,7 @@ struct RdArgs {
   bool lindstrom_turk = false;  // also the draco_lt series (CGAL Lindstrom-Turk decimation) and its envelope
   std::size_t samples = 0;  // face samples per surface for the evaluation; 0 = surface_distance's default
   unsigned threads = 0;     // 0 = hardware_concurrency
-  int level = 8;            // geomip: geometry image level of the pack whose prefixes are measured
+  int level = 8;  // geomip: the pack's geometry image level (without --level: default_grid_level(patches))
   bool no_geomip = false;   // only the baselines
   int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
   int patches = 2;          // geomip: patches of the automatic layout (--patches)
@@ -478,8 +478,12 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_option("--samples", args->samples,
                   "Face samples per surface for the evaluation (default: as `geomip eval`; --quick: 20000)");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)");
-  cmd->add_option("--level", args->level, "geomip: geometry image level of the measured pack (default 8)")
-      ->check(CLI::Range(1, 10));
+  CLI::Option* level =
+      cmd->add_option(
+             "--level", args->level,
+             "geomip: geometry image level of the measured pack (default as `geomip convert`: 8 for two "
+             "squares, fewer for a K-patch layout)")
+          ->check(CLI::Range(1, 10));
   cmd->add_flag("--no-geomip", args->no_geomip, "Only the baselines (no geomip pack)");
   cmd->add_option("--normal-mesh", args->normal_mesh_steps,
                   "geomip: normal-mesh resampling of the finest STEPS wavelet steps (as `geomip convert`; 0 = off)")
@@ -495,7 +499,10 @@ CommandRunner add_rd_command(CLI::App& app) {
       "geomip: the pack `geomip convert --search` keeps (the loops, the 8-patch layout one level "
       "coarser, then the best with --fit, the L-infinity pass and more framed steps; scored on 1.5-32 KB "
       "prefixes)");
-  return [args] { return run_rd(*args); };
+  return [args, level] {
+    if (level->count() == 0) args->level = default_grid_level(static_cast<std::size_t>(args->patches));
+    return run_rd(*args);
+  };
 }
 
 }  // namespace geomip::tools

@@ -19,6 +19,13 @@ namespace geomip::tools {
 /// resampling").
 constexpr int kAutoNormalMeshSteps = 3;
 
+/// The grid level `geomip convert` and `geomip rd` use without --level: 8 (257² samples per patch) for two
+/// squares and a torus's four, and for a K-patch layout the level whose K grids hold about as many samples
+/// as two squares at level 8 (nearest in log; K = 8: 7, 16: 6, 32: 6, 64: 5, 128: 5; at least 3, the
+/// default framed steps), so that a layout changes where the samples are, not how many (a 64-quad layout
+/// at level 8 holds 32 times as many).
+int default_grid_level(std::size_t patches);
+
 struct ConvertOptions {
   int level = 8;              ///< geometry image level N: (2^N+1)² samples per patch
   int normal_level = -1;      ///< normal map level (-1: N+1, at most 10)

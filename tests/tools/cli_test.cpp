@@ -1198,7 +1198,8 @@ TEST_F(CliPack, QuadSplitShorterIsCloserAndSharedByTheSet) {
 }
 
 // --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch
-// count): watertight, genus 0, K·2·4^L faces, V = K·4^L + 2; bad K exit 2 with one line and nothing written.
+// count): watertight, genus 0, K·2·4^L faces, V = K·4^L + 2; convert's level without --level; bad K exit 2
+// with one line and nothing written.
 TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
   const std::string out = dir_ + "/k6";
   Outcome r = geomip("remesh --quiet '" + spot_ + "' --patches 6 --level 3 -o '" + out + "'");
@@ -1225,6 +1226,15 @@ TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
   t = analyze_topology(read_mesh(dir_ + "/spot6.obj"));
   EXPECT_EQ(t.boundary_loops, 0u);
   EXPECT_EQ(t.genus, 0);
+  // Without --level a K-patch layout gets the level whose K grids hold about as many samples as two squares
+  // at level 8: 32 patches, level 6 (32·65² = 135,200 against 2·257² = 132,098), not 16 times as many.
+  const std::string pack32 = dir_ + "/spot32.gip";
+  r = geomip("convert --json '" + spot_ + "' --patches 32 --no-normals -o '" + pack32 + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["level"], 6);
+  r = geomip("decode --json '" + pack32 + "' -o '" + dir_ + "/spot32.obj'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["models"][0]["faces"], 32 * 2 * 64 * 64);
   const std::string bad = dir_ + "/bad";
   for (const std::string& args : {"remesh '" + spot_ + "' --patches 1 --level 2 -o '" + bad + "'",
                                   "remesh '" + spot_ + "' --patches 4000 --level 2 -o '" + bad + "'",

@@ -278,7 +278,7 @@ CommandRunner add_convert_command(CLI::App& app) {
   CLI::Option* level = cmd->add_option(
       "--level", args->level,
       "Grid level N in [1, 10] (default 8: 257² samples per patch, for two squares; for a K-patch layout "
-      "the level whose K grids hold about as many samples: K = 8: 7, 32: 6, 64: 5)");
+      "the coarsest level whose K grids hold at least as many samples: K = 8: 7, 32 or 64: 6)");
   cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
   cmd->add_option("--bits", args->quantization_bits,
                   "Position quantization bits over the largest bounding-box extent (default 14)");

@@ -120,17 +120,14 @@ codec::PackWriteOptions pack_write_options(const ConvertOptions& options) {
 
 int default_grid_level(std::size_t patches) {
   constexpr int kTwoSquares = 8;
-  if (patches <= 4) return kTwoSquares;
-  const double target = 2.0 * std::pow((1 << kTwoSquares) + 1, 2);
-  int best = kTwoSquares;
-  double best_distance = INFINITY;
-  // Not below the default framed steps (3): a layout too fine for that is refused for its patch count.
-  for (int n = kTwoSquares; n >= codec::GeometryCodecOptions{}.frame_steps; --n) {
-    const double distance =
-        std::abs(std::log(static_cast<double>(patches) * std::pow((1 << n) + 1, 2) / target));
-    if (distance < best_distance) best = n, best_distance = distance;
-  }
-  return best;
+  const double two_squares = 2.0 * std::pow((1 << kTwoSquares) + 1, 2);
+  // The coarsest level that keeps as many samples, not below the default framed steps (3): a layout too fine
+  // for that is refused for its patch count anyway.
+  int level = kTwoSquares;
+  while (level > codec::GeometryCodecOptions{}.frame_steps &&
+         static_cast<double>(patches) * std::pow((1 << (level - 1)) + 1, 2) >= two_squares)
+    --level;
+  return level;
 }
 
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options) {

@@ -20,10 +20,12 @@ namespace geomip::tools {
 constexpr int kAutoNormalMeshSteps = 3;
 
 /// The grid level `geomip convert` and `geomip rd` use without --level: 8 (257² samples per patch) for two
-/// squares and a torus's four, and for a K-patch layout the level whose K grids hold about as many samples
-/// as two squares at level 8 (nearest in log; K = 8: 7, 16: 6, 32: 6, 64: 5, 128: 5; at least 3, the
-/// default framed steps), so that a layout changes where the samples are, not how many (a 64-quad layout
-/// at level 8 holds 32 times as many).
+/// squares and a torus's four, and for a K-patch layout the coarsest level whose K grids hold at least as
+/// many samples as two squares at level 8 (K = 8: 7, 16: 7, 32: 6, 64: 6, 128: 5; at least 3, the default
+/// framed steps), so that a layout changes where the samples are rather than multiplying them (a 64-quad
+/// layout at level 8 holds 32 times as many) and never lowers the resolution a pack can reach (the four
+/// animals' 64-quad layout at level 5, half the samples, ends 2–6 dB lower at 32 KB per model:
+/// docs/measurements.md, "The level of a K-patch layout").
 int default_grid_level(std::size_t patches);
 
 struct ConvertOptions {

@@ -1226,8 +1226,9 @@ TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
   t = analyze_topology(read_mesh(dir_ + "/spot6.obj"));
   EXPECT_EQ(t.boundary_loops, 0u);
   EXPECT_EQ(t.genus, 0);
-  // Without --level a K-patch layout gets the level whose K grids hold about as many samples as two squares
-  // at level 8: 32 patches, level 6 (32·65² = 135,200 against 2·257² = 132,098), not 16 times as many.
+  // Without --level a K-patch layout gets the coarsest level whose K grids hold at least as many samples as
+  // two squares at level 8: 32 patches, level 6 (32·65² = 135,200 against 2·257² = 132,098; level 5 would
+  // hold 34,848), not level 8's 16 times as many.
   const std::string pack32 = dir_ + "/spot32.gip";
   r = geomip("convert --json '" + spot_ + "' --patches 32 --no-normals -o '" + pack32 + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -50,10 +50,10 @@ inline constexpr std::size_t kPackHeaderSize = 20;
 /// Format version written. Version 7 (this one): version 6 with compact seam tables — a codec header's seams
 /// follow it as "the same as the header before", one entry per side pair bit-packed (every layout's table),
 /// or the explicit list (pack.cpp, write_seams; docs/codec-v3.md "Seam tables"): the four animals with a
-/// 64-quad layout show their first level of detail after 609 bytes instead of 3,554 (manifest 511 bytes
-/// instead of 3,456). Version 6: version 4's container, codec headers of versions 3 to 5 (the encoder writes
-/// 5: the geometry's wavelet filter kCubicLong, docs/codec-v3.md "Longer lifting filters"). Version 5: the
-/// same container, codec headers of versions 3 and 4 (4: the wavelet's lifting update, docs/codec-v3.md
+/// 64-quad layout at level 8 show their first level of detail after 609 bytes instead of 3,554 (manifest 511
+/// bytes instead of 3,456). Version 6: version 4's container, codec headers of versions 3 to 5 (the encoder
+/// writes 5: the geometry's wavelet filter kCubicLong, docs/codec-v3.md "Longer lifting filters"). Version 5:
+/// the same container, codec headers of versions 3 and 4 (4: the wavelet's lifting update, docs/codec-v3.md
 /// "Lifting update"); each bump lets an older reader say "unsupported version" instead of failing on the
 /// codec header. Version 4: the header diet — CRC32 trailers per chunk group instead of a CRC per chunk in
 /// the up-front table, a varint manifest size, compact doubles and codec headers (above); codec headers of

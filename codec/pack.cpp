@@ -133,8 +133,8 @@ bool read_normalization(ByteReader& r, std::array<double, 16>& m, std::uint16_t 
 // Seam tables of format version 7. GeometryCodecHeader::serialize() lists every seam as patch, other patch
 // (varints) and a byte of sides and orientation, and a layout lists each shared side from both of its
 // patches: 768 bytes per codec header for a 64-quad layout, twice per model with normal maps, once more per
-// model of a consistent set — 3,456 of the 3,554 bytes before the first level of detail of the four animals
-// with their 64-quad layout (docs/codec-v3.md, "Seam tables"). From version 7 the codec header's bytes carry
+// model of a consistent set — 3,072 bytes of the 3,456-byte manifest of the four animals with their 64-quad
+// layout (geometry only; docs/codec-v3.md, "Seam tables"). From version 7 the codec header's bytes carry
 // no seams (its seam count is 0) and the table follows the header's doubles:
 //   u8 form
 //   form 0 (kSeamsListed): varint count, then per seam as serialize() writes it;

@@ -15,6 +15,7 @@
 #include <string>
 #include <tuple>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace geomip {
@@ -114,10 +115,11 @@ double shape_penalty(const std::vector<PatchShape>& shapes, const PartitionStats
 class Simplifier {
  public:
   // `centroid_rule`: of two merged vertices the one nearer their area's centroid stays; else the one that
-  // stands for more area.
+  // stands for more area. `error_weight` > 0: collapses by error and area instead (QuadLayoutOptions), either
+  // vertex may stay, `centroid_rule` unused.
   // `pinned` vertices are never collapsed away (they stay coarse vertices); may be empty.
-  Simplifier(const TriMesh& mesh, bool centroid_rule, const std::vector<int>& pinned)
-      : m_(mesh), centroid_rule_(centroid_rule) {
+  Simplifier(const TriMesh& mesh, bool centroid_rule, const std::vector<int>& pinned, double error_weight)
+      : m_(mesh), centroid_rule_(centroid_rule), error_weight_(error_weight) {
     pinned_.assign(m_.positions.size(), 0);
     for (int v : pinned) pinned_[v] = 1;
     vf_.resize(m_.positions.size());
@@ -128,10 +130,23 @@ class Simplifier {
     stamp_.assign(m_.positions.size(), 0);
     carried_.assign(m_.positions.size(), 0.0);
     moment_.assign(m_.positions.size(), Eigen::Vector3d::Zero());
+    quadric_.assign(m_.positions.size(), Eigen::Matrix4d::Zero());
+    Eigen::AlignedBox3d box;
+    for (const auto& q : m_.positions) box.extend(q);
+    diagonal2_ = box.isEmpty() ? 1.0 : std::max(box.diagonal().squaredNorm(), 1e-300);
     for (const auto& t : m_.triangles) {
+      const Eigen::Vector3d n = normal(t);
+      const double a = 0.5 * n.norm();
+      total_area_ += a;
+      Eigen::Vector4d plane = Eigen::Vector4d::Zero();
+      if (a > 0.0) {
+        plane.head<3>() = n.normalized();
+        plane[3] = -plane.head<3>().dot(m_.positions[t[0]]);
+      }
       for (int v : t) {
-        carried_[v] += normal(t).norm() / 6.0;
-        moment_[v] += normal(t).norm() / 6.0 * m_.positions[v];
+        carried_[v] += n.norm() / 6.0;
+        moment_[v] += n.norm() / 6.0 * m_.positions[v];
+        quadric_[v] += (a / 3.0) * plane * plane.transpose();
       }
     }
     for (int v = 0; v < static_cast<int>(vf_.size()); ++v) {
@@ -237,6 +252,7 @@ class Simplifier {
     vf_[u].clear();
     carried_[v] += carried_[u];
     moment_[v] += moment_[u];
+    quadric_[v] += quadric_[u];
     --alive_;
     const std::vector<int> around = neighbours(v);
     ++stamp_[v];
@@ -257,6 +273,16 @@ class Simplifier {
       const double du = (m_.positions[u] - centre).squaredNorm(),
                    dv = (m_.positions[v] - centre).squaredNorm();
       if (pinned_[u]) continue;  // a pinned vertex stays
+      if (error_weight_ > 0.0) {
+        // Equal error: the quadric error of the merged vertex kept where v is (Garland–Heckbert 1997: Σ of
+        // area-weighted squared distances to the planes of the triangles merged into u and v), over the
+        // total area and the squared diagonal, plus the merged area's share squared.
+        const Eigen::Vector4d x(m_.positions[v].x(), m_.positions[v].y(), m_.positions[v].z(), 1.0);
+        const double error = x.dot((quadric_[u] + quadric_[v]) * x) / (total_area_ * diagonal2_);
+        const double share = merged / total_area_;
+        heap_.push({error_weight_ * error + share * share, u, v, stamp_[u], stamp_[v]});
+        continue;
+      }
       if (!pinned_[v]) {
         if (centroid_rule_) {
           if (dv > du || (dv == du && v > u)) continue;  // the vertex nearer the merged area's centroid stays
@@ -275,9 +301,14 @@ class Simplifier {
   std::vector<std::uint32_t> stamp_;
   std::vector<double> carried_;          // surface area each vertex stands for
   std::vector<Eigen::Vector3d> moment_;  // Σ area · position over that area
+  std::vector<Eigen::Matrix4d>
+      quadric_;  // Σ (area / 3) · plane planeᵀ over the triangles around the vertices merged in
+  double total_area_ = 0.0;
+  double diagonal2_ = 1.0;  // squared bounding-box diagonal
   std::size_t alive_ = 0;
   bool check_normals_ = true;
   bool centroid_rule_ = true;
+  double error_weight_ = 0.0;
   std::priority_queue<Entry> heap_;
 };
 
@@ -871,8 +902,16 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
     if ((pin_tips && tips.empty()) || (!pin_tips && options.only_pinned_tips && !tips.empty())) continue;
     QuadLayoutChoice group;
     double group_cost = 0.0;
-    for (const bool centroid_rule : {true, false}) {
-      Simplifier simplifier(mesh, centroid_rule, pin_tips ? tips : std::vector<int>{});
+    // Equal error: one coarse mesh (the error picks the survivor of a collapse); the equal-area ones, by
+    // either rule, only when none of its pairings partitions the mesh.
+    const bool by_error = options.error_weight > 0.0 && k >= options.min_error_patches;
+    std::vector<std::pair<bool, double>> simplifications;  // (centroid rule, error weight)
+    if (by_error) simplifications.emplace_back(true, options.error_weight);
+    simplifications.emplace_back(true, 0.0);
+    simplifications.emplace_back(false, 0.0);
+    for (const auto& [centroid_rule, error_weight] : simplifications) {
+      if (error_weight == 0.0 && by_error && group.candidates > 0) break;
+      Simplifier simplifier(mesh, centroid_rule, pin_tips ? tips : std::vector<int>{}, error_weight);
       if (!simplifier.simplify_to(static_cast<std::size_t>(target))) {
         last_error = "cannot simplify the mesh to " + std::to_string(target) + " vertices without folding it";
         continue;

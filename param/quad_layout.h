@@ -50,6 +50,19 @@ struct QuadLayoutOptions {
   /// At most this many partitions tried by the shape moves after the balancing (each moves one corner of
   /// the worst-shaped patches; a move is kept only when the objective drops). 0: none.
   int shape_steps = 120;
+  /// How the simplification (step 1 below) picks its collapses. > 0: by equal error, the collapse of the
+  /// lowest error_weight · E / (A · D²) + (a / A)² first, E the quadric error of the merged vertex
+  /// (Garland–Heckbert 1997: the area-weighted squared distances from it to the planes of the mesh triangles
+  /// it stands for), a the area it stands for, A the mesh's area and D its bounding-box diagonal; so the
+  /// coarse vertices, hence the patches, crowd where the surface bends (legs, ears, fingers) and every patch,
+  /// which gets the same grid, holds a similar share of the detail. 0: by equal area (the layouts before
+  /// 2026-12-04, thirteenth session). Measured on pack prefixes (docs/measurements.md, "Equal-error quad
+  /// layouts"): see there for the figures behind the default.
+  double error_weight = 1000.0;
+  /// Equal error from this many patches up; fewer are simplified by equal area whatever error_weight says.
+  /// With so few coarse vertices the equal-error ones go to the tips (hooves, ears, nose) and the patches
+  /// run along the limbs: the horse's 8-patch equal-error layout measured 4.7 dB below its equal-area one.
+  int min_error_patches = 16;
 };
 
 /// What choose_quad_layout() measured on the layout it returns.
@@ -75,10 +88,12 @@ struct QuadLayoutChoice {
 };
 
 /// Chooses a K-quad layout for `closed_manifold` (same preconditions as partition_mesh_layout()):
-/// 1. simplify the mesh by half-edge collapses to K + 2 − 2g vertices (g the genus), the pair of vertices
-///    that stands for the least surface area first (each vertex starts with a third of its star's area and
-///    inherits the area of the vertices merged into it): greedy clustering into equal areas, so the coarse
-///    triangles, hence the patches, get similar areas (every patch gets the same grid). A collapse keeps the
+/// 1. simplify the mesh by half-edge collapses to K + 2 − 2g vertices (g the genus): by equal error (see
+///    QuadLayoutOptions::error_weight) or, with error_weight 0, the pair of vertices that stands for the
+///    least surface area first (each vertex starts with a third of its star's area and inherits the area of
+///    the vertices merged into it): greedy clustering into equal areas, so the coarse triangles, hence the
+///    patches, get similar areas (every patch gets the same grid); by equal area also when no pairing of the
+///    equal-error coarse mesh partitions the mesh. A collapse keeps the
 ///    surviving vertex where it is (so the coarse vertices are mesh vertices), respects the link condition
 ///    (the coarse mesh stays a closed manifold of the same genus) and, while it can, never turns a
 ///    triangle's normal by 90° or more;

@@ -43,7 +43,8 @@ struct ConvertArgs {
   bool short_filter = false;
   bool fit = false;
   bool choose_loop = false;  ///< --choose-loop: the plain, tip or end loop, whichever prefixes are closest
-  bool search = false;       ///< --search: the loops, the 8-patch layout and the fit (tools/convert_search.h)
+  bool search =
+      false;  ///< --search: the loops, the 8- and 32-patch layouts, the fit, ... (tools/convert_search.h)
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
   std::string front;  ///< +x, -x, +y, -y, +z, -z; empty: from the shape
 };
@@ -122,8 +123,8 @@ int run_convert(const ConvertArgs& args) {
   // Without a search: the models now, so that bad input fails before the frame checks below.
   PreparedModels models;
   if (!searching)
-    models = prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches,
-                            loop_asked);
+    models = prepare_models(args.common.meshes, args.common.points, "geomip convert", !report,
+                            args.common.patches, loop_asked, args.common.equal_area_layout);
   if (!args.level_given && !models.inputs.empty() && !models.inputs.front().layout_quads.empty()) {
     level = default_grid_level(models.inputs.front().layout_quads.size());
     check_level_options(args, level);
@@ -324,7 +325,8 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_flag(
       "--search", args->search,
       "One mesh: build the pack with each two-square loop (plain, --tip-loop, --end-loop) and the "
-      "automatic 8-patch layout one level coarser (the same samples), then the best of them with --fit, "
+      "automatic 8- and 32-patch layouts (one and two levels coarser: about the same samples), then the "
+      "best of them with --fit, "
       "then with the L-infinity pass (--linf-sweeps 1000), then with 4 and 5 framed steps, and keep the "
       "one whose 1.5, 2, 4.7, 8.8, 16 and 32 KB geometry prefixes are closest to the mesh (mean PSNR; "
       "tools/convert_search.h); several pipelines: several minutes for the horse");

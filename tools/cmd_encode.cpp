@@ -6,6 +6,7 @@
 #include "mesh/errors.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
+#include "tools/convert_pipeline.h"
 #include "tools/pack_models.h"
 
 #include <nlohmann/json.hpp>
@@ -99,6 +100,7 @@ int run_encode(const EncodeArgs& args) {
   codec::PackWriteOptions write;
   write.normals = !args.no_normals;
   write.geometry.quantization_bits = args.quantization_bits;
+  if (!models.empty()) write.geometry.joint_bytes = geometry_joint_bytes(models.front().geometry.size());
   std::vector<std::uint8_t> pack;
   try {
     pack = codec::write_pack(models, write);

@@ -42,8 +42,9 @@ int run_gimage(const GimageArgs& args) {
     throw InvalidInput("--normal-level " + std::to_string(args.normal_level) + " is outside [" +
                        std::to_string(args.level) + ", " + std::to_string(kMaxGeometryImageLevel) + "]");
   }
-  const PreparedModels models =
-      prepare_models(args.common.meshes, args.common.points, "geomip gimage", args.common.quiet || args.common.json, args.common.patches, loop_kind(args.common));
+  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip gimage",
+                                               args.common.quiet || args.common.json, args.common.patches,
+                                               loop_kind(args.common), args.common.equal_area_layout);
   if (std::filesystem::exists(args.common.output) && !std::filesystem::is_directory(args.common.output))
     throw InvalidInput(args.common.output + " exists and is not a directory");
 

@@ -126,7 +126,9 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
 }
 
 int run_param(const ParamArgs& args) {
-  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param", args.common.quiet || args.common.json, args.common.patches, loop_kind(args.common));
+  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param",
+                                               args.common.quiet || args.common.json, args.common.patches,
+                                               loop_kind(args.common), args.common.equal_area_layout);
   const std::vector<ParameterizationInput>& inputs = models.inputs;
   const std::vector<std::string>& paths = models.paths;
 

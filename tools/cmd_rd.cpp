@@ -59,10 +59,11 @@ struct RdArgs {
   bool no_geomip = false;   // only the baselines
   int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
   int patches = 2;          // geomip: patches of the automatic layout (--patches)
+  bool equal_area_layout = false;  // geomip: --equal-area-layout
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
   bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)
   bool end_loop = false;    // geomip: the loop through the ends (--end-loop, as `geomip convert`)
-  bool search = false;      // geomip: the best of the loops, the 8-patch layout and the fit (--search)
+  bool search = false;  // geomip: the best of the loops, the 8- and 32-patch layouts, the fit, ... (--search)
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -197,12 +198,13 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
   return out;
 }
 
-/// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only pack),
-/// then one job per prefix size: decode the first N bytes and build the level-N mesh.
-/// `search`: the pack of search_conversion() (the loops, the 8-patch layout, the fit), its choice in `chosen`.
-Series geomip_series(const std::string& mesh_path, int level, int patches, LoopKind loop, int normal_mesh_steps,
-                     bool fit, bool search, bool quick, std::vector<std::uint8_t>& pack_out,
-                     std::optional<SearchResult>& chosen, ProgressBar& progress) {
+/// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only
+/// pack), then one job per prefix size: decode the first N bytes and build the level-N mesh. `search`: the
+/// pack of search_conversion() (the loops, the K-patch layouts, the fit, ...), its choice in `chosen`.
+Series geomip_series(const std::string& mesh_path, int level, int patches, bool equal_area_layout,
+                     LoopKind loop, int normal_mesh_steps, bool fit, bool search, bool quick,
+                     std::vector<std::uint8_t>& pack_out, std::optional<SearchResult>& chosen,
+                     ProgressBar& progress) {
   ConvertOptions options;
   options.seam_slide_rounds = default_seam_slide_rounds(loop);
   options.level = level;
@@ -215,7 +217,8 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, LoopK
     chosen = search_conversion(mesh_path, options, full_search_options(), true);
     pack = std::make_shared<const std::vector<std::uint8_t>>(chosen->converted.pack);
   } else {
-    const PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, patches, loop);
+    const PreparedModels models =
+        prepare_models({mesh_path}, "", "geomip rd", true, patches, loop, equal_area_layout);
     pack = std::make_shared<const std::vector<std::uint8_t>>(convert_models(models, options).pack);
   }
   pack_out = *pack;
@@ -309,8 +312,9 @@ int run_rd(const RdArgs& args) {
   std::vector<std::uint8_t> pack;
   std::optional<SearchResult> searched;
   if (!args.no_geomip)
-    plan.push_back(geomip_series(args.mesh, args.level, args.patches, loop, args.normal_mesh_steps, args.fit,
-                                 args.search, args.quick, pack, searched, progress));
+    plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.equal_area_layout, loop,
+                                 args.normal_mesh_steps, args.fit, args.search, args.quick, pack, searched,
+                                 progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -491,14 +495,14 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_flag("--fit,!--no-fit", args->fit,
                 "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip "
                 "convert --fit`; slower: about 30 s at level 8); --no-fit: samples on the surface (default)");
-  add_patches_option(cmd, args->patches);
+  add_patches_option(cmd, args->patches, args->equal_area_layout);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");
   cmd->add_flag("--end-loop", args->end_loop, "geomip: the two-square loop through the ends (as `geomip convert --end-loop`)");
-  cmd->add_flag(
-      "--search", args->search,
-      "geomip: the pack `geomip convert --search` keeps (the loops, the 8-patch layout one level "
-      "coarser, then the best with --fit, the L-infinity pass and more framed steps; scored on 1.5-32 KB "
-      "prefixes)");
+  cmd->add_flag("--search", args->search,
+                "geomip: the pack `geomip convert --search` keeps (the loops, the 8- and 32-patch layouts at "
+                "about the same samples, then the best with --fit, the L-infinity pass and more framed "
+                "steps; scored on 1.5-32 KB "
+                "prefixes)");
   return [args, level] {
     if (level->count() == 0) args->level = default_grid_level(static_cast<std::size_t>(args->patches));
     return run_rd(*args);

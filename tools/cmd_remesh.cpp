@@ -58,7 +58,8 @@ int run_remesh(const RemeshArgs& args) {
                        std::to_string(kMaxGeometryImageLevel) + "]");
   }
   const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip remesh",
-                                               args.common.quiet || args.common.json, args.common.patches, loop_kind(args.common));
+                                               args.common.quiet || args.common.json, args.common.patches,
+                                               loop_kind(args.common), args.common.equal_area_layout);
   if (std::filesystem::exists(args.common.output) && !std::filesystem::is_directory(args.common.output))
     throw InvalidInput(args.common.output + " exists and is not a directory");
 

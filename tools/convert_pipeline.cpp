@@ -106,8 +106,13 @@ const TriMesh& view_frame_mesh(const PreparedModels& models) {
   return repaired ? models.originals[0] : models.inputs.at(0).mesh;
 }
 
-codec::PackWriteOptions pack_write_options(const ConvertOptions& options) {
+std::size_t geometry_joint_bytes(std::size_t patches) {
+  return 1024 * std::max<std::size_t>(patches, 2);
+}
+
+codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::size_t patches) {
   codec::PackWriteOptions write;
+  write.geometry.joint_bytes = geometry_joint_bytes(patches);
   write.normals = options.normals;
   write.geometry.quantization_bits = options.quantization_bits;
   write.geometry.frame_steps = options.frame_steps;
@@ -182,7 +187,8 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
 
   progress("encode", 0.9);
   t0 = std::chrono::steady_clock::now();
-  result.pack = codec::write_pack(inputs, pack_write_options(options));
+  result.pack = codec::write_pack(
+      inputs, pack_write_options(options, inputs.empty() ? 2 : inputs.front().geometry.size()));
   result.encode_seconds = seconds_since(t0);
   if (options.keep_inputs) result.inputs = std::move(inputs);
   progress("encode", 1.0);

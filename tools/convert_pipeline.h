@@ -100,8 +100,17 @@ struct ConvertResult {
 /// a neck from a crown), else the first model. Requires !models.inputs.empty().
 const TriMesh& view_frame_mesh(const PreparedModels& models);
 
-/// The options convert_models() encodes its pack with (codec tools, quantization, normals).
-codec::PackWriteOptions pack_write_options(const ConvertOptions& options);
+/// Bytes of top bit-planes coded by one coder for all `patches` patches of a model before each patch gets its
+/// own (codec::GeometryCodecOptions::joint_bytes): 1 KiB per patch, so two squares keep the codec's 2 KiB and
+/// a K-patch layout's per-patch streams start about as far into the stream per patch. Each per-patch coder
+/// learns its contexts from nothing and costs a segment size per plane; on the 32-patch equal-error layouts
+/// the longer joint part measured +0.2…+0.3 dB from 4.7 to 16 KB (horse, armadillo; docs/measurements.md,
+/// "Equal-error quad layouts"), at the price of decoding those bytes on one thread.
+std::size_t geometry_joint_bytes(std::size_t patches);
+
+/// The options convert_models() encodes its pack of `patches` patches per model with (codec tools,
+/// quantization, normals, geometry_joint_bytes()).
+codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::size_t patches);
 
 /// \throw InvalidInput / SolverFailure from the parameterization; std::invalid_argument never escapes (the
 /// images come from resample_geometry()).

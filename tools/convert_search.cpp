@@ -130,16 +130,16 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
       if (!seen) build({kind, 2, options.level, options.fit}, std::move(m));
     }
   }
-  if (search.layout_patches > 2 && options.level > 1) {
+  for (const int k : search.layout_patches) {
+    const int level = options.level + default_grid_level(static_cast<std::size_t>(k)) - default_grid_level(2);
+    if (k <= 2 || level < 1) continue;
     std::optional<PreparedModels> m;
     try {
-      m = prepare_models({mesh}, "", "geomip convert", true, search.layout_patches, LoopKind::kPlain);
+      m = prepare_models({mesh}, "", "geomip convert", true, k, LoopKind::kPlain);
     } catch (const InvalidInput& e) {  // no such layout on this mesh: not a candidate
-      if (search.log)
-        search.log(std::string("search: no ") + std::to_string(search.layout_patches) + "-patch layout (" +
-                   e.what() + ")");
+      if (search.log) search.log("search: no " + std::to_string(k) + "-patch layout (" + e.what() + ")");
     }
-    if (m) build({LoopKind::kPlain, search.layout_patches, options.level - 1, options.fit}, std::move(*m));
+    if (m) build({LoopKind::kPlain, k, level, options.fit}, std::move(*m));
   }
 
   // The sizes: those below the largest pack. A candidate whose whole pack is smaller than a size is scored
@@ -213,7 +213,8 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
     const auto t0 = Clock::now();
     Built b{c, {}, {}, 0};
     b.geometry = built[layout_best].geometry;
-    b.geometry.pack = codec::write_pack(b.geometry.inputs, pack_write_options(o));
+    b.geometry.pack = codec::write_pack(b.geometry.inputs,
+                                        pack_write_options(o, b.geometry.inputs.front().geometry.size()));
     b.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     built.push_back(std::move(b));
     score(built.back());
@@ -236,7 +237,7 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
 
 SearchOptions full_search_options() {
   SearchOptions s;
-  s.layout_patches = 8;
+  s.layout_patches.assign(std::begin(kSearchLayouts), std::end(kSearchLayouts));
   s.fit = true;
   s.linf_sweeps = kSearchLinfSweeps;
   s.sizes.assign(std::begin(kSearchSizes), std::end(kSearchSizes));

@@ -1,6 +1,6 @@
 // An encoder that tries several configurations of one mesh's pack and keeps the one whose prefixes are
 // closest to the mesh: `geomip convert --choose-loop` (the automatic two-square loops), `geomip convert
-// --search` and `geomip rd --search` (the loops, an automatic 8-patch layout, fitted samples, the
+// --search` and `geomip rd --search` (the loops, automatic 8- and 32-patch layouts, fitted samples, the
 // parameterization's L∞ pass and more framed steps).
 //
 // Which configuration is best depends on the mesh (docs/measurements.md, "A loop through the tips" and "Where
@@ -16,14 +16,13 @@
 // - Every candidate is scored at the same sizes: those of SearchOptions::sizes below the largest candidate's
 //   geometry-only pack (at least one: that pack's size when all are larger); a pack smaller than a size is
 //   scored there whole (what a reader of that many bytes gets).
-// - A candidate whose layout does not exist for the mesh (no protrusion tips, no 8-quad layout) or that
-// repeats
-//   an earlier one is not built; one whose prefix at a scored size decodes to nothing (it ends inside a
-//   larger manifest) is not chosen.
+// - A candidate whose layout does not exist for the mesh (no protrusion tips, no K-quad layout) or that
+//   repeats an earlier one is not built; one whose prefix at a scored size decodes to nothing (it ends inside
+//   a larger manifest) is not chosen.
 // - Deterministic: the same mesh and options choose the same candidate.
 //
-// Cost: one pipeline per candidate (the 8-patch layout's parameterization is the slowest, the fit adds about
-// 15 s at level 8), then one decode and one distance measurement per candidate and size.
+// Cost: one pipeline per candidate (the K-patch layouts' parameterizations are the slowest, the fit adds
+// about 15 s at level 8), then one decode and one distance measurement per candidate and size.
 #pragma once
 
 #include "tools/convert_pipeline.h"
@@ -58,6 +57,10 @@ struct SearchCandidate {
   std::string switches(int default_level) const;
 };
 
+/// The automatic K-patch layouts `--search` tries: 8 patches (equal area) and 32 (equal error: on the
+/// armadillo +3.0 dB on the mean over the equal-area 32, and over every two-square candidate;
+/// docs/measurements.md, "Equal-error quad layouts").
+inline constexpr int kSearchLayouts[] = {8, 32};
 /// The prefix sizes `--search` scores (issue #14's range, 1.5 to 32 KB).
 inline constexpr std::size_t kSearchSizes[] = {1500, 2000, 4700, 8800, 16000, 32000};
 /// The framed steps `--search` tries on its best layout: 3 (the default), 4 or 5 (docs/codec-v3.md, "More
@@ -73,9 +76,10 @@ struct SearchOptions {
   /// The two-square loops: plain, through the tips (`--tip-loop`) and through the ends (`--end-loop`), each
   /// when the mesh has tips for it and its loop differs from the earlier ones.
   bool loops = true;
-  /// Also the automatic `layout_patches`-patch layout one level coarser than ConvertOptions::level when
-  /// layout_patches = 8 (8·4^(N−1) = 2·4^N: the same number of samples as two squares at level N); 0 = none.
-  int layout_patches = 0;
+  /// Also the automatic K-patch layout for each K here (choose_quad_layout() with its default simplification
+  /// for K), each at ConvertOptions::level + default_grid_level(K) − default_grid_level(2): about the samples
+  /// of two squares at ConvertOptions::level (K = 8: one level coarser, K = 32: two). Empty = none.
+  std::vector<int> layout_patches;
   /// Also the best layout with fitted samples (ConvertOptions::fit, when that is not already set for every
   /// candidate); tried on the best layout only (it costs a pipeline of its own, and what it gains depends on
   /// the mesh more than on the layout).
@@ -110,7 +114,7 @@ struct SearchResult {
   ConvertResult converted;             ///< the chosen candidate converted with the caller's options
 };
 
-/// What `--search` (convert and rd) tries: the loops, the 8-patch layout, the fit, kSearchLinfSweeps and
+/// What `--search` (convert and rd) tries: the loops, kSearchLayouts, the fit, kSearchLinfSweeps and
 /// kSearchFrameSteps, scored at kSearchSizes.
 SearchOptions full_search_options();
 

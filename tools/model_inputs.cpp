@@ -116,7 +116,7 @@ std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMe
 // Genus ≥ 2 has no two-square (or 2×2 periodic) layout: quad layouts of increasing K, from the smallest the
 // genus allows (K + 2 − 2g = 4 coarse vertices), until one partitions the mesh.
 QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std::string& name,
-                                       const std::string& command, bool quiet) {
+                                       const std::string& command, bool quiet, bool equal_area_layout) {
   std::vector<int> ks;
   for (int k : {2 * genus + 2, 4 * genus, 6 * genus, 8 * genus, 12 * genus, 16 * genus, 24 * genus, 32 * genus})
     if (k + 2 - 2 * genus <= static_cast<int>(mesh.positions.size()) && (ks.empty() || k > ks.back())) ks.push_back(k);
@@ -125,6 +125,7 @@ QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std
     try {
       QuadLayoutOptions options;
       options.patches = k;
+      if (equal_area_layout) options.error_weight = 0.0;
       QuadLayoutChoice chosen = choose_quad_layout(mesh, options);
       if (!quiet)
         std::cerr << command << ": " << name << " has genus " << genus << ": automatic layout of " << k
@@ -166,7 +167,8 @@ void check_loop_patches(LoopKind loop, int patches) {
 }
 
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file_arg,
-                              const std::string& command, bool quiet, int patches, LoopKind loop) {
+                              const std::string& command, bool quiet, int patches, LoopKind loop,
+                              bool equal_area_layout) {
   const bool tip_loop = loop != LoopKind::kPlain;
   PreparedModels models;
   std::vector<ParameterizationInput>& inputs = models.inputs;
@@ -206,12 +208,14 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
     const std::string where = points_file.empty() ? spec.mesh : points_file;
     const int genus = spec.partition_points.empty() && patches == 2 ? analyze_topology(in.mesh).genus.value_or(0) : 0;
     if (genus >= 2) {
-      const QuadLayoutChoice chosen = layout_for_high_genus(in.mesh, genus, spec.mesh, command, quiet);
+      const QuadLayoutChoice chosen =
+          layout_for_high_genus(in.mesh, genus, spec.mesh, command, quiet, equal_area_layout);
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
     } else if (spec.partition_points.empty() && patches != 2) {
       QuadLayoutOptions layout_options;
       layout_options.patches = patches;
+      if (equal_area_layout) layout_options.error_weight = 0.0;
       const QuadLayoutChoice chosen = choose_quad_layout(in.mesh, layout_options);
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
@@ -253,7 +257,7 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
                   "Sweeps of the L-infinity pass after the stretch optimization: lowers each patch's worst "
                   "stretch (never raises it), raises the L2 stretch (default 0: off)")
       ->check(CLI::Range(0, 10000));
-  add_patches_option(cmd, args.patches);
+  add_patches_option(cmd, args.patches, args.equal_area_layout);
   cmd->add_flag("--tip-loop", args.tip_loop,
                 "Two squares (genus 0): route the cut down each protrusion (legs, ears) to its tip and back, "
                 "splitting it lengthwise between the squares (default off: helps some shapes, hurts others; "
@@ -268,11 +272,15 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
       ->check(CLI::Range(0, 1000));
 }
 
-void add_patches_option(CLI::App* cmd, int& patches) {
+void add_patches_option(CLI::App* cmd, int& patches, bool& equal_area_layout) {
   cmd->add_option("--patches", patches,
                   "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop "
                   "(genus 1: a 2x2 periodic grid; genus >= 2: the first K = 2g+2, 4g, 6g, ... quad layout that fits); "
                   "K >= 3 pairs the triangles of a coarse mesh into K quads (any genus: K + 2 - 2g >= 4)");
+  cmd->add_flag(
+      "--equal-area-layout", equal_area_layout,
+      "K-quad layouts: simplify to the coarse mesh by equal area (the layouts before 2026-12-04) instead "
+      "of equal error (patches crowd where the surface bends)");
 }
 
 void apply_sampling(const ModelArgs& args, ParameterizationOptions& options) {

@@ -51,6 +51,9 @@ struct ModelArgs {
   /// 8g, 12g, … that partitions the mesh); another K = a K-quad layout (choose_quad_layout()). Only without
   /// CORR.json.
   int patches = 2;
+  /// --equal-area-layout: the K-quad layout's coarse mesh by equal area (QuadLayoutOptions::error_weight 0)
+  /// instead of equal error.
+  bool equal_area_layout = false;
   /// --tip-loop: PartitionPointsOptions::tip_loop for automatic two-square points (genus 0, no CORR.json).
   bool tip_loop = false;
   /// --end-loop: LoopKind::kEnds (not with --tip-loop).
@@ -79,12 +82,13 @@ void add_model_options(CLI::App* cmd, ModelArgs& args);
 /// \throw InvalidInput when both or neither are given, several meshes come without CORR.json, a file is
 ///   unreadable, a point is out of range, `patches` < 2, `patches` ≠ 2 comes with CORR.json, or no K-quad
 ///   layout fits the mesh (choose_quad_layout()), or `loop` is not kPlain with CORR.json or `patches` ≠ 2.
-/// `loop`: the automatically chosen two-square loop (LoopKind).
+/// `loop`: the automatically chosen two-square loop (LoopKind). `equal_area_layout`: see
+/// ModelArgs::equal_area_layout.
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file,
                               const std::string& command, bool quiet, int patches = 2,
-                              LoopKind loop = LoopKind::kPlain);
+                              LoopKind loop = LoopKind::kPlain, bool equal_area_layout = false);
 
-/// Registers `--patches K` on `cmd` (same name and help in every command).
-void add_patches_option(CLI::App* cmd, int& patches);
+/// Registers `--patches K` and `--equal-area-layout` on `cmd` (same names and help in every command).
+void add_patches_option(CLI::App* cmd, int& patches, bool& equal_area_layout);
 
 }  // namespace geomip::tools

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
       if (const char* ratio = std::getenv("GEOMIP_MAX_SIDE_RATIO")) options.max_side_ratio = std::atof(ratio);
       if (const char* f = std::getenv("GEOMIP_MIN_FLATNESS")) options.min_flatness = std::atof(f);
       if (const char* n = std::getenv("GEOMIP_SHAPE_STEPS")) options.shape_steps = std::atoi(n);
+      if (const char* w = std::getenv("GEOMIP_ERROR_WEIGHT")) options.error_weight = std::atof(w);
       if (const char* o = std::getenv("GEOMIP_LAYOUT_OBJECTIVE"); o && std::string(o) == "area")
         options.objective = LayoutObjective::kAreaSpread;
       const auto start = std::chrono::steady_clock::now();

@@ -20,12 +20,15 @@ namespace {
 
 QuadLayoutChoice expect_valid_layout(const TriMesh& m, int patches, double min_balance,
                                      int balance_steps = QuadLayoutOptions{}.balance_steps,
-                                     double shape_weight = QuadLayoutOptions{}.shape_weight) {
-  SCOPED_TRACE(std::to_string(patches) + " patches, " + std::to_string(balance_steps) + " balancing steps");
+                                     double shape_weight = QuadLayoutOptions{}.shape_weight,
+                                     double error_weight = QuadLayoutOptions{}.error_weight) {
+  SCOPED_TRACE(std::to_string(patches) + " patches, " + std::to_string(balance_steps) +
+               " balancing steps, error weight " + std::to_string(error_weight));
   QuadLayoutOptions options;
   options.patches = patches;
   options.balance_steps = balance_steps;
   options.shape_weight = shape_weight;
+  options.error_weight = error_weight;
   const QuadLayoutChoice choice = choose_quad_layout(m, options);
   EXPECT_EQ(choice.layout.quads.size(), static_cast<std::size_t>(patches));
   EXPECT_GE(choice.candidates, 1u);
@@ -53,28 +56,61 @@ QuadLayoutChoice expect_valid_layout(const TriMesh& m, int patches, double min_b
   return choice;
 }
 
+// Both simplifications (equal error, the default, and equal area) on each mesh.
 TEST(QuadLayout, SphereLayoutsOfSeveralSizes) {
   const TriMesh m = test::sphere(4);
-  for (int k : {2, 3, 6, 8, 12, 20}) expect_valid_layout(m, k, 0.15);
+  for (double error_weight : {QuadLayoutOptions{}.error_weight, 0.0})
+    for (int k : {2, 3, 6, 8, 12, 20})
+      expect_valid_layout(m, k, 0.15, QuadLayoutOptions{}.balance_steps, 0.0, error_weight);
 }
 
 TEST(QuadLayout, TorusLayout) {
-  expect_valid_layout(test::torus(32, 16), 12, 0.1);
+  for (double error_weight : {QuadLayoutOptions{}.error_weight, 0.0})
+    expect_valid_layout(test::torus(32, 16), 12, 0.1, QuadLayoutOptions{}.balance_steps, 0.0, error_weight);
 }
 
 TEST(QuadLayout, DoubleTorusLayout) {
-  expect_valid_layout(test::subdivide(test::double_torus(), 1), 24, 0.02);
+  for (double error_weight : {QuadLayoutOptions{}.error_weight, 0.0})
+    expect_valid_layout(test::subdivide(test::double_torus(), 1), 24, 0.02, QuadLayoutOptions{}.balance_steps,
+                        0.0, error_weight);
 }
 
-// An ellipsoid (a sphere scaled 2.5 × 1 × 0.6): the coarse mesh's quads differ in area, the balancing moves
-// the corners until the patches are close to equal; it never makes the sampling cost (what it minimizes
-// without the shape term) worse than the layout it starts from.
+// Equal error against equal area on a dome: a sphere whose lower half is pressed flat (z · 0.02), a disc
+// with a third of the area. The disc bends nowhere but at its rim, so the equal-error simplification leaves
+// fewer layout corners inside it (below the equator, within 0.9 of the axis) than the equal-area one (no
+// balancing: that moves corners towards equal areas afterwards). Below min_error_patches both are by area.
+TEST(QuadLayout, EqualErrorSpendsFewCornersOnFlatParts) {
+  TriMesh m = test::sphere(4);
+  for (auto& p : m.positions) {
+    if (p.z() < 0.0) p.z() *= 0.02;
+  }
+  auto corners_inside = [&](double error_weight) {
+    const QuadLayoutChoice choice = expect_valid_layout(m, 16, 0.0, 0, 0.0, error_weight);
+    int inside = 0;
+    for (int c : choice.layout.corners) {
+      const Eigen::Vector3d& p = m.positions[c];
+      inside += p.z() < 0.0 && std::hypot(p.x(), p.y()) < 0.9;
+    }
+    std::printf("error weight %g: %d of %zu corners inside the disc\n", error_weight, inside,
+                choice.layout.corners.size());
+    return inside;
+  };
+  ASSERT_LE(QuadLayoutOptions{}.min_error_patches, 16);
+  EXPECT_LT(corners_inside(QuadLayoutOptions{}.error_weight), corners_inside(0.0));
+  QuadLayoutOptions few, few_by_area;  // below min_error_patches: by area either way
+  few.patches = few_by_area.patches = 8;
+  few_by_area.error_weight = 0.0;
+  ASSERT_LT(few.patches, few.min_error_patches);
+  EXPECT_EQ(choose_quad_layout(m, few).layout.corners, choose_quad_layout(m, few_by_area).layout.corners);
+}
+
 TEST(QuadLayout, BalancingEvensOutPatchAreas) {
   TriMesh m = test::sphere(3);
   for (auto& p : m.positions) p = Eigen::Vector3d(2.5 * p.x(), p.y(), 0.6 * p.z());
   for (int k : {8, 12}) {
-    const QuadLayoutChoice raw = expect_valid_layout(m, k, 0.0, 0, 0.0);
-    const QuadLayoutChoice balanced = expect_valid_layout(m, k, 0.45, QuadLayoutOptions{}.balance_steps, 0.0);
+    const QuadLayoutChoice raw = expect_valid_layout(m, k, 0.0, 0, 0.0, 0.0);
+    const QuadLayoutChoice balanced =
+        expect_valid_layout(m, k, 0.45, QuadLayoutOptions{}.balance_steps, 0.0, 0.0);
     EXPECT_LE(balanced.sampling_cost, raw.sampling_cost + 1e-12);
     EXPECT_LE(balanced.area_spread, 1.05);
   }
@@ -147,11 +183,11 @@ std::pair<double, double> measured_shape(const TriMesh& m, const QuadLayout& lay
   return {max_angle, max_ratio};
 }
 
-// Patch shape (issue 15, L∞ stretch per patch): on a long ellipsoid (5 × 1 × 1) the balanced layouts have
-// thin quads. The reported largest corner angle and side ratio are what the partition has; the shape moves
-// never raise the objective they lower (sampling cost + weight · penalty; the runs with and without them are
-// the same up to those moves); with the shape term the layout's longest side over sqrt(area) is lower than
-// without it, and the choice is the same on a second run (deterministic).
+// Patch shape (issue 15, L∞ stretch per patch): on a long ellipsoid (5 × 1 × 1) the balanced equal-area
+// layouts have thin quads. The reported largest corner angle and side ratio are what the partition has; the
+// shape moves never raise the objective they lower (sampling cost + weight · penalty; the runs with and
+// without them are the same up to those moves); with the shape term the layout's longest side over sqrt(area)
+// is lower than without it, and the choice is the same on a second run (deterministic).
 TEST(QuadLayout, ShapeTermShortensLongSides) {
   ASSERT_EQ(QuadLayoutOptions{}.shape_weight, 0.0);
   TriMesh m = test::sphere(4);
@@ -160,6 +196,7 @@ TEST(QuadLayout, ShapeTermShortensLongSides) {
     SCOPED_TRACE(std::to_string(k) + " patches");
     QuadLayoutOptions plain, shaped, unmoved;  // plain: shape_weight 0, the default
     plain.patches = shaped.patches = unmoved.patches = k;
+    plain.error_weight = shaped.error_weight = unmoved.error_weight = 0.0;  // measured on equal-area layouts
     shaped.shape_weight = unmoved.shape_weight = 1.0;
     unmoved.shape_steps = 0;
     const QuadLayoutChoice a = choose_quad_layout(m, plain), b = choose_quad_layout(m, shaped),

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 namespace geomip {
@@ -1016,10 +1017,10 @@ TEST_F(CliPack, ChooseLoopKeepsTheBestOfTheLoops) {
   }
 }
 
-// --search builds the loops, the 8-patch layout one level coarser, the best of them fitted, the best with
-// the L∞ pass and the best with more framed steps, scores each on the same prefix sizes, and keeps the
-// highest mean: the pack written is byte for byte what convert writes with the chosen switches, and the
-// scores it reports are the decoded prefixes' PSNR (rechecked here with decode --bytes and eval for the
+// --search builds the loops, the 8- and 32-patch layouts one and two levels coarser, the best of them fitted,
+// the best with the L∞ pass and the best with more framed steps, scores each on the same prefix sizes, and
+// keeps the highest mean: the pack written is byte for byte what convert writes with the chosen switches, and
+// the scores it reports are the decoded prefixes' PSNR (rechecked here with decode --bytes and eval for the
 // chosen pack). Mixed with the switches it chooses itself: exit 2, no pack.
 TEST_F(CliPack, SearchKeepsTheBestCandidate) {
   const std::string mesh = write_spiked_ellipsoid(dir_);
@@ -1033,7 +1034,7 @@ TEST_F(CliPack, SearchKeepsTheBestCandidate) {
   ASSERT_FALSE(sizes.empty());
   std::string best;
   double best_psnr = -1;
-  bool fitted = false, layout = false, framed = false, linf = false;
+  bool fitted = false, layout = false, layout32 = false, framed = false, linf = false;
   for (const auto& c : search["candidates"]) {
     const std::string name = c["name"];
     ASSERT_EQ(c["psnr_db"].size(), sizes.size()) << name;
@@ -1041,17 +1042,20 @@ TEST_F(CliPack, SearchKeepsTheBestCandidate) {
     framed = framed || name.find("frame steps 5") != std::string::npos;
     linf = linf || name.find("+ L∞ pass") != std::string::npos;
     layout = layout || name.find("8 patches level 4") != std::string::npos;
+    layout32 = layout32 || name.find("32 patches level 3") != std::string::npos;
     const double mean = c["mean_psnr_db"];
     EXPECT_TRUE(std::isfinite(mean) && mean > 30) << c.dump();
     if (mean > best_psnr) best_psnr = mean, best = name;
   }
   EXPECT_TRUE(fitted) << "the best layout is tried with --fit: " << search.dump();
   EXPECT_TRUE(layout) << "the 8-patch layout one level coarser is a candidate: " << search.dump();
+  EXPECT_TRUE(layout32) << "the 32-patch layout two levels coarser is a candidate: " << search.dump();
   EXPECT_TRUE(framed) << "the best is tried with 4 and 5 framed steps: " << search.dump();
   EXPECT_TRUE(linf) << "the best is tried with the L∞ pass: " << search.dump();
   EXPECT_EQ(search["chosen"], best) << search.dump();
   const std::string switches = search["switches"];
-  EXPECT_EQ(j["level"], switches.find("--level 4") != std::string::npos ? 4 : 5);
+  const std::size_t level_at = switches.find("--level ");
+  EXPECT_EQ(j["level"], level_at == std::string::npos ? 5 : std::stoi(switches.substr(level_at + 8)));
   // The same pack as convert with the chosen switches.
   ASSERT_EQ(geomip("convert -q " + switches + common + "/direct.gip'").exit_code, 0);
   EXPECT_EQ(slurp(dir_ + "/chosen.gip"), slurp(dir_ + "/direct.gip")) << switches;
@@ -1236,6 +1240,22 @@ TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
   r = geomip("decode --json '" + pack32 + "' -o '" + dir_ + "/spot32.obj'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["models"][0]["faces"], 32 * 2 * 64 * 64);
+  // 32 patches are simplified by equal error, --equal-area-layout by equal area: two different layouts,
+  // both without flipped triangles.
+  std::vector<std::set<int>> corner_sets;
+  for (const std::string flag : {"", " --equal-area-layout"}) {
+    const std::string dir = out + (flag.empty() ? "/error" : "/area");
+    r = geomip("param --quiet '" + spot_ + "' --patches 32" + flag + " -o '" + dir + "'");
+    ASSERT_EQ(r.exit_code, 0) << flag << "\n" << r.err;
+    const auto p = nlohmann::json::parse(slurp(dir + "/spot.param.json"));
+    EXPECT_EQ(p["patches"].size(), 32u) << flag;
+    EXPECT_EQ(p["flipped_triangles"], 0) << flag;
+    std::set<int> corners;
+    for (const auto& patch : p["patches"])
+      for (const auto& c : patch["corners"]) corners.insert(c["vertex"].get<int>());
+    corner_sets.push_back(corners);
+  }
+  EXPECT_NE(corner_sets[0], corner_sets[1]);
   const std::string bad = dir_ + "/bad";
   for (const std::string& args : {"remesh '" + spot_ + "' --patches 1 --level 2 -o '" + bad + "'",
                                   "remesh '" + spot_ + "' --patches 4000 --level 2 -o '" + bad + "'",

@@ -44,7 +44,7 @@ struct ConvertArgs {
   bool fit = false;
   bool choose_loop = false;  ///< --choose-loop: the plain, tip or end loop, whichever prefixes are closest
   bool search =
-      false;  ///< --search: the loops, the 8- and 32-patch layouts, the fit, ... (tools/convert_search.h)
+      false;       ///< --search: the loops, the 8- to 64-patch layouts, the fit, ... (tools/convert_search.h)
   std::string up;  ///< x, y, z, auto, none; empty: auto, or none for a geometry-only pack
   std::string front;  ///< +x, -x, +y, -y, +z, -z; empty: from the shape
 };
@@ -325,7 +325,7 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_flag(
       "--search", args->search,
       "One mesh: build the pack with each two-square loop (plain, --tip-loop, --end-loop) and the "
-      "automatic 8- and 32-patch layouts (one and two levels coarser: about the same samples), then the "
+      "automatic 8-, 16-, 32- and 64-patch layouts (at about the same samples), then the "
       "best of them with --fit, "
       "then with the L-infinity pass (--linf-sweeps 1000), then with 4 and 5 framed steps, and keep the "
       "one whose 1.5, 2, 4.7, 8.8, 16 and 32 KB geometry prefixes are closest to the mesh (mean PSNR; "

@@ -63,7 +63,7 @@ struct RdArgs {
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
   bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)
   bool end_loop = false;    // geomip: the loop through the ends (--end-loop, as `geomip convert`)
-  bool search = false;  // geomip: the best of the loops, the 8- and 32-patch layouts, the fit, ... (--search)
+  bool search = false;  // geomip: the best of the loops, the 8- to 64-patch layouts, the fit, ... (--search)
 };
 
 /// One coded mesh: its R-D point (bytes, decode time and parameters filled; distortion not yet) and the
@@ -499,7 +499,7 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");
   cmd->add_flag("--end-loop", args->end_loop, "geomip: the two-square loop through the ends (as `geomip convert --end-loop`)");
   cmd->add_flag("--search", args->search,
-                "geomip: the pack `geomip convert --search` keeps (the loops, the 8- and 32-patch layouts at "
+                "geomip: the pack `geomip convert --search` keeps (the loops, the 8- to 64-patch layouts at "
                 "about the same samples, then the best with --fit, the L-infinity pass and more framed "
                 "steps; scored on 1.5-32 KB "
                 "prefixes)");

@@ -1,6 +1,6 @@
 // An encoder that tries several configurations of one mesh's pack and keeps the one whose prefixes are
 // closest to the mesh: `geomip convert --choose-loop` (the automatic two-square loops), `geomip convert
-// --search` and `geomip rd --search` (the loops, automatic 8- and 32-patch layouts, fitted samples, the
+// --search` and `geomip rd --search` (the loops, automatic 8- to 64-patch layouts, fitted samples, the
 // parameterization's L∞ pass and more framed steps).
 //
 // Which configuration is best depends on the mesh (docs/measurements.md, "A loop through the tips" and "Where
@@ -57,10 +57,10 @@ struct SearchCandidate {
   std::string switches(int default_level) const;
 };
 
-/// The automatic K-patch layouts `--search` tries: 8 patches (equal area) and 32 (equal error: on the
-/// armadillo +3.0 dB on the mean over the equal-area 32, and over every two-square candidate;
-/// docs/measurements.md, "Equal-error quad layouts").
-inline constexpr int kSearchLayouts[] = {8, 32};
+/// The automatic K-patch layouts `--search` tries: 8 patches (equal area), 16, 32 and 64 (equal error). Which
+/// wins depends on the mesh: on the mean prefix PSNR the horse's best is 16 patches, the armadillo's 64 (both
+/// above every two-square candidate), the bunny's 8 (docs/measurements.md, "Equal-error quad layouts").
+inline constexpr int kSearchLayouts[] = {8, 16, 32, 64};
 /// The prefix sizes `--search` scores (issue #14's range, 1.5 to 32 KB).
 inline constexpr std::size_t kSearchSizes[] = {1500, 2000, 4700, 8800, 16000, 32000};
 /// The framed steps `--search` tries on its best layout: 3 (the default), 4 or 5 (docs/codec-v3.md, "More

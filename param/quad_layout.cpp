@@ -130,23 +130,28 @@ class Simplifier {
     stamp_.assign(m_.positions.size(), 0);
     carried_.assign(m_.positions.size(), 0.0);
     moment_.assign(m_.positions.size(), Eigen::Vector3d::Zero());
-    quadric_.assign(m_.positions.size(), Eigen::Matrix4d::Zero());
-    Eigen::AlignedBox3d box;
-    for (const auto& q : m_.positions) box.extend(q);
-    diagonal2_ = box.isEmpty() ? 1.0 : std::max(box.diagonal().squaredNorm(), 1e-300);
+    const bool by_error = error_weight_ > 0.0;
+    if (by_error) {  // quadrics only when they rank the collapses (128 bytes a vertex)
+      quadric_.assign(m_.positions.size(), Eigen::Matrix4d::Zero());
+      Eigen::AlignedBox3d box;
+      for (const auto& q : m_.positions) box.extend(q);
+      diagonal2_ = box.isEmpty() ? 1.0 : std::max(box.diagonal().squaredNorm(), 1e-300);
+    }
     for (const auto& t : m_.triangles) {
       const Eigen::Vector3d n = normal(t);
       const double a = 0.5 * n.norm();
       total_area_ += a;
-      Eigen::Vector4d plane = Eigen::Vector4d::Zero();
-      if (a > 0.0) {
+      Eigen::Matrix4d q = Eigen::Matrix4d::Zero();
+      if (by_error && a > 0.0) {
+        Eigen::Vector4d plane;
         plane.head<3>() = n.normalized();
         plane[3] = -plane.head<3>().dot(m_.positions[t[0]]);
+        q = (a / 3.0) * plane * plane.transpose();
       }
       for (int v : t) {
         carried_[v] += n.norm() / 6.0;
         moment_[v] += n.norm() / 6.0 * m_.positions[v];
-        quadric_[v] += (a / 3.0) * plane * plane.transpose();
+        if (by_error) quadric_[v] += q;
       }
     }
     for (int v = 0; v < static_cast<int>(vf_.size()); ++v) {
@@ -252,7 +257,7 @@ class Simplifier {
     vf_[u].clear();
     carried_[v] += carried_[u];
     moment_[v] += moment_[u];
-    quadric_[v] += quadric_[u];
+    if (!quadric_.empty()) quadric_[v] += quadric_[u];
     --alive_;
     const std::vector<int> around = neighbours(v);
     ++stamp_[v];
@@ -270,8 +275,6 @@ class Simplifier {
     for (int v : neighbours(u)) {
       const double merged = carried_[u] + carried_[v];
       const Eigen::Vector3d centre = (moment_[u] + moment_[v]) / merged;
-      const double du = (m_.positions[u] - centre).squaredNorm(),
-                   dv = (m_.positions[v] - centre).squaredNorm();
       if (pinned_[u]) continue;  // a pinned vertex stays
       if (error_weight_ > 0.0) {
         // Equal error: the quadric error of the merged vertex kept where v is (Garland–Heckbert 1997: Σ of
@@ -284,6 +287,8 @@ class Simplifier {
         continue;
       }
       if (!pinned_[v]) {
+        const double du = (m_.positions[u] - centre).squaredNorm(),
+                     dv = (m_.positions[v] - centre).squaredNorm();
         if (centroid_rule_) {
           if (dv > du || (dv == du && v > u)) continue;  // the vertex nearer the merged area's centroid stays
         } else if (carried_[u] > carried_[v] || (carried_[u] == carried_[v] && v > u)) {
@@ -301,8 +306,8 @@ class Simplifier {
   std::vector<std::uint32_t> stamp_;
   std::vector<double> carried_;          // surface area each vertex stands for
   std::vector<Eigen::Vector3d> moment_;  // Σ area · position over that area
-  std::vector<Eigen::Matrix4d>
-      quadric_;  // Σ (area / 3) · plane planeᵀ over the triangles around the vertices merged in
+  std::vector<Eigen::Matrix4d> quadric_;  // Σ (area / 3) · plane planeᵀ over the triangles around the
+                                          // vertices merged in; by error only
   double total_area_ = 0.0;
   double diagonal2_ = 1.0;  // squared bounding-box diagonal
   std::size_t alive_ = 0;

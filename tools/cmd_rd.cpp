@@ -501,8 +501,7 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_flag("--search", args->search,
                 "geomip: the pack `geomip convert --search` keeps (the loops, the 8- to 64-patch layouts at "
                 "about the same samples, then the best with --fit, the L-infinity pass and more framed "
-                "steps; scored on 1.5-32 KB "
-                "prefixes)");
+                "steps; scored on 1.5-32 KB prefixes)");
   return [args, level] {
     if (level->count() == 0) args->level = default_grid_level(static_cast<std::size_t>(args->patches));
     return run_rd(*args);

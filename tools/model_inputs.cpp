@@ -113,6 +113,14 @@ std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMe
   return ids;
 }
 
+// Options of an automatic K-quad layout: the defaults, by equal area when `equal_area_layout`.
+QuadLayoutOptions automatic_layout_options(int patches, bool equal_area_layout) {
+  QuadLayoutOptions options;
+  options.patches = patches;
+  if (equal_area_layout) options.error_weight = 0.0;
+  return options;
+}
+
 // Genus ≥ 2 has no two-square (or 2×2 periodic) layout: quad layouts of increasing K, from the smallest the
 // genus allows (K + 2 − 2g = 4 coarse vertices), until one partitions the mesh.
 QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std::string& name,
@@ -123,10 +131,7 @@ QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std
   std::string tried;
   for (int k : ks) {
     try {
-      QuadLayoutOptions options;
-      options.patches = k;
-      if (equal_area_layout) options.error_weight = 0.0;
-      QuadLayoutChoice chosen = choose_quad_layout(mesh, options);
+      QuadLayoutChoice chosen = choose_quad_layout(mesh, automatic_layout_options(k, equal_area_layout));
       if (!quiet)
         std::cerr << command << ": " << name << " has genus " << genus << ": automatic layout of " << k
                   << " patches (--patches K chooses another)\n";
@@ -213,10 +218,8 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
     } else if (spec.partition_points.empty() && patches != 2) {
-      QuadLayoutOptions layout_options;
-      layout_options.patches = patches;
-      if (equal_area_layout) layout_options.error_weight = 0.0;
-      const QuadLayoutChoice chosen = choose_quad_layout(in.mesh, layout_options);
+      const QuadLayoutChoice chosen =
+          choose_quad_layout(in.mesh, automatic_layout_options(patches, equal_area_layout));
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
     } else if (spec.partition_points.empty()) {

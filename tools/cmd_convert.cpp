@@ -221,19 +221,28 @@ int run_convert(const ConvertArgs& args) {
                                 {"level", level},
                                 {"normals", !args.no_normals},
                                 {"models", j_models},
-                                {"normal_mesh", {{"steps", converted.normal_mesh_steps},
-                                                 {"samples", converted.normal_mesh_candidates},
-                                                 {"moved", converted.normal_mesh_moved},
-                                                 {"refused_folds", converted.normal_mesh_would_fold},
-                                                 {"mean_shift", converted.normal_mesh_mean_shift}}},
+                                {"normal_mesh",
+                                 {{"steps", converted.normal_mesh_steps},
+                                  {"samples", converted.normal_mesh_candidates},
+                                  {"moved", converted.normal_mesh_moved},
+                                  {"refused_folds", converted.normal_mesh_would_fold},
+                                  {"mean_shift", converted.normal_mesh_mean_shift}}},
                                 {"loop", loop.empty() ? nlohmann::json(nullptr) : nlohmann::json(loop)},
-                                {"loop_psnr_db", {{"plain", std::isfinite(plain_psnr) ? nlohmann::json(plain_psnr) : nlohmann::json(nullptr)},
-                                                  {"tips", std::isfinite(tip_psnr) ? nlohmann::json(tip_psnr) : nlohmann::json(nullptr)},
-                                                  {"ends", std::isfinite(end_psnr) ? nlohmann::json(end_psnr) : nlohmann::json(nullptr)}}},
+                                {"loop_psnr_db",
+                                 {{"plain", std::isfinite(plain_psnr) ? nlohmann::json(plain_psnr)
+                                                                      : nlohmann::json(nullptr)},
+                                  {"tips", std::isfinite(tip_psnr) ? nlohmann::json(tip_psnr)
+                                                                   : nlohmann::json(nullptr)},
+                                  {"ends", std::isfinite(end_psnr) ? nlohmann::json(end_psnr)
+                                                                   : nlohmann::json(nullptr)}}},
                                 {"search", search_report},
                                 {"param_seconds", converted.param_seconds},
                                 {"resample_seconds", converted.resample_seconds},
                                 {"encode_seconds", converted.encode_seconds},
+                                {"two_squares_l2_stretch",
+                                 converted.two_squares_l2_stretch > 0
+                                     ? nlohmann::json(converted.two_squares_l2_stretch)
+                                     : nlohmann::json(nullptr)},
                                 {"seconds", seconds_since(t_start)}}
                      .dump(2)
               << "\n";
@@ -243,6 +252,14 @@ int run_convert(const ConvertArgs& args) {
                 args.no_normals ? ", geometry only" : ", with normal maps");
     std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
                 converted.resample_seconds, converted.encode_seconds);
+    if (!searching && converted.two_squares_l2_stretch >= kStretchedTwoSquares)
+      std::printf(
+          "note: the two squares stretch this shape (L2 stretch %.2f; 1 is none): a layout of more "
+          "patches may code it better (on the mean PSNR of the 1.5-32 KB prefixes, `--patches 16`: horse "
+          "+1.0 dB, armadillo +1.1, cow about the same; `--patches 64`: armadillo +2.8), and `--search` "
+          "measures which "
+          "(docs/measurements.md, \"A note when two squares stretch the shape\")\n",
+          converted.two_squares_l2_stretch);
     if (args.choose_loop) {
       if (std::isfinite(tip_psnr) || std::isfinite(end_psnr)) {
         std::string scores = "plain " + format_db(plain_psnr);

@@ -158,6 +158,9 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   auto t0 = std::chrono::steady_clock::now();
   const std::vector<ModelParameterization> params = parameterize_consistently(models.inputs, param);
   result.param_seconds = seconds_since(t0);
+  if (params.size() == 1 && params[0].patches.size() == 2)
+    result.two_squares_l2_stretch =
+        std::max(params[0].patches[0].stretch.l2, params[0].patches[1].stretch.l2);
 
   t0 = std::chrono::steady_clock::now();
   std::vector<codec::PackModelInput> inputs;

@@ -93,7 +93,17 @@ struct ConvertResult {
   std::size_t normal_mesh_candidates = 0, normal_mesh_moved = 0, normal_mesh_would_fold = 0;
   double normal_mesh_mean_shift = 0;  ///< mean move of the moved samples, in local sample spacings
   double param_seconds = 0, resample_seconds = 0, encode_seconds = 0;
+  /// One model on two squares (genus 0, the default layout): the larger L2 stretch of its two patches
+  /// (param/stretch.h; 1 = no stretch). 0 for any other layout or several models.
+  double two_squares_l2_stretch = 0;
 };
+
+/// From this L2 stretch of a model's two squares up, `geomip convert` suggests K-patch layouts. The two
+/// squares' L2 stretch (as `convert` parameterizes) and which layout coded better (mean PSNR of the
+/// 1.5–32 KB geometry prefixes; docs/measurements.md): venus 1.07, bunny 1.31 (two squares better); horse
+/// 1.78 (16 patches +1.0 dB), armadillo 1.97 (16 patches +1.1 dB, 64 patches +2.8 dB); cow 1.74 (16 patches
+/// about the same: −1.1…+1.6 dB by size).
+inline constexpr double kStretchedTwoSquares = 1.5;
 
 /// The mesh the viewer's frame (ConvertOptions::up, front) is guessed from: the first model as read when it
 /// was repaired (a filled hole — the camel head's neck cut faired into a dome — would hide the cut that tells

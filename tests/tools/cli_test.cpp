@@ -1208,6 +1208,35 @@ TEST_F(CliPack, QuadSplitShorterIsCloserAndSharedByTheSet) {
 // --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch
 // count): watertight, genus 0, K·2·4^L faces, V = K·4^L + 2; convert's level without --level; bad K exit 2
 // with one line and nothing written.
+// A single mesh on two squares gets its patches' L2 stretch in the JSON, and from 1.5 up (tools/
+// convert_pipeline.h, kStretchedTwoSquares: the horse and the armadillo coded better on more patches, the
+// bunny and venus did not) a note pointing at --patches and --search. The cow's legs stretch its squares
+// (about 1.74), the spot's round body does not (about 1.23); another layout has no such figure.
+TEST_F(CliPack, ConvertSuggestsMorePatchesWhenTwoSquaresStretch) {
+  GEOMIP_REQUIRE_SHARED_MESH(cow, "cow.obj");
+  const std::string note = "note: the two squares stretch this shape";
+  const auto stretch = [&](const std::string& mesh, const std::string& switches) {
+    const Outcome r = geomip("convert --json '" + mesh + "' --level 4 --no-normals " + switches + " -o '" +
+                             dir_ + "/s.gip'");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(r.out)["two_squares_l2_stretch"];
+  };
+  const nlohmann::json cow_stretch = stretch(cow, ""), spot_stretch = stretch(spot_, "");
+  EXPECT_GE(cow_stretch.get<double>(), 1.5);
+  EXPECT_GT(spot_stretch.get<double>(), 1.0);
+  EXPECT_LT(spot_stretch.get<double>(), 1.5);
+  EXPECT_TRUE(stretch(spot_, "--patches 6").is_null());
+  Outcome r = geomip("convert '" + cow + "' --level 4 --no-normals -o '" + dir_ + "/cow.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(note), std::string::npos) << r.out;
+  r = geomip("convert '" + spot_ + "' --level 4 --no-normals -o '" + dir_ + "/spot.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find(note), std::string::npos) << r.out;
+  r = geomip("convert --quiet '" + cow + "' --level 4 --no-normals -o '" + dir_ + "/cow.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
 TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
   const std::string out = dir_ + "/k6";
   Outcome r = geomip("remesh --quiet '" + spot_ + "' --patches 6 --level 3 -o '" + out + "'");

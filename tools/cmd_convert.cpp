@@ -257,8 +257,7 @@ int run_convert(const ConvertArgs& args) {
           "note: the two squares stretch this shape (L2 stretch %.2f; 1 is none): a layout of more "
           "patches may code it better (on the mean PSNR of the 1.5-32 KB prefixes, `--patches 16`: horse "
           "+1.0 dB, armadillo +1.1, cow about the same; `--patches 64`: armadillo +2.8), and `--search` "
-          "measures which "
-          "(docs/measurements.md, \"A note when two squares stretch the shape\")\n",
+          "measures which (docs/measurements.md, \"A note when two squares stretch the shape\")\n",
           converted.two_squares_l2_stretch);
     if (args.choose_loop) {
       if (std::isfinite(tip_psnr) || std::isfinite(end_psnr)) {

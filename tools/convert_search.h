@@ -7,9 +7,10 @@
 // the horse's error is" and "Equal-error quad layouts"; docs/codec-v3.md): among the two-square loops the
 // horse prefers the one through its ends, the bunny and cow the one through the tips; with the equal-error
 // K-patch layouts the horse takes 16 patches and the armadillo 64, the bunny and venus keep two squares;
-// fitted samples gain up to +1.7 dB above 16 KB on the horse and nothing on the bunny. So the search measures instead of guessing: each candidate is converted (geometry only), its
-// prefixes at the scored sizes are decoded and measured against the mesh as `geomip rd` measures them (PSNR
-// of the symmetric RMS surface distance), and the candidate with the highest mean PSNR over the sizes wins.
+// fitted samples gain up to +1.7 dB above 16 KB on the horse and nothing on the bunny. So the search
+// measures instead of guessing: each candidate is converted (geometry only), its prefixes at the scored sizes
+// are decoded and measured against the mesh as `geomip rd` measures them (PSNR of the symmetric RMS surface
+// distance), and the candidate with the highest mean PSNR over the sizes wins.
 //
 // Guarantees:
 // - The winner's pack is byte for byte what `geomip convert` writes with the winner's switches (the

@@ -310,8 +310,8 @@ TEST(MeshIoFormat, ExtensionsAreCaseInsensitive) {
 
 // glTF goes through the same entry points as the other formats: a file written by write_mesh() reads back
 // with the same triangles and float-exact positions, from .glb and from .gltf.
-TEST(MeshIoFormat, GltfAndGlbRoundTripThroughReadMesh) {
-  const std::string dir = test::temp_dir("mesh_io_gltf");
+TEST_F(MeshIo, GltfAndGlbRoundTripThroughReadMesh) {
+  const std::string& dir = dir_;
   const TriMesh torus = test::float32(test::torus(9, 5));  // glTF stores float32
   for (const char* name : {"t.glb", "t.gltf"}) {
     const std::string path = write_mesh_file(dir, name, torus);

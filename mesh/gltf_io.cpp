@@ -549,12 +549,14 @@ TriMesh read_gltf_from_memory(std::string_view original, const std::string& name
                 : gltf.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()),
                                            base_dir);
   } catch (const std::exception& e) {
-    throw InvalidInput(name + ": not a readable glTF file (" + e.what() + ")");
+    throw InvalidInput(name + ": not a readable glTF file (" + std::string(e.what()).substr(0, 160) + ")");
   }
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     const std::size_t nl = err.find('\n');
-    throw InvalidInput(name + ": not a readable glTF file" + (err.empty() ? std::string() : " (" + err.substr(0, nl) + ")"));
+    throw InvalidInput(
+        name + ": not a readable glTF file" +
+        (err.empty() ? std::string() : " (" + err.substr(0, std::min<std::size_t>(nl, 160)) + ")"));
   }
   const Reader reader(model, name);
   TriMesh out;

@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "codec/status.h"
 #include "stream_viewer/pack_source.h"
 #include "stream_viewer/png_write.h"
 #include "stream_viewer/renderer.h"
@@ -441,13 +442,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {  // one line, as every other error
-    std::cerr << "geomip-view: " << e.what() << " (see --help)\n";
+    std::cerr << "geomip-view: " << geomip::codec::one_line(e.what()) << " (see --help)\n";
     return kExitBadInput;
   }
   try {
     return run(opt);
   } catch (const std::exception& e) {
-    std::cerr << "geomip-view: " << e.what() << "\n";
+    std::cerr << "geomip-view: " << geomip::codec::one_line(e.what()) << "\n";
     return kExitFailure;
   }
 }

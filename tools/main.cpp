@@ -1,5 +1,6 @@
 // geomip: consistent geometry images from triangle meshes. This file maps every failure to one line on
 // stderr and an exit code: 2 for bad input or usage, 1 for geomip's own failures.
+#include "codec/status.h"
 #include "mesh/errors.h"
 #include "tools/commands.h"
 
@@ -39,7 +40,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e) == 0 ? kExitOk : kExitBadInput;  // --help, --version
-    std::cerr << "geomip: " << e.what() << " (see --help)\n";  // one line, as every error
+    std::cerr << "geomip: " << geomip::codec::one_line(e.what())
+              << " (see --help)\n";  // one line, as every error
     return kExitBadInput;
   }
 
@@ -49,19 +51,19 @@ int main(int argc, char** argv) {
     try {
       return c.run();
     } catch (const geomip::InvalidInput& e) {
-      std::cerr << name << ": " << e.what() << "\n";
+      std::cerr << name << ": " << geomip::codec::one_line(e.what()) << "\n";
       return kExitBadInput;
     } catch (const geomip::IoError& e) {
-      std::cerr << name << ": " << e.what() << "\n";
+      std::cerr << name << ": " << geomip::codec::one_line(e.what()) << "\n";
       return kExitFailure;
     } catch (const geomip::SolverFailure& e) {
-      std::cerr << name << ": internal failure: " << e.what() << "\n";
+      std::cerr << name << ": internal failure: " << geomip::codec::one_line(e.what()) << "\n";
       return kExitFailure;
     } catch (const std::bad_alloc&) {
       std::cerr << name << ": out of memory\n";
       return kExitFailure;
     } catch (const std::exception& e) {
-      std::cerr << name << ": unexpected error: " << e.what() << "\n";
+      std::cerr << name << ": unexpected error: " << geomip::codec::one_line(e.what()) << "\n";
       return kExitFailure;
     }
   }

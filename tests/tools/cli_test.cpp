@@ -88,6 +88,13 @@ class Cli : public ::testing::Test {
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
     EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line expected:\n" << r.err;
+    // Printable: no control bytes (escape sequences from a file's garbage) and no byte that never occurs in
+    // UTF-8 (the messages themselves may hold UTF-8 such as "≥").
+    for (std::size_t i = 0; i + 1 < r.err.size(); ++i) {
+      const auto c = static_cast<unsigned char>(r.err[i]);
+      EXPECT_TRUE(c >= 0x20 && c != 0x7f && c != 0xc0 && c != 0xc1 && c < 0xf5)
+          << "byte " << int(c) << " in " << r.err;
+    }
   }
 };
 
@@ -128,6 +135,13 @@ TEST_F(Cli, BadInputsExitTwoWithOneLine) {
   for (const char* ext : {"obj", "ply", "off", "stl"}) {
     const std::string garbage = file(std::string("garbage.") + ext, noise);
     expect_bad_input("info '" + garbage + "'", garbage);
+  }
+  for (const char* ext : {"gltf", "glb", "json"}) {  // JSON parsers quote the bytes they stopped at
+    const std::string junk =
+        file(std::string("junk.") + ext, std::string("n\xff\xfe\x01\x1b[31m") + std::string(400, 'x'));
+    expect_bad_input(std::string(ext) == "json" ? "param --points '" + junk + "' -o '" + dir_ + "/p'"
+                                                : "info '" + junk + "'",
+                     junk);
   }
   const std::string nan = file("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   expect_bad_input("info '" + nan + "'", nan);

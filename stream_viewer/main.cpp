@@ -291,12 +291,13 @@ int run(const Options& opt) {
       }
       if (!headless && t1 - last_title > std::chrono::milliseconds(250)) {
         last_title = t1;
-        const std::string title = "geomip-view — level " + std::to_string(s.level < 0 ? ui.max_level : s.level) +
-                                  (ui.auto_level ? " (auto)" : "") + ", detail " + std::to_string(detail) + " — " +
-                                  kb(source.received()) + " / " + kb(source.total()) + " — " +
-                                  std::to_string(static_cast<int>(frame_ms * 10) / 10.0).substr(0, 5) + " ms" +
-                                  (s.target >= 0 ? " — t " + std::to_string(s.t).substr(0, 4) : "") +
-                                  (err.empty() ? "" : " — ERROR: " + err);
+        const std::string title = "geomip-view — level " +
+                                  std::to_string(s.level < 0 ? ui.max_level : s.level) +
+                                  (ui.auto_level ? " (auto)" : "") + ", detail " + std::to_string(detail) +
+                                  " — " + kb(source.received()) + " / " + kb(source.total()) + " — " +
+                                  std::to_string(static_cast<int>(frame_ms * 10) / 10.0).substr(0, 5) +
+                                  " ms" + (s.target >= 0 ? " — t " + std::to_string(s.t).substr(0, 4) : "") +
+                                  (err.empty() ? "" : " — ERROR: " + geomip::codec::one_line(err));
         glfwSetWindowTitle(window, title.c_str());
       }
 
@@ -345,7 +346,7 @@ int run(const Options& opt) {
       }
     }
     // Exactly one line for whatever went wrong.
-    std::string err = source.error();
+    std::string err = geomip::codec::one_line(source.error());
     if (err.empty()) err = timed_out;
     if (usage_error) {
       // already said

@@ -248,7 +248,7 @@ int run(const Options& opt) {
         std::cout << "geomip-view: showing " << shown_bytes << " of " << total << " bytes, detail level " << detail
                   << "/" << ui.max_level << "\n";
       }
-      const std::string err = source.error();  // shown in the title; printed once, on exit
+      const std::string err = geomip::codec::one_line(source.error());  // in the title; printed once, on exit
       const bool loaded = source.done();
 
       // morph / animate
@@ -297,7 +297,7 @@ int run(const Options& opt) {
                                   " — " + kb(source.received()) + " / " + kb(source.total()) + " — " +
                                   std::to_string(static_cast<int>(frame_ms * 10) / 10.0).substr(0, 5) +
                                   " ms" + (s.target >= 0 ? " — t " + std::to_string(s.t).substr(0, 4) : "") +
-                                  (err.empty() ? "" : " — ERROR: " + geomip::codec::one_line(err));
+                                  (err.empty() ? "" : " — ERROR: " + err);
         glfwSetWindowTitle(window, title.c_str());
       }
 

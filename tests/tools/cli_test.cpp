@@ -1219,9 +1219,6 @@ TEST_F(CliPack, QuadSplitShorterIsCloserAndSharedByTheSet) {
   EXPECT_FALSE(fs::exists(dir_ + "/bad.obj"));
 }
 
-// --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch
-// count): watertight, genus 0, K·2·4^L faces, V = K·4^L + 2; convert's level without --level; bad K exit 2
-// with one line and nothing written.
 // A single mesh on two squares gets its patches' L2 stretch in the JSON, and from 1.5 up (tools/
 // convert_pipeline.h, kStretchedTwoSquares: the horse and the armadillo coded better on more patches, the
 // bunny and venus did not) a note pointing at --patches and --search. The cow's legs stretch its squares
@@ -1251,6 +1248,9 @@ TEST_F(CliPack, ConvertSuggestsMorePatchesWhenTwoSquaresStretch) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch
+// count): watertight, genus 0, K·2·4^L faces, V = K·4^L + 2; convert's level without --level; bad K exit 2
+// with one line and nothing written.
 TEST_F(CliPack, KPatchLayoutThroughRemeshConvertAndDecode) {
   const std::string out = dir_ + "/k6";
   Outcome r = geomip("remesh --quiet '" + spot_ + "' --patches 6 --level 3 -o '" + out + "'");

@@ -377,6 +377,17 @@ static CLI::Validator non_negative(const std::string& what) {
       "≥ 0");
 }
 
+/// The same for options that must be > 0.
+static CLI::Validator positive(const std::string& what) {
+  return CLI::Validator(
+      [what](std::string& v) {
+        double x = 0;
+        return CLI::detail::lexical_cast(v, x) && x > 0 ? std::string()
+                                                        : v + " is not above 0 (" + what + ")";
+      },
+      "> 0");
+}
+
 int main(int argc, char** argv) {
   Options opt;
   CLI::App app{"geomip-view — progressive viewer of .gip packs (file or http:// URL).\n"
@@ -412,7 +423,7 @@ int main(int argc, char** argv) {
                "keep each model in its own frame (default: models 1… are aligned to model 0 by the least-squares "
                "similarity over corresponding samples)");
   app.add_option("--frames", opt.frames, "headless: render N frames after loading, then exit")
-      ->check(CLI::PositiveNumber);
+      ->check(positive("a frame count"));
   app.add_option("--width", opt.width, "framebuffer width")->check(CLI::Range(16, 8192));
   app.add_option("--height", opt.height, "framebuffer height")->check(CLI::Range(16, 8192));
   app.add_option("--screenshot", opt.screenshot, "headless: write the last frame as PNG");

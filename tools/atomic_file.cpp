@@ -17,7 +17,8 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw IoError(path + ": output directory '" + dir.string() + "' does not exist");
+  if (!fs::is_directory(dir, ec))  // the user's path, not a failure of the machine: exit 2
+    throw InvalidInput(path + ": output directory '" + dir.string() + "' does not exist");
   std::string tmp_name = ".";
   tmp_name += target.filename().string();
   tmp_name += ".tmp-";
@@ -37,6 +38,28 @@ void write_file_atomically(const std::string& path, const std::function<void(std
     fs::remove(tmp, ec);
     throw;
   }
+}
+
+void check_output_directory(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw InvalidInput(dir + " exists and is not a directory");
+}
+
+void make_output_directory(const std::string& dir) {
+  namespace fs = std::filesystem;
+  check_output_directory(dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!ec) return;
+  // A parent that is a file is the user's path; anything else (permissions, a full disk) is the machine's.
+  for (fs::path p = fs::path(dir).parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path()) {
+    std::error_code e;
+    if (fs::exists(p, e) && !fs::is_directory(p, e))
+      throw InvalidInput(dir + ": " + p.string() + " exists and is not a directory");
+  }
+  throw IoError(dir + ": cannot create the output directory: " + ec.message());
 }
 
 }  // namespace geomip::tools

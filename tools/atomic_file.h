@@ -14,4 +14,13 @@ namespace geomip::tools {
 /// \throw IoError when the directory is not writable or the disk is full.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// Checks, before any work, that `dir` can be made an output directory: absent or a directory.
+/// \throw InvalidInput when it exists and is not a directory.
+void check_output_directory(const std::string& dir);
+
+/// Creates the output directory `dir` and its parents (nothing when it exists).
+/// \throw InvalidInput when it, or a parent, exists and is not a directory; IoError when it cannot be
+/// created.
+void make_output_directory(const std::string& dir);
+
 }  // namespace geomip::tools

@@ -37,6 +37,7 @@ struct ConvertArgs {
   double normal_mesh_reach = ConvertOptions{}.normal_mesh_max_shift;
   int normal_mesh_guard = ConvertOptions{}.normal_mesh_fold_guard;
   int frame_steps = ConvertOptions{}.frame_steps;
+  bool frame_steps_given = false;  ///< --frame-steps on the command line
   int tangential_shift = ConvertOptions{}.tangential_shift;
   bool no_orientation_weights = false;
   bool no_lifting_update = false;
@@ -87,7 +88,8 @@ void check_level_options(const ConvertArgs& args, int level) {
   if (args.normal_mesh_steps < -1 || args.normal_mesh_steps > level)
     throw InvalidInput("--normal-mesh " + std::to_string(args.normal_mesh_steps) + " is outside [0, " +
                        std::to_string(level) + "] (the level)");
-  if (args.frame_steps < 0 || args.frame_steps > level)
+  // The default (3) is capped at the level by the codec; a number the user gave must fit.
+  if (args.frame_steps < 0 || (args.frame_steps_given && args.frame_steps > level))
     throw InvalidInput("--frame-steps " + std::to_string(args.frame_steps) + " is outside [0, " +
                        std::to_string(level) + "] (the level)");
 }
@@ -166,6 +168,7 @@ int run_convert(const ConvertArgs& args) {
   ConvertResult converted;
   std::optional<SearchResult> searched;
   const int named_level = level;  // the level the search names its candidates against
+  bool relayouted = false;        // moved from two stretched squares to kStretchedShapePatches patches
   if (searching) {
     // --choose-loop: the loops only (with --fit every loop fitted: options.fit).
     SearchOptions search = args.search ? full_search_options() : SearchOptions{};
@@ -181,7 +184,35 @@ int run_convert(const ConvertArgs& args) {
     models = std::move(searched->models);
     level = searched->chosen.level;
   } else {
-    converted = convert_models(models, options);
+    // One mesh on the plain two squares, layout and level left to us: a shape they stretch moves to 16
+    // patches one level coarser (kStretchedTwoSquares), unless the level-dependent options do not fit there.
+    int relayout_level = 0;
+    if (!args.common.patches_given && args.common.points.empty() && args.common.meshes.size() == 1 &&
+        loop_asked == LoopKind::kPlain) {
+      relayout_level = stretched_shape_level(level);
+      try {
+        if (relayout_level > 0) check_level_options(args, relayout_level);
+      } catch (const InvalidInput&) {
+        relayout_level = 0;
+      }
+    }
+    converted = convert_relayout_when_stretched(
+        models, options, relayout_level,
+        [&](int patches) {
+          return prepare_models(args.common.meshes, "", "geomip convert", true, patches, LoopKind::kPlain,
+                                args.common.equal_area_layout);
+        },
+        [&](double stretch) {
+          bar.finish();
+          if (report)
+            std::printf(
+                "layout: the two squares stretch this shape (L2 stretch %.2f; 1 is none): converting it "
+                "again on %d patches at level %d, which code such shapes better (--patches 2 keeps the "
+                "two squares)\n",
+                stretch, kStretchedShapePatches, relayout_level);
+        },
+        relayouted);
+    level = options.level;
   }
   // --choose-loop's report: the mean PSNR of each loop (NaN: not built, e.g. a mesh without tips).
   std::string loop = searched ? std::string(searched->chosen.patches == 2 ? "" : "none") : "";
@@ -219,6 +250,8 @@ int run_convert(const ConvertArgs& args) {
                                 {"manifest_bytes", info.manifest_end},
                                 {"chunks", info.chunks.size()},
                                 {"level", level},
+                                {"patches", info.models.front().geometry.num_patches},
+                                {"moved_to_patches", relayouted},
                                 {"normals", !args.no_normals},
                                 {"models", j_models},
                                 {"normal_mesh",
@@ -252,7 +285,7 @@ int run_convert(const ConvertArgs& args) {
                 args.no_normals ? ", geometry only" : ", with normal maps");
     std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
                 converted.resample_seconds, converted.encode_seconds);
-    if (!searching && converted.two_squares_l2_stretch >= kStretchedTwoSquares)
+    if (!searching && !relayouted && converted.two_squares_l2_stretch >= kStretchedTwoSquares)
       std::printf(
           "note: the two squares stretch this shape (L2 stretch %.2f; 1 is none): a layout of more "
           "patches may code it better (on the mean PSNR of the 1.5-32 KB prefixes, `--patches 16`: horse "
@@ -295,7 +328,8 @@ CommandRunner add_convert_command(CLI::App& app) {
   CLI::Option* level = cmd->add_option(
       "--level", args->level,
       "Grid level N in [1, 10] (default 8: 257² samples per patch, for two squares; for a K-patch layout "
-      "the coarsest level whose K grids hold at least as many samples: K = 8: 7, 32 or 64: 6)");
+      "the coarsest level whose K grids hold at least as many samples: K = 3 to 7: 8, 8 to 31: 7, 32 to 121: "
+      "6; a stretched shape moved to 16 patches gets one level below the two squares' N)");
   cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
   cmd->add_option("--bits", args->quantization_bits,
                   "Position quantization bits over the largest bounding-box extent (default 14)");
@@ -318,9 +352,11 @@ CommandRunner add_convert_command(CLI::App& app) {
                 "the surface, not its interpolant (gimage/fit.h, after the normal-mesh resampling; hole-mask "
                 "quads left out); --no-fit: samples on the surface (default)");
   // Codec tools, for ablations (docs/codec-v3.md); the defaults are the codec's best measured.
-  cmd->add_option("--frame-steps", args->frame_steps,
-                  "Code the details of the finest STEPS wavelet steps in local (normal, tangent) frames "
-                  "(default " + std::to_string(ConvertOptions{}.frame_steps) + ", 0 = off)");
+  CLI::Option* frame_steps =
+      cmd->add_option("--frame-steps", args->frame_steps,
+                      "Code the details of the finest STEPS wavelet steps in local (normal, tangent) frames "
+                      "(default " +
+                          std::to_string(ConvertOptions{}.frame_steps) + ", at most the level; 0 = off)");
   cmd->add_option("--tangential-shift", args->tangential_shift,
                   "Quantize framed tangential components 2^S times coarser than normal ones (default " +
                       std::to_string(ConvertOptions{}.tangential_shift) + ")");
@@ -358,8 +394,9 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "camera): +x, -x, +y, -y, +z or -z, across the up axis. Default: from the first model's "
                   "shape (docs/streaming.md, \"Upright and front\")")
       ->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
-  return [args, level] {
+  return [args, level, frame_steps] {
     args->level_given = level->count() > 0;
+    args->frame_steps_given = frame_steps->count() > 0;
     return run_convert(*args);
   };
 }

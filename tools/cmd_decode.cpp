@@ -77,9 +77,15 @@ int run_decode(const DecodeArgs& args) {
   if (decoded.status == codec::Status::kTruncated && decoded.models.empty()) {
     // The bytes end inside the manifest: decode_pack() knows no chunk sizes, only the header's manifest size.
     if (prefix_asked && static_cast<std::size_t>(args.bytes) < bytes.size()) {
-      throw InvalidInput(args.pack + ": the first " + std::to_string(args.bytes) +
-                         " bytes end inside the pack's manifest (" + std::to_string(manifest_end) +
-                         " bytes needed before any level of detail)");
+      // The whole file knows its chunks: name the prefix that does decode.
+      codec::PackInfo whole;
+      const bool known = codec::read_pack_info(bytes, whole) == codec::Status::kOk;
+      throw InvalidInput(
+          args.pack + ": the first " + std::to_string(args.bytes) +
+          " bytes end inside the pack's manifest (" + std::to_string(manifest_end) + " bytes" +
+          (known ? "; the first level of detail needs " + std::to_string(first_level_bytes(whole))
+                 : std::string()) +
+          ")");
     }
     throw InvalidInput(args.pack + ": the pack is truncated inside its manifest (the file has " +
                        std::to_string(bytes.size()) + " bytes, the manifest alone needs " +
@@ -188,9 +194,9 @@ CommandRunner add_decode_command(CLI::App& app) {
                   "Output mesh; with several models, <stem>.<model>.<ext> beside it")
       ->required();
   cmd->add_option("--bytes", args->bytes, "Decode as if only the first N bytes of the file had arrived")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   cmd->add_option("--level", args->level, "Output grid level K (default: the pack's level)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   cmd->add_flag("--draco{14}", args->draco,
                 "glTF output compressed by Draco (KHR_draco_mesh_compression): positions quantized to BITS bits "
                 "(--draco=BITS, 1..30; default 14), normals 10, texture coordinates 12");

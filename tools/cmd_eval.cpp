@@ -172,7 +172,7 @@ CommandRunner add_eval_command(CLI::App& app) {
                   "Write ORIGINAL as PLY coloured by its distance to APPROX");
   cmd->add_option("--error-map-scale", args->error_map_scale_pct,
                   "Distance shown as red, in % of the diagonal (default: the 99th percentile of face RMS)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_flag("--json", args->json,
                 "Machine-readable output: hausdorff_pct, rms_pct, psnr_db (null = +inf), raw values, "
                 "per-direction max/mean/rms and sample counts, bbox_diagonal");

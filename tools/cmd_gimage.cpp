@@ -4,8 +4,9 @@
 #include "gimage/exr_io.h"
 #include "gimage/fit.h"
 #include "gimage/resample.h"
-#include "param/consistent_parameterization.h"
 #include "mesh/errors.h"
+#include "param/consistent_parameterization.h"
+#include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/model_inputs.h"
 #include "tools/progress.h"
@@ -45,8 +46,7 @@ int run_gimage(const GimageArgs& args) {
   const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip gimage",
                                                args.common.quiet || args.common.json, args.common.patches,
                                                loop_kind(args.common), args.common.equal_area_layout);
-  if (std::filesystem::exists(args.common.output) && !std::filesystem::is_directory(args.common.output))
-    throw InvalidInput(args.common.output + " exists and is not a directory");
+  check_output_directory(args.common.output);
 
   ParameterizationOptions options;
   apply_sampling(args.common, options);
@@ -58,7 +58,7 @@ int run_gimage(const GimageArgs& args) {
   const double param_seconds = seconds_since(t0);
   bar.finish();
   // Only now: a failed parameterization leaves no (empty) output directory behind.
-  std::filesystem::create_directories(args.common.output);
+  make_output_directory(args.common.output);
 
   nlohmann::json summary = nlohmann::json::array();
   for (std::size_t i = 0; i < result.size(); ++i) {

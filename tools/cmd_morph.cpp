@@ -31,13 +31,17 @@ struct MorphArgs {
 };
 
 int run_morph(const MorphArgs& args) {
+  check_output_directory(args.output);
   const std::vector<std::uint8_t> bytes = read_pack_file(args.pack);
   codec::PackDecodeResult decoded = codec::decode_pack(bytes);
   if (decoded.status != codec::Status::kOk)
     throw InvalidInput(args.pack + ": " + std::string(codec::status_message(decoded.status)));
   const int count = static_cast<int>(decoded.models.size());
+  if (count < 2)
+    throw InvalidInput(args.pack +
+                       " holds one model; a morph needs a pack of two or more (geomip convert --points)");
   if (args.from >= count || args.to >= count)
-    throw InvalidInput(args.pack + " holds " + std::to_string(count) + " model(s); --from/--to out of range");
+    throw InvalidInput(args.pack + " holds " + std::to_string(count) + " models; --from/--to out of range");
   const bool wavelet = args.schedule == "wavelet";
   morph::DecodeSettings settings;
   settings.bands = wavelet ? args.bands : 1;
@@ -64,7 +68,7 @@ int run_morph(const MorphArgs& args) {
       for (std::size_t q = 0; q < other[p].size() && q < frame.hole_mask[p].size(); ++q)
         frame.hole_mask[p][q] = frame.hole_mask[p][q] || other[p][q];
 
-  std::filesystem::create_directories(args.output);
+  make_output_directory(args.output);
   const auto schedule = wavelet ? morph::MorphSchedule::kWavelet : morph::MorphSchedule::kLinear;
   // The morph's two ends choose the quad split together: every frame gets the same face list.
   const std::vector<const codec::DecodedModel*> ends{&decoded.models[args.from], &decoded.models[args.to]};
@@ -92,14 +96,14 @@ CommandRunner add_morph_command(CLI::App& app) {
       "morph", "Morph between two models of a consistent .gip pack: N OBJ meshes with the same connectivity.");
   cmd->add_option("pack", args->pack, "The .gip pack (at least two consistent models)")->required();
   cmd->add_option("-o,--output", args->output, "Output directory (morph_0000.obj, ...)")->required();
-  cmd->add_option("--frames", args->frames, "Number of frames, t = 0 … 1")->check(CLI::PositiveNumber);
+  cmd->add_option("--frames", args->frames, "Number of frames, t = 0 … 1")->check(positive_number());
   cmd->add_option("--schedule", args->schedule, "linear, or wavelet (per-band schedule, paper §6.2)")
       ->check(CLI::IsMember({"linear", "wavelet"}));
   cmd->add_option("--bands", args->bands, "Wavelet bands of the wavelet schedule")->check(CLI::Range(2, 8));
-  cmd->add_option("--from", args->from, "Source model index")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--to", args->to, "Target model index")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--from", args->from, "Source model index")->check(non_negative_number());
+  cmd->add_option("--to", args->to, "Target model index")->check(non_negative_number());
   cmd->add_option("--level", args->level, "Output grid level (default: the pack's level)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   cmd->add_flag("--no-align", args->no_align,
                 "Keep each model in its own frame (default: models are aligned to model 0 by the least-squares "
                 "similarity over their corresponding samples, so the morph does not rotate or shrink)");

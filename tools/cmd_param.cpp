@@ -126,6 +126,7 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
 }
 
 int run_param(const ParamArgs& args) {
+  check_output_directory(args.common.output);  // before the work, not after it
   const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param",
                                                args.common.quiet || args.common.json, args.common.patches,
                                                loop_kind(args.common), args.common.equal_area_layout);
@@ -144,7 +145,7 @@ int run_param(const ParamArgs& args) {
   bar.finish();
 
   // Only now: a failed run leaves no (empty) output directory behind.
-  std::filesystem::create_directories(args.common.output);
+  make_output_directory(args.common.output);
   nlohmann::json summary = nlohmann::json::array();
   for (std::size_t i = 0; i < result.size(); ++i) {
     const std::string stem = (std::filesystem::path(args.common.output) / inputs[i].name).string();

@@ -51,6 +51,7 @@ struct RdArgs {
   std::string mesh;
   std::string output;
   bool json = false;
+  bool quiet = false;  // -q: no progress bar, no table
   bool quick = false;
   bool lindstrom_turk = false;  // also the draco_lt series (CGAL Lindstrom-Turk decimation) and its envelope
   std::size_t samples = 0;  // face samples per surface for the evaluation; 0 = surface_distance's default
@@ -59,6 +60,7 @@ struct RdArgs {
   bool no_geomip = false;   // only the baselines
   int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
   int patches = 2;          // geomip: patches of the automatic layout (--patches)
+  bool patches_given = false;  // --patches on the command line (else a stretched shape moves to 16 patches)
   bool equal_area_layout = false;  // geomip: --equal-area-layout
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
   bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)
@@ -201,10 +203,13 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
 /// geomip: the mesh converted once (repair → parameterization → level-N geometry images → geometry-only
 /// pack), then one job per prefix size: decode the first N bytes and build the level-N mesh. `search`: the
 /// pack of search_conversion() (the loops, the K-patch layouts, the fit, ...), its choice in `chosen`.
+/// `relayout`: the layout was left to us (no --patches, the plain loop), so a shape that two squares stretch
+/// moves to 16 patches one level coarser, as `geomip convert` does (convert_relayout_when_stretched());
+/// `moved` then holds the two squares' L2 stretch and the level, else stays empty.
 Series geomip_series(const std::string& mesh_path, int level, int patches, bool equal_area_layout,
-                     LoopKind loop, int normal_mesh_steps, bool fit, bool search, bool quick,
+                     LoopKind loop, int normal_mesh_steps, bool fit, bool search, bool quick, bool relayout,
                      std::vector<std::uint8_t>& pack_out, std::optional<SearchResult>& chosen,
-                     ProgressBar& progress) {
+                     std::optional<std::pair<double, int>>& moved, ProgressBar& progress) {
   ConvertOptions options;
   options.seam_slide_rounds = default_seam_slide_rounds(loop);
   options.level = level;
@@ -217,9 +222,19 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, bool 
     chosen = search_conversion(mesh_path, options, full_search_options(), true);
     pack = std::make_shared<const std::vector<std::uint8_t>>(chosen->converted.pack);
   } else {
-    const PreparedModels models =
+    PreparedModels models =
         prepare_models({mesh_path}, "", "geomip rd", true, patches, loop, equal_area_layout);
-    pack = std::make_shared<const std::vector<std::uint8_t>>(convert_models(models, options).pack);
+    const int coarser = stretched_shape_level(level);
+    const bool fits = normal_mesh_steps <= coarser && ConvertOptions{}.frame_steps <= coarser;
+    bool switched = false;
+    ConvertResult converted = convert_relayout_when_stretched(
+        models, options, relayout && fits ? coarser : 0,
+        [&](int k) {
+          return prepare_models({mesh_path}, "", "geomip rd", true, k, LoopKind::kPlain, equal_area_layout);
+        },
+        {}, switched);
+    if (switched) moved.emplace(converted.two_squares_l2_stretch, options.level);
+    pack = std::make_shared<const std::vector<std::uint8_t>>(std::move(converted.pack));
   }
   pack_out = *pack;
   codec::PackInfo info;
@@ -298,6 +313,7 @@ int run_rd(const RdArgs& args) {
   // Before the baselines' work: bad loop options fail at once.
   const LoopKind loop = loop_kind(args.tip_loop, args.end_loop);
   check_loop_patches(loop, args.patches);
+  check_output_directory(args.output);
   if (args.search && (args.patches != 2 || loop != LoopKind::kPlain || args.fit))
     throw InvalidInput("--search chooses the layout and the fit itself: not with --patches, --tip-loop, "
                        "--end-loop or --fit");
@@ -307,13 +323,16 @@ int run_rd(const RdArgs& args) {
       args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
   const Sweep sweep = make_sweep(args.quick);
 
-  ProgressBar progress("rd", !args.json);
+  ProgressBar progress("rd", !args.json && !args.quiet);
   std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
   std::optional<SearchResult> searched;
+  std::optional<std::pair<double, int>>
+      moved;  // two squares' stretch and the level, when moved to 16 patches
   if (!args.no_geomip)
     plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.equal_area_layout, loop,
-                                 args.normal_mesh_steps, args.fit, args.search, args.quick, pack, searched,
+                                 args.normal_mesh_steps, args.fit, args.search, args.quick,
+                                 !args.patches_given && loop == LoopKind::kPlain, pack, searched, moved,
                                  progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
@@ -376,7 +395,7 @@ int run_rd(const RdArgs& args) {
   plot.title = "Rate-distortion: " + std::filesystem::path(args.mesh).filename().string() + " (" +
                std::to_string(original->num_triangles()) + " faces)";
   write_rd_svg(svg, all, plot);
-  std::filesystem::create_directories(args.output);
+  make_output_directory(args.output);
   const std::filesystem::path dir(args.output);
   write_file_atomically((dir / "rd.csv").string(), [&](std::ostream& out) { out << csv.str(); });
   write_file_atomically((dir / "rd.svg").string(), [&](std::ostream& out) { out << svg.str(); });
@@ -430,11 +449,16 @@ int run_rd(const RdArgs& args) {
     j["geomip_vs_draco_envelope"] = comparison;
     if (!lt_points.empty()) j["geomip_vs_draco_lt_envelope"] = lt_comparison;
     if (searched) j["search"] = search_json(*searched, args.level);
+    if (moved)
+      j["geomip_moved_to_patches"] = {{"patches", kStretchedShapePatches},
+                                      {"level", moved->second},
+                                      {"two_squares_l2_stretch", moved->first}};
     j["points"] = nlohmann::json::array();
     for (const RdPoint& p : all) j["points"].push_back(point_to_json(p));
     std::cout << j.dump(2) << "\n";
     return kExitOk;
   }
+  if (args.quiet) return kExitOk;
   std::cout << args.mesh << ": " << original->num_triangles() << " faces, " << original->num_vertices()
             << " vertices\n"
             << format("%-15s %7s %3s %9s %9s %8s %9s %9s\n", "method", "faces", "Q", "bytes", "KB", "PSNR dB",
@@ -454,6 +478,11 @@ int run_rd(const RdArgs& args) {
     std::cout << "geomip pack: " << searched->chosen.name(args.level) << " (--search; mean PSNR of its "
               << searched->sizes.size() << " scored prefixes: " << scores << ")\n";
   }
+  if (moved)
+    std::cout << format(
+        "geomip pack: %d patches at level %d (the two squares stretch this shape: L2 stretch %.2f; "
+        "--patches 2 keeps them)\n",
+        kStretchedShapePatches, moved->second, moved->first);
   std::cout << "(" << candidates << " decimate-then-Draco points, the envelopes' candidates, are in rd.csv)\n"
             << comparison_text
             << "wrote " << (dir / "rd.csv").string() << " and " << (dir / "rd.svg").string()
@@ -474,6 +503,8 @@ CommandRunner add_rd_command(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();
   cmd->add_flag("--json", args->json, "Print every point as JSON instead of the table");
+  cmd->add_flag("-q,--quiet", args->quiet,
+                "No progress bar and no table (rd.csv and rd.svg are still written)");
   cmd->add_flag("--quick", args->quick, "A few points only, coarser evaluation (for tests)");
   cmd->add_flag(
       "--lindstrom-turk", args->lindstrom_turk,
@@ -495,7 +526,7 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_flag("--fit,!--no-fit", args->fit,
                 "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip "
                 "convert --fit`; slower: about 30 s at level 8); --no-fit: samples on the surface (default)");
-  add_patches_option(cmd, args->patches, args->equal_area_layout);
+  add_patches_option(cmd, args->patches, args->patches_given, args->equal_area_layout);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");
   cmd->add_flag("--end-loop", args->end_loop, "geomip: the two-square loop through the ends (as `geomip convert --end-loop`)");
   cmd->add_flag("--search", args->search,

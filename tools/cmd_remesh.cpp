@@ -60,8 +60,7 @@ int run_remesh(const RemeshArgs& args) {
   const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip remesh",
                                                args.common.quiet || args.common.json, args.common.patches,
                                                loop_kind(args.common), args.common.equal_area_layout);
-  if (std::filesystem::exists(args.common.output) && !std::filesystem::is_directory(args.common.output))
-    throw InvalidInput(args.common.output + " exists and is not a directory");
+  check_output_directory(args.common.output);
 
   ParameterizationOptions options;
   apply_sampling(args.common, options);
@@ -73,7 +72,7 @@ int run_remesh(const RemeshArgs& args) {
   const double param_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bar.finish();
   // Only now: a failed parameterization leaves no (empty) output directory behind.
-  std::filesystem::create_directories(args.common.output);
+  make_output_directory(args.common.output);
 
   nlohmann::json summary = nlohmann::json::array();
   // Uniform: every model's images and remesh first, so that the models of a set choose the quad split
@@ -219,7 +218,7 @@ CommandRunner add_remesh_command(CLI::App& app) {
   cmd->add_option("--adaptive", args->adaptive,
                   "Adaptive remesh (paper §4, eq. 4-6) with error bound EPS (fraction of the bounding-box "
                   "diagonal): DIR/<stem>.adaptive.obj, one face list for a consistent set")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   cmd->add_option("--max-depth", args->max_depth,
                   "Adaptive: maximum quadtree depth N in [0, 10] (default 8)");
   cmd->add_flag("--measure-samples", args->measure_samples,

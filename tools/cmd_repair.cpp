@@ -47,7 +47,8 @@ std::string summary(const RepairResult& r) {
 int run_repair(const RepairArgs& args) {
   const MeshFormat out_format = mesh_format_from_path(args.output);  // fail before the work
   if (out_format == MeshFormat::kStl) {
-    std::cerr << "geomip repair: " << args.output << ": STL output is not supported (use .obj, .ply or .off)\n";
+    std::cerr << "geomip repair: " << args.output
+              << ": STL output is not supported (use .obj, .ply, .off, .gltf or .glb)\n";
     return kExitBadInput;
   }
   const TriMesh input = read_mesh(args.input);
@@ -104,8 +105,8 @@ CommandRunner add_repair_command(CLI::App& app) {
       "Make a scanned mesh ready for parameterization: drop unreferenced/duplicate vertices and degenerate faces, "
       "split non-manifold vertices, fill holes (CGAL triangulate+refine+fair), orient outward. Original vertices "
       "keep their positions and order; new vertices are appended. OUT is written atomically.");
-  cmd->add_option("input", args->input, "Input mesh (.obj .ply .off .stl)")->required();
-  cmd->add_option("-o,--output", args->output, "Output mesh (.obj .ply .off)")->required();
+  cmd->add_option("input", args->input, "Input mesh (.obj .ply .off .stl .gltf .glb)")->required();
+  cmd->add_option("-o,--output", args->output, "Output mesh (.obj .ply .off .gltf .glb)")->required();
   cmd->add_flag("--no-fill", args->no_fill, "Do not fill holes");
   cmd->add_flag("--largest-component", args->largest_component,
                 "Keep only the largest connected component (by face count) and drop the others, then repair: "

@@ -17,6 +17,27 @@ enum ExitCode : int {
 
 using CommandRunner = std::function<int()>;
 
+/// Option checks that say what is wrong (CLI11's NonNegativeNumber and PositiveNumber print their range as
+/// "0.000000 to 1.79…e308", and PositiveNumber calls 0 in range): "must be >= 0" / "must be > 0".
+inline CLI::Validator non_negative_number() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(value, v)) return "'" + value + "' is not a number";
+        return v >= 0 ? "" : "must be >= 0, got " + value;
+      },
+      "NONNEGATIVE");
+}
+inline CLI::Validator positive_number() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(value, v)) return "'" + value + "' is not a number";
+        return v > 0 ? "" : "must be > 0, got " + value;
+      },
+      "POSITIVE");
+}
+
 CommandRunner add_info_command(CLI::App& app);
 CommandRunner add_repair_command(CLI::App& app);
 CommandRunner add_param_command(CLI::App& app);

@@ -135,6 +135,34 @@ int default_grid_level(std::size_t patches) {
   return level;
 }
 
+int stretched_shape_level(int level) {
+  const int shifted =
+      level + default_grid_level(static_cast<std::size_t>(kStretchedShapePatches)) - default_grid_level(2);
+  return shifted >= 1 ? shifted : 0;
+}
+
+ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOptions& options,
+                                              int relayout_level,
+                                              const std::function<PreparedModels(int patches)>& prepare,
+                                              const std::function<void(double stretch)>& before_switch,
+                                              bool& switched) {
+  switched = false;
+  ConvertResult result = convert_models(models, options);
+  const double stretch = result.two_squares_l2_stretch;
+  if (relayout_level < 1 || stretch < kStretchedTwoSquares) return result;
+  if (before_switch) before_switch(stretch);
+  models = prepare(kStretchedShapePatches);
+  options.level = relayout_level;
+  const ConvertResult first = std::move(result);
+  result = convert_models(models, options);
+  result.two_squares_l2_stretch = stretch;
+  result.param_seconds += first.param_seconds;  // the time both conversions took
+  result.resample_seconds += first.resample_seconds;
+  result.encode_seconds += first.encode_seconds;
+  switched = true;
+  return result;
+}
+
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options) {
   auto progress = [&](const char* stage, double fraction) {
     if (options.progress) options.progress(stage, fraction);

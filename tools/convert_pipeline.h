@@ -9,6 +9,7 @@
 #include "tools/model_inputs.h"
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -98,12 +99,23 @@ struct ConvertResult {
   double two_squares_l2_stretch = 0;
 };
 
-/// From this L2 stretch of a model's two squares up, `geomip convert` suggests K-patch layouts. The two
+/// From this L2 stretch of a model's two squares up, `geomip convert` and `geomip rd` move the mesh to
+/// kStretchedShapePatches patches when --patches is not given (convert_relayout_when_stretched()). The two
 /// squares' L2 stretch (as `convert` parameterizes) and which layout coded better (mean PSNR of the
-/// 1.5–32 KB geometry prefixes; docs/measurements.md): venus 1.07, bunny 1.31 (two squares better); horse
-/// 1.78 (16 patches +1.0 dB), armadillo 1.97 (16 patches +1.1 dB, 64 patches +2.8 dB); cow 1.74 (16 patches
-/// about the same: −1.1…+1.6 dB by size).
+/// 1.5–32 KB geometry prefixes; docs/measurements.md, "A note when two squares stretch the shape" and
+/// "Stretched shapes move to 16 patches"): venus 1.07, max-planck 1.07, pig 1.17, camelhead 1.19, spot 1.23,
+/// bunny 1.31 (two squares better by 0.8–2.6 dB); fandisk 1.22 (16 patches +0.5 dB); cow 1.74 (16 patches
+/// about the same: −1.1…+1.6 dB by size); horse 1.78 (16 patches +1.0 dB), armadillo 1.97 (16 patches
+/// +1.1 dB, 64 patches +2.8 dB).
 inline constexpr double kStretchedTwoSquares = 1.5;
+
+/// The layout a stretched shape moves to: 16 patches, an automatic layout (choose_quad_layout()).
+inline constexpr int kStretchedShapePatches = 16;
+
+/// The grid level of that layout for two squares at `level`: about their samples, as --search names its
+/// K-patch candidates (level + default_grid_level(16) − default_grid_level(2), i.e. one level coarser);
+/// 0 when that is below 1.
+int stretched_shape_level(int level);
 
 /// The mesh the viewer's frame (ConvertOptions::up, front) is guessed from: the first model as read when it
 /// was repaired (a filled hole — the camel head's neck cut faired into a dome — would hide the cut that tells
@@ -125,5 +137,18 @@ codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::s
 /// \throw InvalidInput / SolverFailure from the parameterization; std::invalid_argument never escapes (the
 /// images come from resample_geometry()).
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options);
+
+/// convert_models(models, options); then, when `relayout_level` ≥ 1 and that converted one mesh on two
+/// squares whose L2 stretch is at least kStretchedTwoSquares: `before_switch(stretch)`, the mesh prepared
+/// again by `prepare(kStretchedShapePatches)` and converted at `relayout_level`. `models` and `options.level`
+/// then describe the second conversion, whose result is returned with the two squares' stretch kept in
+/// two_squares_l2_stretch; `switched` says which happened. The callers pass 0 (no switch) when the user
+/// chose the layout (--patches, --points, a loop) or the level-dependent options do not fit the coarser
+/// level.
+ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOptions& options,
+                                              int relayout_level,
+                                              const std::function<PreparedModels(int patches)>& prepare,
+                                              const std::function<void(double stretch)>& before_switch,
+                                              bool& switched);
 
 }  // namespace geomip::tools

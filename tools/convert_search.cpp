@@ -72,7 +72,8 @@ std::string SearchCandidate::switches(int default_level) const {
   auto add = [&](const std::string& w) { s += (s.empty() ? "" : " ") + w; };
   if (loop == LoopKind::kTips) add("--tip-loop");
   if (loop == LoopKind::kEnds) add("--end-loop");
-  if (patches != 2) add("--patches " + std::to_string(patches));
+  if (patches != 2 || (loop == LoopKind::kPlain && two_squares_named))
+    add("--patches " + std::to_string(patches));
   if (level != default_level) add("--level " + std::to_string(level));
   if (fit) add("--fit");
   if (linf_sweeps > 0) add("--linf-sweeps " + std::to_string(linf_sweeps));
@@ -111,6 +112,8 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
   // The plain loop first: its errors (unreadable mesh, genus the two squares cannot hold) are the user's.
   build({LoopKind::kPlain, 2, options.level, options.fit},
         prepare_models({mesh}, "", "geomip convert", quiet, 2, LoopKind::kPlain));
+  if (built.front().geometry.two_squares_l2_stretch >= kStretchedTwoSquares)
+    built.front().candidate.two_squares_named = true;
   const PreparedModels& first = built.front().models;
   const TriMesh reference =
       first.originals.front().positions.empty() ? first.inputs.front().mesh : first.originals.front();

@@ -51,11 +51,14 @@ struct SearchCandidate {
   std::size_t linf_sweeps = 0;
   /// Local frames on this many wavelet steps (ConvertOptions::frame_steps); -1 = ConvertOptions' default.
   int frame_steps = -1;
+  /// Two squares must be named (`--patches 2`): the plain loop of a shape they stretch, which `convert`
+  /// without --patches would move to 16 patches (kStretchedTwoSquares).
+  bool two_squares_named = false;
   /// "plain", "tips", "ends" or "8 patches", then " level N" when the level is not `default_level`, then
   /// " + fit" when fitted, then " + L∞ pass" with linf_sweeps, then " + frame steps N" when not the default.
   std::string name(int default_level) const;
   /// The switches of `geomip convert` that build this candidate ("--end-loop --fit", "--patches 8 --level
-  /// 7", "--tip-loop --fit --linf-sweeps 1000").
+  /// 7", "--tip-loop --fit --linf-sweeps 1000", "--patches 2 --fit").
   std::string switches(int default_level) const;
 };
 

@@ -40,6 +40,15 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e) == 0 ? kExitOk : kExitBadInput;  // --help, --version
+    // A word where the command goes: CLI11 only says that a subcommand is required.
+    if (argc > 1 && argv[1][0] != '-' && app.get_subcommands().empty()) {
+      std::string names;
+      for (const CLI::App* c : app.get_subcommands([](CLI::App*) { return true; }))
+        names += (names.empty() ? "" : ", ") + c->get_name();
+      std::cerr << "geomip: unknown command '" << geomip::codec::one_line(argv[1]) << "' (commands: " << names
+                << "; see --help)\n";
+      return kExitBadInput;
+    }
     std::cerr << "geomip: " << geomip::codec::one_line(e.what())
               << " (see --help)\n";  // one line, as every error
     return kExitBadInput;

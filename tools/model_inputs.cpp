@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -228,6 +229,10 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       in.partition_points = chosen.partition_points;
       in.auxiliary_points = chosen.auxiliary_points;
       in.side_guides = chosen.side_guides;
+      if (tip_loop && in.side_guides.empty() && !quiet)  // say so, rather than quietly give the plain loop
+        std::fprintf(
+            stderr, "%s: %s: %s found no protrusion tips to route the loop through; the plain loop is used\n",
+            command.c_str(), spec.mesh.c_str(), loop_flag(loop));
     } else {
       in.partition_points = resolve_points(spec.partition_points, source, in.mesh, "partition_points", where);
       in.auxiliary_points = resolve_points(spec.auxiliary_points, source, in.mesh, "auxiliary_points", where);
@@ -260,7 +265,7 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
                   "Sweeps of the L-infinity pass after the stretch optimization: lowers each patch's worst "
                   "stretch (never raises it), raises the L2 stretch (default 0: off)")
       ->check(CLI::Range(0, 10000));
-  add_patches_option(cmd, args.patches, args.equal_area_layout);
+  add_patches_option(cmd, args.patches, args.patches_given, args.equal_area_layout);
   cmd->add_flag("--tip-loop", args.tip_loop,
                 "Two squares (genus 0): route the cut down each protrusion (legs, ears) to its tip and back, "
                 "splitting it lengthwise between the squares (default off: helps some shapes, hurts others; "
@@ -275,11 +280,15 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
       ->check(CLI::Range(0, 1000));
 }
 
-void add_patches_option(CLI::App* cmd, int& patches, bool& equal_area_layout) {
-  cmd->add_option("--patches", patches,
-                  "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop "
-                  "(genus 1: a 2x2 periodic grid; genus >= 2: the first K = 2g+2, 4g, 6g, ... quad layout that fits); "
-                  "K >= 3 pairs the triangles of a coarse mesh into K quads (any genus: K + 2 - 2g >= 4)");
+void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_area_layout) {
+  cmd->add_option(
+         "--patches", patches,
+         "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop "
+         "(genus 1: a 2x2 periodic grid; genus >= 2: the first K = 2g+2, 4g, 6g, ... quad layout that fits); "
+         "K >= 3 pairs the triangles of a coarse mesh into K quads (any genus: K + 2 - 2g >= 4). "
+         "convert and rd without --patches move one mesh that two squares stretch (L2 stretch >= 1.5) "
+         "to 16 patches one level coarser; --patches 2 keeps the two squares")
+      ->each([&given](const std::string&) { given = true; });
   cmd->add_flag(
       "--equal-area-layout", equal_area_layout,
       "K-quad layouts: simplify to the coarse mesh by equal area (the layouts before 2026-12-04) instead "

@@ -51,6 +51,9 @@ struct ModelArgs {
   /// 8g, 12g, … that partitions the mesh); another K = a K-quad layout (choose_quad_layout()). Only without
   /// CORR.json.
   int patches = 2;
+  /// --patches was on the command line: the user chose the layout (`convert` and `rd` move a stretched shape
+  /// to 16 patches only without it: kStretchedTwoSquares).
+  bool patches_given = false;
   /// --equal-area-layout: the K-quad layout's coarse mesh by equal area (QuadLayoutOptions::error_weight 0)
   /// instead of equal error.
   bool equal_area_layout = false;
@@ -88,7 +91,8 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
                               const std::string& command, bool quiet, int patches = 2,
                               LoopKind loop = LoopKind::kPlain, bool equal_area_layout = false);
 
-/// Registers `--patches K` and `--equal-area-layout` on `cmd` (same names and help in every command).
-void add_patches_option(CLI::App* cmd, int& patches, bool& equal_area_layout);
+/// Registers `--patches K` and `--equal-area-layout` on `cmd` (same names and help in every command);
+/// `given` is set when --patches is on the command line.
+void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_area_layout);
 
 }  // namespace geomip::tools

@@ -156,6 +156,28 @@ TEST_F(Cli, BadInputsExitTwoWithOneLine) {
   expect_bad_input("repair '" + nan + "' -o '" + dir_ + "/out.obj'", nan);
 }
 
+// Command-line mistakes: one line that says what is wrong, exit 2, before any work and with nothing written.
+TEST_F(Cli, CommandLineMistakesSayWhatIsWrong) {
+  const std::string spot = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
+  expect_bad_input("frob", "unknown command 'frob'");
+  expect_bad_input("frob", "convert");  // the list of commands
+  // Ranges say the bound, not 0.000000 to 1.79e308.
+  expect_bad_input("decode x.gip --bytes -1 -o x.obj", "--bytes: must be >= 0, got -1");
+  expect_bad_input("morph x.gip --frames 0 -o m", "--frames: must be > 0, got 0");
+  expect_bad_input("eval '" + spot + "' '" + spot + "' --error-map x.ply --error-map-scale 0",
+                   "--error-map-scale: must be > 0");
+  // An output that cannot be a directory, found before the parameterization runs.
+  const std::string a_file = file("a_file", "x");
+  for (const std::string cmd : {"param", "gimage --level 3", "remesh --level 3"}) {
+    expect_bad_input(cmd + " '" + spot + "' -o '" + a_file + "'", "exists and is not a directory");
+    expect_bad_input(cmd + " '" + spot + "' -o '" + a_file + "/sub'", "exists and is not a directory");
+  }
+  expect_bad_input("rd --quick '" + spot + "' -o '" + a_file + "'", "exists and is not a directory");
+  expect_bad_input("morph x.gip -o '" + a_file + "'", "exists and is not a directory");
+  EXPECT_EQ(slurp(a_file), "x");
+  expect_bad_input("convert '" + spot + "' -o '" + dir_ + "/no/dir/x.gip'", "does not exist");
+}
+
 TEST_F(Cli, RepairWritesAtomicallyAndNeverLeavesPartialFiles) {
   const std::string out = dir_ + "/out.obj";
   // Failing run: no output file, no temporary left behind.
@@ -169,7 +191,7 @@ TEST_F(Cli, RepairWritesAtomicallyAndNeverLeavesPartialFiles) {
   // Output into a missing directory: a clear error, nothing written.
   const Outcome bad_dir = geomip("repair '" + std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj' -o '" + dir_ +
                              "/no/such/dir/x.obj'");
-  EXPECT_NE(bad_dir.exit_code, 0);
+  EXPECT_EQ(bad_dir.exit_code, 2);  // the user's path: bad input, not a failure of the machine
   EXPECT_NE(bad_dir.err.find("does not exist"), std::string::npos) << bad_dir.err;
   // Unsupported output format is rejected before any work.
   EXPECT_EQ(geomip("repair '" + nan + "' -o '" + dir_ + "/x.stl'").exit_code, 2);
@@ -1219,30 +1241,58 @@ TEST_F(CliPack, QuadSplitShorterIsCloserAndSharedByTheSet) {
   EXPECT_FALSE(fs::exists(dir_ + "/bad.obj"));
 }
 
-// A single mesh on two squares gets its patches' L2 stretch in the JSON, and from 1.5 up (tools/
-// convert_pipeline.h, kStretchedTwoSquares: the horse and the armadillo coded better on more patches, the
-// bunny and venus did not) a note pointing at --patches and --search. The cow's legs stretch its squares
-// (about 1.74), the spot's round body does not (about 1.23); another layout has no such figure.
-TEST_F(CliPack, ConvertSuggestsMorePatchesWhenTwoSquaresStretch) {
+// A single mesh on two squares gets its patches' L2 stretch in the JSON. From 1.5 up (tools/
+// convert_pipeline.h, kStretchedTwoSquares: the horse and the armadillo coded better on 16 patches, six
+// rounder shapes did not) convert moves it to 16 patches one level coarser when the layout is left to it,
+// and with --patches 2 prints a note pointing at --patches and --search instead. The cow's legs stretch its
+// squares (about 1.74), the spot's round body does not (about 1.23); another layout has no such figure.
+TEST_F(CliPack, ConvertMovesAStretchedShapeTo16PatchesUnlessTold) {
   GEOMIP_REQUIRE_SHARED_MESH(cow, "cow.obj");
   const std::string note = "note: the two squares stretch this shape";
-  const auto stretch = [&](const std::string& mesh, const std::string& switches) {
-    const Outcome r = geomip("convert --json '" + mesh + "' --level 4 --no-normals " + switches + " -o '" +
-                             dir_ + "/s.gip'");
+  const std::string moved = "layout: the two squares stretch this shape";
+  const auto convert_json = [&](const std::string& mesh, const std::string& switches,
+                                const std::string& out) {
+    const Outcome r =
+        geomip("convert --json '" + mesh + "' --level 4 --no-normals " + switches + " -o '" + out + "'");
     EXPECT_EQ(r.exit_code, 0) << r.err;
-    return nlohmann::json::parse(r.out)["two_squares_l2_stretch"];
+    return nlohmann::json::parse(r.out);
   };
-  const nlohmann::json cow_stretch = stretch(cow, ""), spot_stretch = stretch(spot_, "");
-  EXPECT_GE(cow_stretch.get<double>(), 1.5);
-  EXPECT_GT(spot_stretch.get<double>(), 1.0);
-  EXPECT_LT(spot_stretch.get<double>(), 1.5);
-  EXPECT_TRUE(stretch(spot_, "--patches 6").is_null());
+  // The cow (L2 stretch 1.74 on two squares) moves to 16 patches one level coarser: the same pack, byte for
+  // byte, as asking for that layout.
+  const nlohmann::json cow_auto = convert_json(cow, "", dir_ + "/cow-auto.gip");
+  EXPECT_GE(cow_auto["two_squares_l2_stretch"].get<double>(), 1.5);
+  EXPECT_EQ(cow_auto["patches"], 16);
+  EXPECT_EQ(cow_auto["level"], 3);
+  EXPECT_TRUE(cow_auto["moved_to_patches"].get<bool>());
+  ASSERT_EQ(geomip("convert -q '" + cow + "' --patches 16 --level 3 --no-normals -o '" + dir_ + "/cow16.gip'")
+                .exit_code,
+            0);
+  EXPECT_EQ(slurp(dir_ + "/cow-auto.gip"), slurp(dir_ + "/cow16.gip"));
+  // --patches 2 keeps the two squares (and the note says more patches may code it better).
+  const nlohmann::json cow_two = convert_json(cow, "--patches 2", dir_ + "/cow2.gip");
+  EXPECT_EQ(cow_two["patches"], 2);
+  EXPECT_EQ(cow_two["level"], 4);
+  EXPECT_FALSE(cow_two["moved_to_patches"].get<bool>());
+  // Spot (1.23) stays on two squares.
+  const nlohmann::json spot = convert_json(spot_, "", dir_ + "/spot.gip");
+  EXPECT_GT(spot["two_squares_l2_stretch"].get<double>(), 1.0);
+  EXPECT_LT(spot["two_squares_l2_stretch"].get<double>(), 1.5);
+  EXPECT_EQ(spot["patches"], 2);
+  EXPECT_FALSE(spot["moved_to_patches"].get<bool>());
+  EXPECT_TRUE(convert_json(spot_, "--patches 6", dir_ + "/spot6.gip")["two_squares_l2_stretch"].is_null());
+  // What the report says.
   Outcome r = geomip("convert '" + cow + "' --level 4 --no-normals -o '" + dir_ + "/cow.gip'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(moved), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(note), std::string::npos) << r.out;
+  r = geomip("convert '" + cow + "' --patches 2 --level 4 --no-normals -o '" + dir_ + "/cow.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find(note), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(moved), std::string::npos) << r.out;
   r = geomip("convert '" + spot_ + "' --level 4 --no-normals -o '" + dir_ + "/spot.gip'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out.find(note), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(moved), std::string::npos) << r.out;
   r = geomip("convert --quiet '" + cow + "' --level 4 --no-normals -o '" + dir_ + "/cow.gip'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
@@ -1432,6 +1482,37 @@ TEST_F(CliPack, PrefixesWithoutALevelOfDetailExitTwoWithoutOutput) {
       << r.err;
   EXPECT_EQ(r.err.find(" of 0 bytes"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ + "/cut.obj"));
+  // A prefix asked of the whole file that ends inside the manifest names the prefix that decodes.
+  r = geomip("decode '" + pack + "' --bytes 20 -o '" + dir_ + "/short.obj'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("the first level of detail needs " + std::to_string(level_one_size)),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/short.obj"));
+}
+
+// Small conveniences: --level 1 and 2 work with the default framed steps (capped at the level), --tip-loop on
+// a shape without tips says that it fell back to the plain loop, morph of a one-model pack says it needs
+// two, rd -q prints nothing and still writes its files.
+TEST_F(CliPack, DefaultsFitLowLevelsAndFallbacksAreSaid) {
+  for (const char* level : {"1", "2"}) {
+    Outcome r = geomip("convert -q '" + spot_ + "' --level " + level + " -o '" + dir_ + "/low.gip'");
+    EXPECT_EQ(r.exit_code, 0) << level << ": " << r.err;
+  }
+  expect_bad_input("convert -q '" + spot_ + "' --level 2 --frame-steps 3 -o '" + dir_ + "/low.gip'",
+                   "--frame-steps 3");
+  Outcome r = geomip("convert '" + spot_ + "' --tip-loop --level 3 --no-normals -o '" + dir_ + "/t.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const bool tips = r.err.find("found no protrusion tips") == std::string::npos;
+  ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 3 --no-normals -o '" + dir_ + "/p.gip'").exit_code, 0);
+  // Said exactly when the pack is the plain loop's.
+  EXPECT_EQ(tips, slurp(dir_ + "/t.gip") != slurp(dir_ + "/p.gip")) << r.err;
+  expect_bad_input("morph '" + dir_ + "/p.gip' -o '" + dir_ + "/m'", "holds one model");
+  EXPECT_FALSE(fs::exists(dir_ + "/m"));
+  r = geomip("rd -q --quick '" + spot_ + "' -o '" + dir_ + "/rd'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_TRUE(fs::exists(dir_ + "/rd/rd.csv"));
 }
 
 // convert --up: the viewer's frame goes into each model's normalization only (decoded meshes keep the mesh's

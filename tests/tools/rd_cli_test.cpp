@@ -140,6 +140,24 @@ TEST_F(RdCli, LoopFlagsMeasureThatLoopsPack) {
   }
 }
 
+// Without --patches, rd measures the pack `convert` would write: the cow, which two squares stretch, on 16
+// patches one level coarser (byte for byte convert's pack), and says so; --patches 2 keeps the two squares.
+TEST_F(RdCli, StretchedShapeIsMeasuredOnConvertsLayout) {
+  GEOMIP_REQUIRE_SHARED_MESH(cow, "cow.obj");
+  std::string err;
+  ASSERT_EQ(geomip("rd --quick --level 4 '" + cow + "' -o '" + dir_ + "/rd'", err), 0) << err;
+  EXPECT_NE(slurp(fs::path(dir_) / "stdout").find("geomip pack: 16 patches at level 3"), std::string::npos);
+  ASSERT_EQ(geomip("convert -q --no-normals --level 4 '" + cow + "' -o '" + dir_ + "/c.gip'", err), 0) << err;
+  EXPECT_EQ(slurp(fs::path(dir_) / "rd" / "cow.gip"), slurp(fs::path(dir_) / "c.gip"));
+  ASSERT_EQ(geomip("rd --quick --json --level 4 --patches 2 '" + cow + "' -o '" + dir_ + "/rd2'", err), 0)
+      << err;
+  EXPECT_EQ(slurp(fs::path(dir_) / "stdout").find("geomip_moved_to_patches"), std::string::npos);
+  ASSERT_EQ(
+      geomip("convert -q --no-normals --level 4 --patches 2 '" + cow + "' -o '" + dir_ + "/c2.gip'", err), 0)
+      << err;
+  EXPECT_EQ(slurp(fs::path(dir_) / "rd2" / "cow.gip"), slurp(fs::path(dir_) / "c2.gip"));
+}
+
 TEST_F(RdCli, MissingMeshFailsCleanly) {
   const std::string out_dir = dir_ + "/rd";
   std::string err;

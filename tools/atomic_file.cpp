@@ -1,6 +1,7 @@
 #include "tools/atomic_file.h"
 
 #include "mesh/errors.h"
+#include "mesh/mesh_io.h"
 
 #include <unistd.h>
 
@@ -60,6 +61,18 @@ void make_output_directory(const std::string& dir) {
       throw InvalidInput(dir + ": " + p.string() + " exists and is not a directory");
   }
   throw IoError(dir + ": cannot create the output directory: " + ec.message());
+}
+
+void check_pack_output_name(const std::string& path) {
+  bool mesh_name = true;
+  try {
+    mesh_format_from_path(path);
+  } catch (const InvalidInput&) {
+    mesh_name = false;  // not a mesh extension: any name will do
+  }
+  if (mesh_name)
+    throw InvalidInput("-o " + path +
+                       ": this writes a .gip pack, not a mesh; name it .gip (geomip decode writes meshes)");
 }
 
 }  // namespace geomip::tools

@@ -14,6 +14,10 @@ namespace geomip::tools {
 /// \throw IoError when the directory is not writable or the disk is full.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// Checks, before any work, that a pack output is not named like a mesh (x.obj, x.glb, ...): a .gip pack
+/// under a mesh's extension would be opened as a mesh by other tools. \throw InvalidInput naming `path`.
+void check_pack_output_name(const std::string& path);
+
 /// Checks, before any work, that `dir` can be made an output directory: absent or a directory.
 /// \throw InvalidInput when it exists and is not a directory.
 void check_output_directory(const std::string& dir);

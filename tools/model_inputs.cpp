@@ -219,8 +219,12 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
     } else if (spec.partition_points.empty() && patches != 2) {
-      const QuadLayoutChoice chosen =
-          choose_quad_layout(in.mesh, automatic_layout_options(patches, equal_area_layout));
+      QuadLayoutChoice chosen;
+      try {
+        chosen = choose_quad_layout(in.mesh, automatic_layout_options(patches, equal_area_layout));
+      } catch (const InvalidInput& e) {  // name the mesh: the message is the layout's
+        throw InvalidInput(spec.mesh + ": " + e.what());
+      }
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
     } else if (spec.partition_points.empty()) {

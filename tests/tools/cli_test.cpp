@@ -176,6 +176,11 @@ TEST_F(Cli, CommandLineMistakesSayWhatIsWrong) {
   expect_bad_input("morph x.gip -o '" + a_file + "'", "exists and is not a directory");
   EXPECT_EQ(slurp(a_file), "x");
   expect_bad_input("convert '" + spot + "' -o '" + dir_ + "/no/dir/x.gip'", "does not exist");
+  // A pack named like a mesh is refused (other tools would open it as one); a layout the mesh cannot hold
+  // names the mesh.
+  expect_bad_input("convert '" + spot + "' -o '" + dir_ + "/x.obj'", "name it .gip");
+  EXPECT_FALSE(fs::exists(dir_ + "/x.obj"));
+  expect_bad_input("convert '" + spot + "' --patches 100000 -o '" + dir_ + "/x.gip'", spot);
 }
 
 TEST_F(Cli, RepairWritesAtomicallyAndNeverLeavesPartialFiles) {

@@ -449,6 +449,16 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
 
 namespace {
 
+/// A library's message cut for a one-line error: at most about 160 bytes, at the last space before that
+/// (a word is not cut in two), with "…" when something was left out.
+std::string shortened(const std::string& message) {
+  constexpr std::size_t kMax = 160;
+  if (message.size() <= kMax) return message;
+  std::size_t cut = message.rfind(' ', kMax);
+  if (cut == std::string::npos || cut < kMax / 2) cut = kMax;
+  return message.substr(0, cut) + " …";
+}
+
 /// Merges vertices at bit-identical positions into the first of them (glTF splits a vertex wherever one of
 /// its attributes changes — texture seams, hard edges — and geomip reads positions only).
 void weld_identical_positions(TriMesh& mesh) {
@@ -549,14 +559,13 @@ TriMesh read_gltf_from_memory(std::string_view original, const std::string& name
                 : gltf.LoadASCIIFromString(&model, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()),
                                            base_dir);
   } catch (const std::exception& e) {
-    throw InvalidInput(name + ": not a readable glTF file (" + std::string(e.what()).substr(0, 160) + ")");
+    throw InvalidInput(name + ": not a readable glTF file (" + shortened(e.what()) + ")");
   }
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     const std::size_t nl = err.find('\n');
-    throw InvalidInput(
-        name + ": not a readable glTF file" +
-        (err.empty() ? std::string() : " (" + err.substr(0, std::min<std::size_t>(nl, 160)) + ")"));
+    throw InvalidInput(name + ": not a readable glTF file" +
+                       (err.empty() ? std::string() : " (" + shortened(err.substr(0, nl)) + ")"));
   }
   const Reader reader(model, name);
   TriMesh out;

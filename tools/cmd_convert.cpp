@@ -281,9 +281,9 @@ int run_convert(const ConvertArgs& args) {
                      .dump(2)
               << "\n";
   } else if (report) {
-    std::printf("convert %zu model(s) → %s: %zu bytes (manifest %zu, %zu chunks), level %d%s\n", models.inputs.size(),
-                args.common.output.c_str(), pack.size(), info.manifest_end, info.chunks.size(), level,
-                args.no_normals ? ", geometry only" : ", with normal maps");
+    std::printf("convert %zu model(s) → %s: %zu bytes (header and manifest %zu, %zu chunks), level %d%s\n",
+                models.inputs.size(), args.common.output.c_str(), pack.size(), info.manifest_end,
+                info.chunks.size(), level, args.no_normals ? ", geometry only" : ", with normal maps");
     std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
                 converted.resample_seconds, converted.encode_seconds);
     if (!searching && !relayouted && converted.two_squares_l2_stretch >= kStretchedTwoSquares)

@@ -113,11 +113,13 @@ nlohmann::json pack_info(const std::string& path) {
 }
 
 void print_pack(const nlohmann::json& j) {
-  std::printf("%s: geomip pack, format %d, %llu bytes (manifest %llu), first level of detail after %llu bytes\n",
-              j["file"].get<std::string>().c_str(), j["format_version"].get<int>(),
-              static_cast<unsigned long long>(j["bytes"].get<std::uint64_t>()),
-              static_cast<unsigned long long>(j["manifest_bytes"].get<std::uint64_t>()),
-              static_cast<unsigned long long>(j["first_level_bytes"].get<std::uint64_t>()));
+  std::printf(
+      "%s: geomip pack, format %d, %llu bytes (header and manifest %llu), first level of detail after %llu "
+      "bytes\n",
+      j["file"].get<std::string>().c_str(), j["format_version"].get<int>(),
+      static_cast<unsigned long long>(j["bytes"].get<std::uint64_t>()),
+      static_cast<unsigned long long>(j["manifest_bytes"].get<std::uint64_t>()),
+      static_cast<unsigned long long>(j["first_level_bytes"].get<std::uint64_t>()));
   for (std::size_t m = 0; m < j["models"].size(); ++m) {
     const auto& mj = j["models"][m];
     const std::string up = mj["up"].get<std::string>();

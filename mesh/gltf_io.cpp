@@ -456,6 +456,8 @@ std::string shortened(const std::string& message) {
   if (message.size() <= kMax) return message;
   std::size_t cut = message.rfind(' ', kMax);
   if (cut == std::string::npos || cut < kMax / 2) cut = kMax;
+  while (cut > 0 && (static_cast<unsigned char>(message[cut]) & 0xC0) == 0x80)
+    --cut;  // not inside a character
   return message.substr(0, cut) + " …";
 }
 

@@ -12,14 +12,22 @@
 
 namespace geomip::tools {
 
-void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+void check_output_file(const std::string& path) {
   namespace fs = std::filesystem;
-  const fs::path target(path);
-  fs::path dir = target.parent_path();
+  if (path.empty()) throw InvalidInput("-o: the output path is empty");
+  fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
   std::error_code ec;
   if (!fs::is_directory(dir, ec))  // the user's path, not a failure of the machine: exit 2
     throw InvalidInput(path + ": output directory '" + dir.string() + "' does not exist");
+}
+
+void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  check_output_file(path);
+  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  std::error_code ec;
   std::string tmp_name = ".";
   tmp_name += target.filename().string();
   tmp_name += ".tmp-";
@@ -43,23 +51,25 @@ void write_file_atomically(const std::string& path, const std::function<void(std
 
 void check_output_directory(const std::string& dir) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw InvalidInput(dir + " exists and is not a directory");
+  if (dir.empty()) throw InvalidInput("-o: the output directory is empty");
+  // The directory itself or any parent that exists and is a file (x.gip, x.gip/sub) can never be made.
+  for (fs::path p(dir); !p.empty(); p = p.parent_path()) {
+    std::error_code ec;
+    if (fs::exists(p, ec) && !fs::is_directory(p, ec))
+      throw InvalidInput(p.string() == dir ? dir + " exists and is not a directory"
+                                           : dir + ": " + p.string() + " exists and is not a directory");
+    if (p == p.parent_path()) break;
+  }
 }
 
 void make_output_directory(const std::string& dir) {
   namespace fs = std::filesystem;
-  check_output_directory(dir);
+  check_output_directory(dir);  // a file in the way is the user's path
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!ec) return;
-  // A parent that is a file is the user's path; anything else (permissions, a full disk) is the machine's.
-  for (fs::path p = fs::path(dir).parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path()) {
-    std::error_code e;
-    if (fs::exists(p, e) && !fs::is_directory(p, e))
-      throw InvalidInput(dir + ": " + p.string() + " exists and is not a directory");
-  }
+  check_output_directory(
+      dir);  // it may have appeared since; anything else (permissions, a full disk) is the machine's
   throw IoError(dir + ": cannot create the output directory: " + ec.message());
 }
 

@@ -18,8 +18,13 @@ void write_file_atomically(const std::string& path, const std::function<void(std
 /// under a mesh's extension would be opened as a mesh by other tools. \throw InvalidInput naming `path`.
 void check_pack_output_name(const std::string& path);
 
-/// Checks, before any work, that `dir` can be made an output directory: absent or a directory.
-/// \throw InvalidInput when it exists and is not a directory.
+/// Checks, before any work, that `path` can be written: not empty, its directory exists.
+/// \throw InvalidInput naming the missing directory.
+void check_output_file(const std::string& path);
+
+/// Checks, before any work, that `dir` can be made an output directory: not empty, and neither it nor a
+/// parent exists as something other than a directory.
+/// \throw InvalidInput naming what is in the way.
 void check_output_directory(const std::string& dir);
 
 /// Creates the output directory `dir` and its parents (nothing when it exists).

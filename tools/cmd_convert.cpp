@@ -96,6 +96,7 @@ void check_level_options(const ConvertArgs& args, int level) {
 
 int run_convert(const ConvertArgs& args) {
   check_pack_output_name(args.common.output);
+  check_output_file(args.common.output);
   // The level: --level, else default_grid_level() of --patches (a CORR.json's layout is counted once it is
   // read).
   int level =

@@ -56,6 +56,7 @@ MeshFormat format_of(const std::string& path) {
 }
 
 int run_decode(const DecodeArgs& args) {
+  check_output_file(args.output);
   const MeshFormat format = format_of(args.output);
   const bool gltf = format == MeshFormat::kGltf || format == MeshFormat::kGlb;
   if (args.draco != 0 && !gltf)

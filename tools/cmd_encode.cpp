@@ -88,6 +88,7 @@ GeometryImages load_images(const std::string& geometry_path, bool normals, std::
 
 int run_encode(const EncodeArgs& args) {
   check_pack_output_name(args.output);
+  check_output_file(args.output);
   if (args.quantization_bits < 8 || args.quantization_bits > 24)
     throw InvalidInput("--bits " + std::to_string(args.quantization_bits) + " is outside [8, 24]");
   std::vector<codec::PackModelInput> models;

@@ -69,6 +69,7 @@ int run_eval(EvalArgs args) {
   for (const std::string* path : {&args.error_map, &args.error_map_original}) {
     if (!path->empty() && mesh_format_from_path(*path) != MeshFormat::kPly)
       throw InvalidInput(*path + ": an error map is written as PLY (.ply)");
+    if (!path->empty()) check_output_file(*path);
   }
   const TriMesh original = read_mesh(args.original);
   const TriMesh approx = read_mesh(args.approx);

@@ -225,7 +225,7 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, bool 
     PreparedModels models =
         prepare_models({mesh_path}, "", "geomip rd", true, patches, loop, equal_area_layout);
     const int coarser = stretched_shape_level(level);
-    const bool fits = normal_mesh_steps <= coarser && ConvertOptions{}.frame_steps <= coarser;
+    const bool fits = normal_mesh_steps <= coarser;  // the default framed steps are capped at the level
     bool switched = false;
     ConvertResult converted = convert_relayout_when_stretched(
         models, options, relayout && fits ? coarser : 0,

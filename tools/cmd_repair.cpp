@@ -45,6 +45,7 @@ std::string summary(const RepairResult& r) {
 }
 
 int run_repair(const RepairArgs& args) {
+  check_output_file(args.output);
   const MeshFormat out_format = mesh_format_from_path(args.output);  // fail before the work
   if (out_format == MeshFormat::kStl) {
     std::cerr << "geomip repair: " << args.output

@@ -147,19 +147,31 @@ ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOpt
                                               const std::function<void(double stretch)>& before_switch,
                                               bool& switched) {
   switched = false;
+  if (relayout_level < 1) return convert_models(models, options);
+  // The two squares' parameterization tells; the rest of their pipeline runs only when they stay.
+  ConvertOptions probe = options;
+  probe.stop_when_stretched = kStretchedTwoSquares;
+  ConvertResult first = convert_models(models, probe);
+  if (!first.stopped_stretched) return first;
+  const double stretch = first.two_squares_l2_stretch;
+  try {
+    PreparedModels moved = prepare(kStretchedShapePatches);
+    if (before_switch) before_switch(stretch);
+    ConvertOptions at_level = options;
+    at_level.level = relayout_level;
+    ConvertResult result = convert_models(moved, at_level);
+    result.two_squares_l2_stretch = stretch;
+    result.param_seconds += first.param_seconds;  // both parameterizations
+    models = std::move(moved);
+    options = at_level;
+    switched = true;
+    return result;
+  } catch (const InvalidInput&) {  // no 16-patch layout fits this mesh (too few vertices, paths that fail)
+  } catch (const SolverFailure&) {
+  }
+  // Two squares after all: their whole pipeline (the note on the stretch is the caller's).
   ConvertResult result = convert_models(models, options);
-  const double stretch = result.two_squares_l2_stretch;
-  if (relayout_level < 1 || stretch < kStretchedTwoSquares) return result;
-  if (before_switch) before_switch(stretch);
-  models = prepare(kStretchedShapePatches);
-  options.level = relayout_level;
-  const ConvertResult first = std::move(result);
-  result = convert_models(models, options);
-  result.two_squares_l2_stretch = stretch;
-  result.param_seconds += first.param_seconds;  // the time both conversions took
-  result.resample_seconds += first.resample_seconds;
-  result.encode_seconds += first.encode_seconds;
-  switched = true;
+  result.param_seconds += first.param_seconds;
   return result;
 }
 
@@ -189,6 +201,10 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   if (params.size() == 1 && params[0].patches.size() == 2)
     result.two_squares_l2_stretch =
         std::max(params[0].patches[0].stretch.l2, params[0].patches[1].stretch.l2);
+  if (options.stop_when_stretched > 0 && result.two_squares_l2_stretch >= options.stop_when_stretched) {
+    result.stopped_stretched = true;
+    return result;
+  }
 
   t0 = std::chrono::steady_clock::now();
   std::vector<codec::PackModelInput> inputs;

@@ -83,6 +83,10 @@ struct ConvertOptions {
   /// Keep the pack's inputs (geometry images, normal maps, hole masks before coding) in
   /// ConvertResult::inputs (codec_bench --normals measures the coded normal maps against them).
   bool keep_inputs = false;
+  /// > 0: when one model lands on two squares whose L2 stretch is at least this, stop after the
+  /// parameterization (ConvertResult::stopped_stretched, no pack): convert_relayout_when_stretched() moves
+  /// such a shape to more patches and needs nothing else from this pipeline.
+  double stop_when_stretched = 0;
 };
 
 struct ConvertResult {
@@ -97,6 +101,8 @@ struct ConvertResult {
   /// One model on two squares (genus 0, the default layout): the larger L2 stretch of its two patches
   /// (param/stretch.h; 1 = no stretch). 0 for any other layout or several models.
   double two_squares_l2_stretch = 0;
+  /// ConvertOptions::stop_when_stretched applied: the parameterization only, `pack` empty.
+  bool stopped_stretched = false;
 };
 
 /// From this L2 stretch of a model's two squares up, `geomip convert` and `geomip rd` move the mesh to
@@ -138,13 +144,14 @@ codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::s
 /// images come from resample_geometry()).
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options);
 
-/// convert_models(models, options); then, when `relayout_level` ≥ 1 and that converted one mesh on two
-/// squares whose L2 stretch is at least kStretchedTwoSquares: `before_switch(stretch)`, the mesh prepared
-/// again by `prepare(kStretchedShapePatches)` and converted at `relayout_level`. `models` and `options.level`
-/// then describe the second conversion, whose result is returned with the two squares' stretch kept in
-/// two_squares_l2_stretch; `switched` says which happened. The callers pass 0 (no switch) when the user
-/// chose the layout (--patches, --points, a loop) or the level-dependent options do not fit the coarser
-/// level.
+/// convert_models(models, options), except that with `relayout_level` ≥ 1 one mesh whose two squares have
+/// an L2 stretch of at least kStretchedTwoSquares is, right after that parameterization, prepared again by
+/// `prepare(kStretchedShapePatches)`, announced by `before_switch(stretch)` and converted at
+/// `relayout_level`; `models` and `options.level` then describe that conversion, whose result is returned
+/// with the two squares' stretch in two_squares_l2_stretch and both parameterizations' seconds. When no
+/// such layout fits the mesh (InvalidInput, SolverFailure) the two squares are converted after all.
+/// `switched` says which happened. The callers pass 0 (no switch) when the user chose the layout (--patches,
+/// --points, a loop) or the level-dependent options do not fit the coarser level.
 ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOptions& options,
                                               int relayout_level,
                                               const std::function<PreparedModels(int patches)>& prepare,

@@ -1304,6 +1304,56 @@ TEST_F(CliPack, ConvertMovesAStretchedShapeTo16PatchesUnlessTold) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// A long box (10 × 1 × 1) of `segments` square rings: two squares stretch it, so convert tries 16 patches.
+// With 2 segments (12 vertices) no 16-patch layout fits: the two squares are kept (exit 0, the note), as
+// before the move existed. With 20, convert and rd --level 3 both move it (to level 2) and agree byte for
+// byte.
+TEST_F(CliPack, AStretchedShapeThatCannotMoveKeepsItsTwoSquares) {
+  const auto box = [&](int segments) {
+    std::ostringstream obj;
+    for (int i = 0; i <= segments; ++i) {
+      const double x = 10.0 * i / segments;
+      obj << "v " << x << " 0 0\nv " << x << " 1 0\nv " << x << " 1 1\nv " << x << " 0 1\n";
+    }
+    for (int i = 0; i < segments; ++i) {
+      for (int k = 0; k < 4; ++k) {
+        const int a = 4 * i + k + 1, b = 4 * i + (k + 1) % 4 + 1, c = a + 4, d = b + 4;
+        obj << "f " << a << " " << d << " " << c << "\nf " << a << " " << b << " " << d << "\n";
+      }
+    }
+    const int last = 4 * segments;
+    obj << "f 1 3 2\nf 1 4 3\n";
+    obj << "f " << last + 1 << " " << last + 2 << " " << last + 3 << "\nf " << last + 1 << " " << last + 3
+        << " " << last + 4 << "\n";
+    return file("box" + std::to_string(segments) + ".obj", obj.str());
+  };
+  const std::string small = box(2);
+  Outcome r = geomip("convert --json '" + small + "' --level 4 --no-normals -o '" + dir_ + "/small.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GE(j["two_squares_l2_stretch"].get<double>(), 1.5);
+  EXPECT_EQ(j["patches"], 2);
+  EXPECT_FALSE(j["moved_to_patches"].get<bool>());
+  ASSERT_EQ(
+      geomip("convert -q '" + small + "' --patches 2 --level 4 --no-normals -o '" + dir_ + "/small2.gip'")
+          .exit_code,
+      0);
+  EXPECT_EQ(slurp(dir_ + "/small.gip"), slurp(dir_ + "/small2.gip"));
+  r = geomip("convert '" + small + "' --level 4 --no-normals -o '" + dir_ + "/small.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("note: the two squares stretch this shape"), std::string::npos) << r.out;
+
+  const std::string long_box = box(20);
+  r = geomip("convert --json '" + long_box + "' --level 3 --no-normals -o '" + dir_ + "/long.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j["moved_to_patches"].get<bool>());
+  EXPECT_EQ(j["level"], 2);
+  r = geomip("rd -q --quick --level 3 '" + long_box + "' -o '" + dir_ + "/rd'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(dir_ + "/rd/box20.gip"), slurp(dir_ + "/long.gip"));
+}
+
 // --patches K: a K-quad layout through remesh, convert and decode (the codec and the decoder take any patch
 // count): watertight, genus 0, K·2·4^L faces, V = K·4^L + 2; convert's level without --level; bad K exit 2
 // with one line and nothing written.

@@ -198,6 +198,7 @@ int run_convert(const ConvertArgs& args) {
         relayout_level = 0;
       }
     }
+    bool announced = false;
     converted = convert_relayout_when_stretched(
         models, options, relayout_level,
         [&](int patches) {
@@ -206,6 +207,7 @@ int run_convert(const ConvertArgs& args) {
         },
         [&](double stretch) {
           bar.finish();
+          announced = true;
           if (report)
             std::printf(
                 "layout: the two squares stretch this shape (L2 stretch %.2f; 1 is none): converting it "
@@ -214,6 +216,10 @@ int run_convert(const ConvertArgs& args) {
                 stretch, kStretchedShapePatches, relayout_level);
         },
         relayouted);
+    // The announced layout failed after its announcement (its parameterization): say what was written.
+    if (announced && !relayouted && report)
+      std::printf("layout: no %d-patch layout fits this mesh; keeping the two squares\n",
+                  kStretchedShapePatches);
     level = options.level;
   }
   // --choose-loop's report: the mean PSNR of each loop (NaN: not built, e.g. a mesh without tips).

@@ -38,12 +38,14 @@ struct PatchWork {
   ProgressiveMesh pm;
   std::vector<Eigen::Vector2d> uv;  // per local vertex (base vertices valid after the base embedding)
   std::vector<double> weights;      // per local vertex: sampling weights (empty: uniform)
+  std::vector<Eigen::Matrix3d> metrics;  // per local vertex: metric tensors (empty: Euclidean)
 };
 
 struct ModelWork {
   PartitionResult partition;
   std::vector<PatchWork> patches;
   std::vector<int> feature_patch;  // patch of each feature
+  std::vector<Eigen::Matrix3d> metrics;  // per partition-mesh vertex (empty: Euclidean)
 };
 
 void report(const ParameterizationOptions& o, const char* stage, double f) {
@@ -175,7 +177,7 @@ void store_base(const BaseMesh& b, PatchWork& w) {
 // e.g. L2 stretch 96 instead of 1.3 on one of fandisk's patches).
 void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine& c2f,
                     const std::vector<char>& locked, const ParameterizationOptions& options, unsigned seed,
-                    const std::vector<double>* weights) {
+                    const std::vector<double>* weights, const std::vector<Eigen::Matrix3d>* metrics) {
   std::vector<std::array<int, 3>> triangles;
   std::vector<char> present(positions.size(), 0);
   for (const auto& t : c2f.current_triangles()) {
@@ -191,6 +193,7 @@ void optimize_level(const std::vector<Eigen::Vector3d>& positions, CoarseToFine&
   level_options.max_sweeps = options.level_sweeps;
   level_options.seed = options.seed + seed;
   level_options.vertex.vertex_weights = weights;
+  level_options.vertex.vertex_metrics = metrics;
   optimize_stretch(positions, triangles, uv, locked, level_options);
   for (std::size_t v = 0; v < uv.size(); ++v) {
     if (present[v]) c2f.uv()[v] = uv[v];
@@ -268,6 +271,7 @@ std::size_t reconcile_seams(ModelParameterization& m) {
 // global stretch sweeps over every patch with its boundary and features locked. Both copies of a seam vertex
 // get the same parameter, so the seams still agree (reconcile_seams() makes them bit-identical).
 void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>>& weights,
+                 const std::vector<std::vector<Eigen::Matrix3d>>& metrics,
                  const ParameterizationOptions& options) {
   const std::size_t np = m.patches.size();
   const PatchIndex index = index_patches(m);
@@ -358,6 +362,7 @@ void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>
       o.max_sweeps = options.seam_slide_sweeps;
       o.seed = options.seed + 977u * static_cast<unsigned>(round + 1) + 13u * static_cast<unsigned>(p);
       o.vertex.vertex_weights = weights[p].empty() ? nullptr : &weights[p];
+      o.vertex.vertex_metrics = metrics[p].empty() ? nullptr : &metrics[p];
       optimize_stretch(positions[p], patch.triangles, patch.uv, locked, o);
     });
   }
@@ -467,6 +472,12 @@ PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size
     for (int v : base.to_patch) base_weights.push_back(pw.weights[v]);
     base_options.vertex.vertex_weights = &base_weights;
   }
+  std::vector<Eigen::Matrix3d> base_metrics;
+  if (!w.metrics.empty()) {
+    for (int v : pw.to_mesh) pw.metrics.push_back(w.metrics[v]);
+    for (int v : base.to_patch) base_metrics.push_back(pw.metrics[v]);
+    base_options.vertex.vertex_metrics = &base_metrics;
+  }
   optimize_stretch(base.positions, base.triangles, base.uv, locked, base_options);
   store_base(base, pw);
   seconds.base_embedding += seconds_since(t0);
@@ -510,6 +521,10 @@ ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::s
   // Features: interior vertices of a patch, in the same patch in every model.
   const std::vector<int> vertex_feature = feature_of_vertex(in, w.partition.mesh.positions.size());
   w.feature_patch.assign(in.features.size(), -1);
+  if (options.curvature_metric > 0) {
+    w.metrics = curvature_metric_tensors(w.partition.mesh.positions, w.partition.mesh.triangles,
+                                         options.curvature_metric);
+  }
   // The patches in parallel; each writes only its own slots (and feature_patch of its own features).
   const std::size_t num_patches = w.partition.patches.size();
   w.patches.resize(num_patches);
@@ -617,6 +632,8 @@ CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<
   const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
   VertexOptimizationOptions local_options = options.local_optimization;
   local_options.vertex_weights = weights;
+  const std::vector<Eigen::Matrix3d>* metrics = pw.metrics.empty() ? nullptr : &pw.metrics;
+  local_options.vertex_metrics = metrics;
   const VertexOptimizer optimize = [&](int v, const std::vector<int>& ring) {
     if (locked[v]) return;
     for (int round = 0; round < options.local_rounds; ++round) {
@@ -632,8 +649,8 @@ CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<
       progress(p, static_cast<double>(c2f.splits_done()) / static_cast<double>(c2f.num_splits()));
     }
     if (options.level_sweeps > 0 && level_vertices >= next_level * options.level_growth && !c2f.finished()) {
-      optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices),
-                     weights);
+      optimize_level(pw.local.positions, c2f, locked, options, static_cast<unsigned>(level_vertices), weights,
+                     metrics);
       next_level = level_vertices;
     }
   }
@@ -678,6 +695,7 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
   std::vector<char> locked = boundary_mask(pw);
   for (int v : pw.features) locked[v] = 1;
   const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
+  const std::vector<Eigen::Matrix3d>* metrics = pw.metrics.empty() ? nullptr : &pw.metrics;
 
   auto t0 = Clock::now();
   CoarseToFineResult r = refine_patch(pw, p, locked, options, progress);
@@ -689,6 +707,7 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
     final_options.max_sweeps = options.final_sweeps;
     final_options.seed = options.seed + 101u * static_cast<unsigned>(p + 1);
     final_options.vertex.vertex_weights = weights;
+    final_options.vertex.vertex_metrics = metrics;
     optimize_stretch(pw.local.positions, r.triangles, r.uv, locked, final_options);
   }
   seconds.final_optimization += seconds_since(t0);
@@ -723,6 +742,7 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
       StretchOptimizationOptions fallback = options.base_optimization;
       fallback.seed = options.seed + 31u * static_cast<unsigned>(p + 1);
       fallback.vertex.vertex_weights = weights;
+      fallback.vertex.vertex_metrics = metrics;
       optimize_stretch(pw.local.positions, pw.local.triangles, mvc.uv, locked, fallback);
       const StretchValues s = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
       if (s.l2 < pp.stretch.l2 && count_flipped(pw.local.triangles, mvc.uv) == 0) {
@@ -763,6 +783,8 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
   if (!(options.linf_floor >= 0) || !std::isfinite(options.linf_floor) || !(options.linf_relative_floor >= 0) ||
       !(options.linf_relative_floor <= 1))
     throw InvalidInput("parameterize_consistently: linf_floor must be finite and >= 0, linf_relative_floor in [0, 1]");
+  if (!(options.curvature_metric >= 0) || !std::isfinite(options.curvature_metric))
+    throw InvalidInput("parameterize_consistently: curvature_metric must be finite and >= 0");
   check_feature_counts(models);
   const std::size_t num_features = models[0].features.size();
   const double n = static_cast<double>(models.size());
@@ -807,8 +829,10 @@ std::vector<ModelParameterization> parameterize_consistently(const std::vector<P
     if (options.seam_slide_rounds > 0) {
       const auto t0 = Clock::now();
       std::vector<std::vector<double>> weights(num_patches);
+      std::vector<std::vector<Eigen::Matrix3d>> metrics(num_patches);
       for (std::size_t p = 0; p < num_patches; ++p) weights[p] = w.patches[p].weights;
-      slide_seams(o, weights, options);
+      for (std::size_t p = 0; p < num_patches; ++p) metrics[p] = w.patches[p].metrics;
+      slide_seams(o, weights, metrics, options);
       o.seconds.final_optimization += seconds_since(t0);
     }
     o.seam_mismatches = reconcile_seams(o);

@@ -107,6 +107,13 @@ struct ParameterizationOptions {
   /// Sander 2001's uniform geometric stretch.
   bool curvature_sampling = true;
   SamplingWeightOptions sampling_weights;
+  /// Anisotropic, curvature-adapted stretch: λ of curvature_metric_tensors(), computed once per model on the
+  /// partitioned mesh (so both patches of a seam see the same tensors), measures every stretch
+  /// optimization's triangles in M = I + λ·D·|S| (VertexOptimizationOptions::vertex_metrics): a direction
+  /// in which the surface bends gets more parameter length, hence more samples, than one along which it
+  /// is straight (around a leg rather than along it). 0 = the Euclidean metric (Sander 2001). The figures
+  /// a parameterization reports (PatchParameterization::stretch) stay Euclidean.
+  double curvature_metric = 0;
   /// Seed of the random search directions (results are deterministic for a given seed).
   unsigned seed = 1;
   /// Threads over the patches of a model (progressive meshes and base embeddings, then coarse-to-fine, final

@@ -3,6 +3,8 @@
 #include "mesh/errors.h"
 #include "param/stretch_optimization.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -108,6 +110,76 @@ std::vector<double> curvature_sampling_weights(const std::vector<Eigen::Vector3d
     for (std::size_t v = 0; v < nv; ++v)
       if (referenced[v]) weights[v] *= total / weighted;
   return weights;
+}
+
+std::vector<Eigen::Matrix3d> curvature_metric_tensors(const std::vector<Eigen::Vector3d>& positions,
+                                                      const std::vector<std::array<int, 3>>& triangles,
+                                                      double lambda, double max_curvature) {
+  const std::size_t nv = positions.size();
+  std::vector<Eigen::Matrix3d> out(nv, Eigen::Matrix3d::Identity());
+  if (nv == 0 || triangles.empty()) return out;
+  std::vector<Eigen::Vector3d> normal(nv, Eigen::Vector3d::Zero());
+  for (const auto& t : triangles) {
+    const Eigen::Vector3d n = (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]);
+    for (int i : t) normal[i] += n;
+  }
+  for (auto& n : normal)
+    if (n.norm() > 0) n.normalize();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
+  for (const auto& t : triangles)
+    for (int i : t) lo = lo.cwiseMin(positions[i]), hi = hi.cwiseMax(positions[i]);
+  const double diagonal = (hi - lo).norm();
+  std::vector<Eigen::Matrix3d> face_k(triangles.size(), Eigen::Matrix3d::Zero());
+  std::vector<double> face_area(triangles.size(), 0);
+  std::vector<Eigen::Matrix3d> vk(nv, Eigen::Matrix3d::Zero());
+  std::vector<double> va(nv, 0);
+  for (std::size_t f = 0; f < triangles.size(); ++f) {
+    const auto& t = triangles[f];
+    const Eigen::Vector3d e2 = positions[t[1]] - positions[t[0]];
+    Eigen::Vector3d nf = e2.cross(positions[t[2]] - positions[t[0]]);
+    const double a = 0.5 * nf.norm();
+    if (!(a > 0) || !(e2.norm() > 0)) continue;
+    nf.normalize();
+    const Eigen::Vector3d t1 = e2.normalized(), t2 = nf.cross(t1);
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      const int p = t[(i + 1) % 3], q = t[(i + 2) % 3];
+      const Eigen::Vector3d e = positions[q] - positions[p], dn = normal[q] - normal[p];
+      const double u1 = e.dot(t1), u2 = e.dot(t2), w1 = dn.dot(t1), w2 = dn.dot(t2);
+      // a·u1 + b·u2 = w1, b·u1 + c·u2 = w2 for S = [[a, b], [b, c]]
+      const Eigen::Vector3d r1(u1, u2, 0), r2(0, u1, u2);
+      ata += r1 * r1.transpose() + r2 * r2.transpose();
+      atb += r1 * w1 + r2 * w2;
+    }
+    const Eigen::Vector3d abc = ata.ldlt().solve(atb);
+    if (!abc.allFinite()) continue;
+    Eigen::Matrix2d s;
+    s << abc[0], abc[1], abc[1], abc[2];
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(s);
+    Eigen::Vector2d ev = es.eigenvalues().cwiseAbs();
+    for (int i = 0; i < 2; ++i) ev[i] = lambda * diagonal * std::min(ev[i], max_curvature / diagonal);
+    const Eigen::Matrix2d abs_s = es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+    Eigen::Matrix<double, 3, 2> frame;
+    frame.col(0) = t1, frame.col(1) = t2;
+    face_k[f] = frame * abs_s * frame.transpose();
+    face_area[f] = a;
+    for (int i : t) vk[i] += a * face_k[f], va[i] += a;
+  }
+  for (std::size_t v = 0; v < nv; ++v)
+    if (va[v] > 0) vk[v] /= va[v];
+  // one smoothing pass: faces take their corners' mean, vertices the area-weighted mean of their faces
+  std::vector<Eigen::Matrix3d> sk(nv, Eigen::Matrix3d::Zero());
+  std::vector<double> sa(nv, 0);
+  for (std::size_t f = 0; f < triangles.size(); ++f) {
+    if (!(face_area[f] > 0)) continue;
+    const auto& t = triangles[f];
+    const Eigen::Matrix3d k = (vk[t[0]] + vk[t[1]] + vk[t[2]]) / 3.0;
+    for (int i : t) sk[i] += face_area[f] * k, sa[i] += face_area[f];
+  }
+  for (std::size_t v = 0; v < nv; ++v)
+    if (sa[v] > 0) out[v] = Eigen::Matrix3d::Identity() + sk[v] / sa[v];
+  return out;
 }
 
 }  // namespace geomip

@@ -36,4 +36,14 @@ std::vector<double> curvature_sampling_weights(const std::vector<Eigen::Vector3d
                                                const std::vector<std::array<int, 3>>& triangles,
                                                const SamplingWeightOptions& options = {});
 
+/// Per-vertex metric tensors for an anisotropic, curvature-adapted stretch (VertexOptimizationOptions::
+/// vertex_metrics): M = I + λ·D·|S|, S the shape operator (per face from the vertex normals' differences
+/// along its edges, least squares; |S| its eigenvalues made positive; area-weighted to the vertices and
+/// averaged over one ring once), D the bounding-box diagonal, κ·D clamped at `max_curvature`. Linear
+/// interpolation error along a direction of curvature κ grows as κ·h², so uniform samples in the metric |S|
+/// spread the error evenly; λ blends it with the Euclidean metric.
+std::vector<Eigen::Matrix3d> curvature_metric_tensors(const std::vector<Eigen::Vector3d>& positions,
+                                                      const std::vector<std::array<int, 3>>& triangles,
+                                                      double lambda, double max_curvature = 200);
+
 }  // namespace geomip

@@ -35,6 +35,21 @@ TriangleMetric triangle_metric(const Eigen::Vector3d& q0, const Eigen::Vector3d&
           0.5 * (q1 - q0).cross(q2 - q0).norm()};
 }
 
+/// The same in the metric M (lengths eᵀMe, area from the Gram matrix of two edges in M).
+TriangleMetric triangle_metric(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
+                               const Eigen::Vector3d& q2, const Eigen::Matrix3d& m) {
+  const Eigen::Vector3d e0 = q2 - q1, e1 = q2 - q0, e2 = q1 - q0;
+  const double g11 = e2.dot(m * e2), g22 = e1.dot(m * e1), g12 = e2.dot(m * e1);
+  return {{e0.dot(m * e0), g22, g11}, 0.5 * std::sqrt(std::max(0.0, g11 * g22 - g12 * g12))};
+}
+
+TriangleMetric triangle_metric(const std::vector<Eigen::Vector3d>& positions,
+                               const std::vector<Eigen::Matrix3d>* metrics, int a, int b, int c) {
+  if (!metrics) return triangle_metric(positions[a], positions[b], positions[c]);
+  const Eigen::Matrix3d m = ((*metrics)[a] + (*metrics)[b] + (*metrics)[c]) / 3.0;
+  return triangle_metric(positions[a], positions[b], positions[c], m);
+}
+
 /// One ring triangle seen from the moving vertex v: v is corner 0, corners 1 and 2 follow counter-clockwise.
 struct RingTriangle {
   Eigen::Vector2d p1, p2;
@@ -229,8 +244,9 @@ void check_vertex_options(const char* function, const VertexOptimizationOptions&
 
 /// Ring of v in RingTriangle form, from raw positions (optimize_vertex, local_stretch), into `out`.
 void build_ring(const char* function, int v, const std::vector<int>& ring,
-                const std::vector<Eigen::Vector3d>& positions, const std::vector<std::array<int, 3>>& triangles,
-                const std::vector<Eigen::Vector2d>& uv, const std::vector<double>* vertex_weights,
+                const std::vector<Eigen::Vector3d>& positions,
+                const std::vector<std::array<int, 3>>& triangles, const std::vector<Eigen::Vector2d>& uv,
+                const std::vector<double>* vertex_weights, const std::vector<Eigen::Matrix3d>* vertex_metrics,
                 std::vector<RingTriangle>& out) {
   const auto fail = [function](const std::string& what) {
     throw InvalidInput(std::string(function) + ": " + what);
@@ -239,6 +255,7 @@ void build_ring(const char* function, int v, const std::vector<int>& ring,
     fail(std::to_string(vertex_weights->size()) + " vertex weights for " + std::to_string(positions.size()) +
          " vertices");
   }
+  if (vertex_metrics && vertex_metrics->size() != positions.size()) fail("vertex metrics mismatch");
   if (uv.size() != positions.size()) {
     fail(std::to_string(uv.size()) + " uv coordinates for " + std::to_string(positions.size()) + " vertices");
   }
@@ -256,7 +273,7 @@ void build_ring(const char* function, int v, const std::vector<int>& ring,
     if (corner < 0)
       fail("ring triangle " + std::to_string(f) + " does not contain vertex " + std::to_string(v));
     const int a = t[(corner + 1) % 3], b = t[(corner + 2) % 3];
-    const TriangleMetric m = triangle_metric(positions[v], positions[a], positions[b]);
+    const TriangleMetric m = triangle_metric(positions, vertex_metrics, v, a, b);
     const double weight =
         vertex_weights ? ((*vertex_weights)[v] + (*vertex_weights)[a] + (*vertex_weights)[b]) / 3 : 1.0;
     out.push_back({uv[a], uv[b], m.opposite_sq[0], m.opposite_sq[1], m.opposite_sq[2], m.area3, weight});
@@ -282,7 +299,8 @@ double optimize_vertex(int v, const std::vector<int>& ring, const std::vector<Ei
   check_vertex_options("optimize_vertex", options);
   RingScratch& scratch = ring_scratch();
   const std::vector<RingTriangle>& r = scratch.ring;
-  build_ring("optimize_vertex", v, ring, positions, triangles, uv, options.vertex_weights, scratch.ring);
+  build_ring("optimize_vertex", v, ring, positions, triangles, uv, options.vertex_weights,
+             options.vertex_metrics, scratch.ring);
   if (!uv[v].allFinite())
     throw InvalidInput("optimize_vertex: uv of vertex " + std::to_string(v) + " not finite");
   if (scratch.terms.size() < r.size()) scratch.terms.resize(r.size());
@@ -297,7 +315,8 @@ double local_stretch(int v, const std::vector<int>& ring, const std::vector<Eige
                      const VertexOptimizationOptions& options) {
   check_vertex_options("local_stretch", options);
   std::vector<RingTriangle>& r = ring_scratch().ring;
-  build_ring("local_stretch", v, ring, positions, triangles, uv, options.vertex_weights, r);
+  build_ring("local_stretch", v, ring, positions, triangles, uv, options.vertex_weights,
+             options.vertex_metrics, r);
   return std::sqrt(
       ring_energy(uv[v], r.data(), r.size(), ring_weights(r.data(), r.size(), blend_weight(options))));
 }
@@ -358,7 +377,9 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
   std::vector<double> face_weight(triangles.size(), 1.0);
   for (std::size_t f = 0; f < triangles.size(); ++f) {
     const auto& t = triangles[f];
-    metrics[f] = triangle_metric(positions[t[0]], positions[t[1]], positions[t[2]]);
+    if (options.vertex.vertex_metrics && options.vertex.vertex_metrics->size() != nv)
+      throw InvalidInput("optimize_stretch: vertex metrics mismatch");
+    metrics[f] = triangle_metric(positions, options.vertex.vertex_metrics, t[0], t[1], t[2]);
     if (vertex_weights)
       face_weight[f] = ((*vertex_weights)[t[0]] + (*vertex_weights)[t[1]] + (*vertex_weights)[t[2]]) / 3;
   }

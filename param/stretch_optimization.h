@@ -63,6 +63,12 @@ struct VertexOptimizationOptions {
   /// Sander et al. 2002; see curvature_sampling_weights()). Null = every weight 1 (Sander 2001). The L∞
   /// term is not weighted.
   const std::vector<double>* vertex_weights = nullptr;
+  /// Optional metric tensors, one per vertex (indexed like `positions`; not owned): symmetric positive
+  /// definite 3×3 matrices M. A triangle's 3D edge lengths and area are measured in the mean of its corners'
+  /// M (|e|² = eᵀMe), so the optimizer sees each triangle as it is in that metric: with M = I + λ·D·|S|
+  /// (curvature_metric_tensors()) a curved direction is longer and gets more parameter length than a flat
+  /// one (anisotropic sampling). Null = the Euclidean metric.
+  const std::vector<Eigen::Matrix3d>* vertex_metrics = nullptr;
 };
 
 /// Moves `uv[v]` to lower the local stretch objective E(v) (see the top of this file) of its incident

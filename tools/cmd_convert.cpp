@@ -153,6 +153,7 @@ int run_convert(const ConvertArgs& args) {
   options.quantization_bits = args.quantization_bits;
   options.hole_mask_level = args.hole_mask_level;
   options.sampling_exponent = args.common.sampling_exponent;
+  options.curvature_metric = args.common.curvature_metric;
   options.linf_sweeps = static_cast<std::size_t>(args.common.linf_sweeps);
   options.seam_slide_rounds = slide_rounds(loop_asked);
   options.normal_mesh_steps = args.normal_mesh_steps;
@@ -331,6 +332,7 @@ CommandRunner add_convert_command(CLI::App& app) {
       "Mesh(es) → progressive .gip pack: repair when needed, consistent parameterization, geometry images "
       "(and normal maps) at level N, wavelet coding. Holes of a repaired mesh are kept as holes (a mask).");
   args->common.sampling_exponent = ConvertOptions{}.sampling_exponent;  // streaming: best at low rates
+  args->common.curvature_metric = ConvertOptions{}.curvature_metric;
   add_model_options(cmd, args->common);
   cmd->get_option("--output")->description("Output pack file (.gip)");
   CLI::Option* level = cmd->add_option(

@@ -192,6 +192,7 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
   param.measure_mvc_baseline = false;
   param.curvature_sampling = options.sampling_exponent > 0;
   param.sampling_weights.exponent = options.sampling_exponent;
+  param.curvature_metric = options.curvature_metric;
   param.linf_sweeps = options.linf_sweeps;
   param.seam_slide_rounds = options.seam_slide_rounds;
   param.progress = [&](const char* stage, double fraction) { progress(stage, 0.8 * fraction); };

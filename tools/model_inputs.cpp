@@ -265,6 +265,13 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
                   "Curvature sampling exponent g: stretch weights ((eps + |II|^2)/eps)^g give bent regions more "
                   "samples; 0 = plain geometric stretch (default: 1/3 for param, gimage, remesh; 0 for convert)")
       ->check(CLI::Range(0.0, 2.0));
+  cmd->add_option(
+         "--curvature-metric", args.curvature_metric,
+         "Anisotropic stretch: measure triangles in the metric I + L*D*|S| (S the shape operator, D the "
+         "bounding-box diagonal), so directions in which the surface bends get more samples than "
+         "straight ones (around a leg, not along it); 0 = Euclidean (default: 0.03 for convert and rd, "
+         "0 for param, gimage, remesh)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--linf-sweeps", args.linf_sweeps,
                   "Sweeps of the L-infinity pass after the stretch optimization: lowers each patch's worst "
                   "stretch (never raises it), raises the L2 stretch (default 0: off)")
@@ -302,6 +309,7 @@ void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_ar
 void apply_sampling(const ModelArgs& args, ParameterizationOptions& options) {
   options.curvature_sampling = args.sampling_exponent > 0;
   options.sampling_weights.exponent = args.sampling_exponent;
+  options.curvature_metric = args.curvature_metric;
   options.linf_sweeps = static_cast<std::size_t>(args.linf_sweeps);
   options.seam_slide_rounds = args.slide_seams >= 0 ? args.slide_seams : default_seam_slide_rounds(loop_kind(args));
 }

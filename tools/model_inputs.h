@@ -44,6 +44,8 @@ struct ModelArgs {
   bool quiet = false;
   /// Curvature sampling exponent γ (SamplingWeightOptions::exponent); 0 = uniform geometric stretch.
   double sampling_exponent = SamplingWeightOptions{}.exponent;
+  /// λ of the anisotropic curvature metric (ParameterizationOptions::curvature_metric); 0 = Euclidean.
+  double curvature_metric = 0;
   /// --linf-sweeps N: ParameterizationOptions::linf_sweeps (0 = no L∞ pass).
   int linf_sweeps = 0;
   /// --patches K: patches of the automatic layout. 2 = the two-square partition (choose_partition_points();

@@ -367,6 +367,31 @@ TEST(ConsistentParameterization, LinfPassNeverRaisesLinfNorFolds) {
   }
 }
 
+// The anisotropic curvature metric (ParameterizationOptions::curvature_metric) changes where the samples go,
+// not what a parameterization guarantees: valid squares, seams that agree, no flips; a negative or NaN λ is
+// refused.
+TEST(ConsistentParameterization, CurvatureMetricKeepsValidSquares) {
+  const TriMesh spiked = test::spiked_ellipsoid(4, 0.3);
+  ParameterizationOptions options;
+  options.measure_mvc_baseline = false;
+  const auto plain = parameterize_consistently({test::automatic_input(spiked, "spiked")}, options);
+  options.curvature_metric = 0.05;
+  const auto metric = parameterize_consistently({test::automatic_input(spiked, "spiked")}, options);
+  ASSERT_EQ(metric.size(), 1u);
+  expect_valid(metric[0], "spiked, curvature metric");
+  double moved = 0;
+  for (std::size_t p = 0; p < metric[0].patches.size(); ++p) {
+    ASSERT_EQ(metric[0].patches[p].uv.size(), plain[0].patches[p].uv.size());
+    for (std::size_t v = 0; v < metric[0].patches[p].uv.size(); ++v)
+      moved = std::max(moved, (metric[0].patches[p].uv[v] - plain[0].patches[p].uv[v]).norm());
+  }
+  EXPECT_GT(moved, 1e-3) << "the metric moves samples";
+  options.curvature_metric = -0.1;
+  EXPECT_THROW(parameterize_consistently({test::automatic_input(spiked, "spiked")}, options), InvalidInput);
+  options.curvature_metric = std::nan("");
+  EXPECT_THROW(parameterize_consistently({test::automatic_input(spiked, "spiked")}, options), InvalidInput);
+}
+
 TEST(ConsistentParameterization, RejectsLinfFloorsOutOfRange) {
   ParameterizationOptions options;
   options.linf_floor = -1;

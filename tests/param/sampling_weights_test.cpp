@@ -116,5 +116,86 @@ TEST(WeightedStretch, WeightedTrianglesGetMoreParameterAreaAndNothingFlips) {
   EXPECT_THROW(optimize_stretch(m.positions, m.triangles, weighted, locked, options), InvalidInput);
 }
 
+// The anisotropic metric M = I + λ·D·|S|: Euclidean on a plane, λ·D/r more along both tangent directions
+// of a sphere of radius r, and on a cylinder only around it (its generators are straight); λ = 0 is the
+// identity everywhere, and the normal direction never changes.
+TEST(CurvatureMetric, FlatIsEuclideanSphereIsotropicCylinderOnlyAround) {
+  const TriMesh flat = test::grid(12);
+  for (const auto& m : curvature_metric_tensors(flat.positions, flat.triangles, 0.1))
+    EXPECT_LT((m - Eigen::Matrix3d::Identity()).norm(), 1e-9);
+  const double lambda = 0.05;
+  const TriMesh sphere = test::sphere(4);  // unit sphere: D = 2√3, |S| = I on the tangent plane
+  const double d_sphere = 2 * std::sqrt(3.0);
+  // the discrete estimate (vertex normals' differences along edges) is within 20 % everywhere, 10 % on most
+  const auto ms = curvature_metric_tensors(sphere.positions, sphere.triangles, lambda);
+  std::size_t within_10 = 0;
+  for (std::size_t v = 0; v < sphere.positions.size(); ++v) {
+    const Eigen::Vector3d n = sphere.positions[v].normalized();
+    const Eigen::Vector3d t = n.unitOrthogonal(), b = n.cross(t);
+    EXPECT_NEAR(n.dot(ms[v] * n), 1.0, 0.02 * lambda * d_sphere);
+    for (const Eigen::Vector3d& dir : {t, b}) {
+      const double excess = (dir.dot(ms[v] * dir) - 1) / (lambda * d_sphere);  // the estimated curvature
+      EXPECT_NEAR(excess, 1.0, 0.2) << "vertex " << v;
+      within_10 += std::abs(excess - 1) < 0.1;
+    }
+  }
+  EXPECT_GT(within_10, 2 * sphere.positions.size() * 9 / 10);
+  const TriMesh cyl = test::open_cylinder(48, 24);  // radius 1, height 2: D = √12
+  const auto mc = curvature_metric_tensors(cyl.positions, cyl.triangles, lambda);
+  const double d_cyl = std::sqrt(12.0);
+  for (std::size_t v = 0; v < cyl.positions.size(); ++v) {
+    const Eigen::Vector3d& p = cyl.positions[v];
+    if (p.z() < 0.2 || p.z() > 1.8) continue;  // away from the boundary loops
+    const Eigen::Vector3d around(-p.y(), p.x(), 0), along(0, 0, 1);
+    EXPECT_NEAR(along.dot(mc[v] * along), 1.0, 0.02 * lambda * d_cyl) << "vertex " << v;
+    EXPECT_NEAR(around.dot(mc[v] * around), 1 + lambda * d_cyl, 0.1 * lambda * d_cyl) << "vertex " << v;
+  }
+  for (const auto& m : curvature_metric_tensors(cyl.positions, cyl.triangles, 0.0))
+    EXPECT_EQ(m, Eigen::Matrix3d::Identity());
+}
+
+// The metric drives the optimizer: identity tensors leave the Euclidean result (to rounding), and a half of a
+// flat grid that the metric makes twice as long along x gets more of the square along u, not along v;
+// nothing flips and locked vertices stay.
+TEST(CurvatureMetric, TheOptimizerGivesALongerDirectionMoreParameterLength) {
+  const TriMesh m = test::grid(16);
+  std::vector<Eigen::Vector2d> uv;
+  std::vector<char> locked;
+  std::vector<Eigen::Matrix3d> identity(m.positions.size(), Eigen::Matrix3d::Identity()), metric;
+  for (const auto& p : m.positions) {
+    uv.emplace_back(p.x() + 0.02 * std::sin(9 * p.y()) * p.x() * (1 - p.x()), p.y());  // off the optimum
+    locked.push_back(p.x() == 0 || p.x() == 1 || p.y() == 0 || p.y() == 1);
+    Eigen::Matrix3d t = Eigen::Matrix3d::Identity();
+    if (p.x() < 0.5) t(0, 0) = 4;  // |e|² = 4·dx² + dy²: the left half twice as long along x
+    metric.push_back(t);
+  }
+  StretchOptimizationOptions options;
+  options.max_sweeps = 100;
+  options.threshold = 1e-6;
+  std::vector<Eigen::Vector2d> plain = uv, with_identity = uv, with_metric = uv;
+  optimize_stretch(m.positions, m.triangles, plain, locked, options);
+  options.vertex.vertex_metrics = &identity;
+  optimize_stretch(m.positions, m.triangles, with_identity, locked, options);
+  double worst = 0;
+  for (std::size_t v = 0; v < uv.size(); ++v) worst = std::max(worst, (plain[v] - with_identity[v]).norm());
+  EXPECT_LT(worst, 1e-4) << "identity tensors: the Euclidean optimum";
+  options.vertex.vertex_metrics = &metric;
+  optimize_stretch(m.positions, m.triangles, with_metric, locked, options);
+  EXPECT_EQ(count_flipped(m.triangles, with_metric), 0u);
+  double u_mid = 0, v_shift = 0;
+  int n_mid = 0;
+  for (std::size_t v = 0; v < uv.size(); ++v) {
+    if (locked[v]) EXPECT_EQ(with_metric[v], uv[v]);
+    if (std::abs(m.positions[v].x() - 0.5) < 1e-9 && !locked[v]) u_mid += with_metric[v].x(), ++n_mid;
+    v_shift = std::max(v_shift, std::abs(with_metric[v].y() - m.positions[v].y()));
+  }
+  ASSERT_GT(n_mid, 0);
+  EXPECT_GT(u_mid / n_mid, 0.58) << "the longer half takes more than half of u";
+  EXPECT_LT(v_shift, 0.05) << "and v stays as it was";
+  std::vector<Eigen::Matrix3d> short_metrics(3, Eigen::Matrix3d::Identity());
+  options.vertex.vertex_metrics = &short_metrics;
+  EXPECT_THROW(optimize_stretch(m.positions, m.triangles, with_metric, locked, options), InvalidInput);
+}
+
 }  // namespace
 }  // namespace geomip

@@ -1146,17 +1146,20 @@ TEST_F(CliPack, NormalMeshRefusedForSeveralMeshes) {
 // resampling) the whole pack decodes losslessly up to the quantization, i.e. every decoded vertex lies within
 // half a quantization step per coordinate of the level-N remesh's (same parameterization, same samples);
 // with the default frames the rotation rounds (about a step per coordinate), which this bound does not allow.
-// Out-of-range switches: exit 2, one line, no pack.
+// Both commands are given the same curvature metric (convert's default is not remesh's), so the same
+// parameterization. Out-of-range switches: exit 2, one line, no pack.
 TEST_F(CliPack, CodecSwitchesForAblations) {
-  Outcome r = geomip("remesh --quiet '" + spot_ + "' --level 4 --sampling-exponent 0 -o '" + dir_ + "/m'");
+  Outcome r = geomip("remesh --quiet '" + spot_ +
+                     "' --level 4 --sampling-exponent 0 --curvature-metric 0.03 -o '" + dir_ + "/m'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const TriMesh remesh = read_mesh(dir_ + "/m/spot.M4.obj");
   const BoundingBox box = referenced_bounding_box(remesh);
   const double step = (box.max - box.min).maxCoeff() / 16384.0;  // 14 bits over the largest extent
   const auto largest_offset_in_steps = [&](const std::string& switches) {
     const std::string pack = dir_ + "/ablation.gip";
-    const Outcome c = geomip("convert -q '" + spot_ + "' --level 4 --no-normals --normal-mesh 0 " + switches +
-                             " -o '" + pack + "'");
+    const Outcome c =
+        geomip("convert -q '" + spot_ + "' --level 4 --no-normals --normal-mesh 0 --curvature-metric 0.03 " +
+               switches + " -o '" + pack + "'");
     EXPECT_EQ(c.exit_code, 0) << c.err;
     const Outcome d = geomip("decode -q '" + pack + "' -o '" + dir_ + "/ablation.obj'");
     EXPECT_EQ(d.exit_code, 0) << d.err;

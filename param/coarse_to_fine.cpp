@@ -1,10 +1,10 @@
 #include "param/coarse_to_fine.h"
 
-
 #include "mesh/errors.h"
 #include "mesh/predicates.h"
-#include "param/unit_square.h"
 #include "param/mean_value_embedding.h"
+#include "param/sampling_weights.h"
+#include "param/unit_square.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +73,8 @@ CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm,
   if (pm.num_vertices != n || pm.num_triangles != patch.triangles.size()) {
     fail(kFn, "the progressive mesh was not built from this patch");
   }
+  if (options.side_metrics && options.side_metrics->size() != n)
+    fail(kFn, "metric tensors per vertex: wrong count");
   if (base_uv.size() != n)
     fail(kFn, "base_uv has " + std::to_string(base_uv.size()) + " entries, not " + std::to_string(n));
   const double kNan = std::numeric_limits<double>::quiet_NaN();
@@ -114,7 +116,7 @@ CoarseToFine::CoarseToFine(const TriMesh& patch, const ProgressiveMesh& pm,
     }
     double s = 0.0;
     for (std::size_t i = 1; i < side.size(); ++i) {
-      s += (patch.positions[side[i]] - patch.positions[side[i - 1]]).norm();
+      s += metric_edge_length(patch.positions, options.side_metrics, side[i - 1], side[i]);
       if (i + 1 < side.size()) {
         side_of_[side[i]] = k;
         arclength_[side[i]] = s;

@@ -26,6 +26,10 @@ struct CoarseToFineOptions {
   /// After every split, also count flipped triangles over the whole current level (O(F) per split, so
   /// O(F²) in all): for tests and debugging. The local check around the changed vertices is always on.
   bool check_all_triangles = false;
+  /// Optional metric tensors per patch vertex (not owned; must outlive the object): the sides' chord
+  /// lengths are measured in them, as square_boundary_uv() with the same tensors places the base mesh's
+  /// side vertices. Null = Euclidean.
+  const std::vector<Eigen::Matrix3d>* side_metrics = nullptr;
 };
 
 struct CoarseToFineResult {

@@ -457,7 +457,11 @@ PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size
   seconds.progressive_mesh += seconds_since(t0);
 
   t0 = Clock::now();
-  const std::vector<FixedUv> boundary = square_boundary_uv(pw.local.positions, pw.pm.sides);
+  if (!w.metrics.empty()) {
+    for (int v : pw.to_mesh) pw.metrics.push_back(w.metrics[v]);
+  }
+  const std::vector<Eigen::Matrix3d>* metrics = pw.metrics.empty() ? nullptr : &pw.metrics;
+  const std::vector<FixedUv> boundary = square_boundary_uv(pw.local.positions, pw.pm.sides, metrics);
   pw.uv = mean_value_embedding(pw.local.positions, pw.pm.base_triangles, boundary).uv;
   BaseMesh base = base_mesh(pw);
   std::vector<char> locked(base.to_patch.size(), 0);
@@ -473,8 +477,7 @@ PatchWork prepare_patch(const ParameterizationInput& in, ModelWork& w, std::size
     base_options.vertex.vertex_weights = &base_weights;
   }
   std::vector<Eigen::Matrix3d> base_metrics;
-  if (!w.metrics.empty()) {
-    for (int v : pw.to_mesh) pw.metrics.push_back(w.metrics[v]);
+  if (metrics) {
     for (int v : base.to_patch) base_metrics.push_back(pw.metrics[v]);
     base_options.vertex.vertex_metrics = &base_metrics;
   }
@@ -627,7 +630,9 @@ void align_patch_features(std::vector<ModelWork>& work, std::size_t p,
 // `progress`.
 CoarseToFineResult refine_patch(PatchWork& pw, std::size_t p, const std::vector<char>& locked,
                                 const ParameterizationOptions& options, PatchProgress& progress) {
-  CoarseToFine c2f(pw.local, pw.pm, pw.uv);
+  CoarseToFineOptions c2f_options;
+  c2f_options.side_metrics = pw.metrics.empty() ? nullptr : &pw.metrics;
+  CoarseToFine c2f(pw.local, pw.pm, pw.uv, c2f_options);
   std::mt19937 rng(options.seed * 7919u + static_cast<unsigned>(p));
   const std::vector<double>* weights = pw.weights.empty() ? nullptr : &pw.weights;
   VertexOptimizationOptions local_options = options.local_optimization;
@@ -734,7 +739,7 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
   if (options.measure_mvc_baseline || pw.features.empty()) {
     t0 = Clock::now();
     auto mvc = mean_value_embedding(pw.local.positions, pw.local.triangles,
-                                    square_boundary_uv(pw.local.positions, pw.pm.sides));
+                                    square_boundary_uv(pw.local.positions, pw.pm.sides, metrics));
     pp.mvc_stretch = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
     seconds.mvc_baseline += seconds_since(t0);
     if (pw.features.empty() && pp.mvc_stretch.l2 < pp.stretch.l2) {

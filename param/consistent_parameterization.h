@@ -111,8 +111,9 @@ struct ParameterizationOptions {
   /// partitioned mesh (so both patches of a seam see the same tensors), measures every stretch
   /// optimization's triangles in M = I + λ·D·|S| (VertexOptimizationOptions::vertex_metrics): a direction
   /// in which the surface bends gets more parameter length, hence more samples, than one along which it
-  /// is straight (around a leg rather than along it). 0 = the Euclidean metric (Sander 2001). The figures
-  /// a parameterization reports (PatchParameterization::stretch) stay Euclidean.
+  /// is straight (around a leg rather than along it); the sides' chord lengths are measured in it too
+  /// (square_boundary_uv(), CoarseToFineOptions::side_metrics). 0 = the Euclidean metric (Sander 2001). The
+  /// figures a parameterization reports (PatchParameterization::stretch) stay Euclidean.
   double curvature_metric = 0;
   /// Seed of the random search directions (results are deterministic for a given seed).
   unsigned seed = 1;

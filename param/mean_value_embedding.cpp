@@ -1,6 +1,7 @@
 #include "param/mean_value_embedding.h"
 
 #include "mesh/errors.h"
+#include "param/sampling_weights.h"
 #include "param/unit_square.h"
 
 #include <Eigen/OrderingMethods>
@@ -24,10 +25,13 @@ namespace {
 }  // namespace
 
 std::vector<FixedUv> square_boundary_uv(const std::vector<Eigen::Vector3d>& positions,
-                                        const std::array<std::vector<int>, 4>& sides) {
+                                        const std::array<std::vector<int>, 4>& sides,
+                                        const std::vector<Eigen::Matrix3d>* metrics) {
   constexpr const char* kFn = "square_boundary_uv";
   const auto& kCorner = unit_square_corners();
   const int n = static_cast<int>(positions.size());
+  if (metrics && metrics->size() != positions.size())
+    fail(kFn, "metric tensors and positions differ in size");
   std::vector<FixedUv> out;
   for (int k = 0; k < 4; ++k) {
     const auto& side = sides[k];
@@ -40,7 +44,7 @@ std::vector<FixedUv> square_boundary_uv(const std::vector<Eigen::Vector3d>& posi
     }
     std::vector<double> s(side.size(), 0.0);
     for (std::size_t i = 1; i < side.size(); ++i)
-      s[i] = s[i - 1] + (positions[side[i]] - positions[side[i - 1]]).norm();
+      s[i] = s[i - 1] + metric_edge_length(positions, metrics, side[i - 1], side[i]);
     const double length = s.back();
     if (!(length > 0.0)) fail(kFn, "side " + std::to_string(k) + " has zero length");
     const Eigen::Vector2d a = kCorner[k], b = kCorner[(k + 1) % 4];

@@ -23,10 +23,13 @@ using FixedUv = std::pair<int, Eigen::Vector2d>;
 /// length from the side's first corner divided by the side's length). One entry per boundary vertex (corners
 /// once), in side order.
 /// \param positions  3D positions (any unit) indexed by the ids in `sides`
+/// \param metrics    optional metric tensors indexed like `positions`: chord lengths measured in them
+///                   (metric_edge_length(); ParameterizationOptions::curvature_metric); null = Euclidean
 /// \throw InvalidInput if a side has fewer than 2 vertices, does not end where the next begins, has an id out
-///        of range, or has zero length.
+///        of range, or has zero length, or if `metrics` has another size than `positions`.
 std::vector<FixedUv> square_boundary_uv(const std::vector<Eigen::Vector3d>& positions,
-                                        const std::array<std::vector<int>, 4>& sides);
+                                        const std::array<std::vector<int>, 4>& sides,
+                                        const std::vector<Eigen::Matrix3d>* metrics = nullptr);
 
 struct MeanValueEmbeddingOptions {
   /// Upper bound on tan(α/2) in eq. (3), reached only by triangles with an angle within ~1e-6 rad of π

@@ -9,6 +9,7 @@
 
 #include "mesh/mesh.h"
 
+#include <cmath>
 #include <vector>
 
 namespace geomip {
@@ -35,6 +36,18 @@ struct SamplingWeightOptions {
 std::vector<double> curvature_sampling_weights(const std::vector<Eigen::Vector3d>& positions,
                                                const std::vector<std::array<int, 3>>& triangles,
                                                const SamplingWeightOptions& options = {});
+
+/// Length of the edge a→b in the mean of its ends' metric tensors (`metrics` indexed like `positions`;
+/// null = Euclidean): the chord lengths that place a patch's side vertices when its interior is
+/// parameterized in that metric (square_boundary_uv(), CoarseToFineOptions::side_metrics).
+inline double metric_edge_length(const std::vector<Eigen::Vector3d>& positions,
+                                 const std::vector<Eigen::Matrix3d>* metrics, int a, int b) {
+  const Eigen::Vector3d e = positions[static_cast<std::size_t>(b)] - positions[static_cast<std::size_t>(a)];
+  if (!metrics) return e.norm();
+  const Eigen::Matrix3d m =
+      0.5 * ((*metrics)[static_cast<std::size_t>(a)] + (*metrics)[static_cast<std::size_t>(b)]);
+  return std::sqrt(e.dot(m * e));
+}
 
 /// Per-vertex metric tensors for an anisotropic, curvature-adapted stretch (VertexOptimizationOptions::
 /// vertex_metrics): M = I + λ·D·|S|, S the shape operator (per face from the vertex normals' differences

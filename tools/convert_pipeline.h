@@ -52,7 +52,7 @@ struct ConvertOptions {
   /// "Curvature sampling").
   double sampling_exponent = 0;
   /// λ of the parameterization's anisotropic curvature metric (ParameterizationOptions::curvature_metric;
-  /// 0 = Euclidean stretch). 0.03 by default here: +0.2…+0.5 dB on the mean prefix PSNR of the bunny, the
+  /// 0 = Euclidean stretch). 0.03 by default here: +0.20…+0.53 dB on the mean prefix PSNR of the bunny, the
   /// horse, venus and the armadillo (docs/measurements.md, "An anisotropic curvature metric"); the
   /// remeshing commands default to 0.
   double curvature_metric = 0.03;

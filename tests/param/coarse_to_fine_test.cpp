@@ -182,6 +182,41 @@ TEST(CoarseToFine, BoundaryVerticesGoToTheirChordLengthPosition) {
   EXPECT_LE(off, boundary / 10);
 }
 
+// With side metrics the boundary vertices go to their chord-length positions in the metric, where
+// square_boundary_uv() with the same tensors puts them (the base mesh's and the full patch's sides agree).
+TEST(CoarseToFine, BoundaryVerticesFollowTheSideMetric) {
+  const int n = 16;
+  TriMesh g = test::grid(n);
+  const PatchSides sides = patch_sides(g, grid_corners(n));
+  std::vector<Eigen::Matrix3d> metrics;
+  for (const auto& q : g.positions) {
+    Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
+    m(0, 0) = 1 + 8 * q.x() * q.x();  // x grows longer to the right
+    metrics.push_back(m);
+  }
+  Pipeline p;
+  p.patch = std::move(g);
+  p.sides = sides;
+  p.pm = progressive_mesh(p.patch, p.sides, {});
+  const auto target = square_boundary_uv(p.patch.positions, p.sides, &metrics);
+  p.base_uv = mean_value_embedding(p.patch.positions, p.pm.base_triangles, target).uv;
+  CoarseToFineOptions options;
+  options.side_metrics = &metrics;
+  const CoarseToFineResult r = coarse_to_fine(p.patch, p.pm, p.base_uv, options);
+  expect_valid_square_parameterization(p, r);
+  std::size_t off = 0, moved = 0;
+  for (const auto& [v, uv] : target) {
+    off += (r.uv[v] - uv).norm() > 1e-12 ? 1 : 0;
+    moved += (uv - p.patch.positions[v].head<2>()).norm() > 1e-3 ? 1 : 0;
+  }
+  EXPECT_EQ(off, r.boundary_off_chord);
+  EXPECT_LE(off, target.size() / 10);
+  EXPECT_GT(moved, target.size() / 4) << "the metric moved the side vertices off their Euclidean places";
+  std::vector<Eigen::Matrix3d> short_metrics(3, Eigen::Matrix3d::Identity());
+  options.side_metrics = &short_metrics;
+  EXPECT_THROW(CoarseToFine(p.patch, p.pm, p.base_uv, options), InvalidInput);
+}
+
 TEST(CoarseToFine, OptimizerSeesNewVertexAndNeighboursButNeverCornersOrFeatures) {
   const Pipeline p = curved_pipeline(20);
   CoarseToFine c2f(p.patch, p.pm, p.base_uv);

@@ -57,6 +57,37 @@ TEST(SquareBoundaryUv, CornersOnCornersAndChordLengthAlongSides) {
   EXPECT_THROW(square_boundary_uv(empty.positions, sides), InvalidInput);
 }
 
+// With metric tensors the chord lengths are measured in them (the mean of an edge's ends): a metric that
+// makes the left half of the grid twice as long along x moves the bottom side's vertices right, in closed
+// form, and leaves the left side (whose edges run along y) where it was. Tensors of the wrong count are
+// refused.
+TEST(SquareBoundaryUv, ChordLengthInAMetric) {
+  const int n = 8;
+  const TriMesh g = test::grid(n);
+  const PatchSides sides = patch_sides(g, grid_corners(n));
+  std::vector<Eigen::Matrix3d> metrics;
+  for (const auto& p : g.positions) {
+    Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
+    if (p.x() < 0.5) m(0, 0) = 4;
+    metrics.push_back(m);
+  }
+  const auto uv = square_boundary_uv(g.positions, sides, &metrics);
+  // bottom side: three edges of length 2/8, one of √2.5/8 (its ends' mean is 2.5), four of 1/8
+  const double total = 6 + std::sqrt(2.5) + 4;
+  for (const auto& [v, p] : uv) {
+    const Eigen::Vector3d& q = g.positions[v];
+    if (q.y() == 0 && q.x() > 0 && q.x() < 1) {
+      const int i = static_cast<int>(std::lround(q.x() * n));
+      const double s = i <= 3 ? 2.0 * i : i == 4 ? 6 + std::sqrt(2.5) : 6 + std::sqrt(2.5) + (i - 4);
+      EXPECT_NEAR(p.x(), s / total, 1e-14) << "vertex " << v;
+      EXPECT_EQ(p.y(), 0.0);
+    }
+    if (q.x() == 0) EXPECT_NEAR(p.y(), q.y(), 1e-15) << "left side, vertex " << v;
+  }
+  std::vector<Eigen::Matrix3d> short_metrics(3, Eigen::Matrix3d::Identity());
+  EXPECT_THROW(square_boundary_uv(g.positions, sides, &short_metrics), InvalidInput);
+}
+
 TEST(MeanValueEmbedding, ReproducesAPlanarTriangulationOfTheSquare) {
   // Mean value coordinates reproduce linear functions: with the boundary at its true place, a planar mesh
   // is its own parameterization, however irregular.

@@ -172,6 +172,34 @@ void store_base(const BaseMesh& b, PatchWork& w) {
   for (std::size_t i = 0; i < b.to_patch.size(); ++i) w.uv[b.to_patch[i]] = b.uv[i];
 }
 
+// One triangle's term of the optimizer's L2 energy, A3·(Γ² + γ²)/2, with its 3D lengths and area measured in
+// the metric m (the cotangent form of stretch_optimization.cpp; m = I gives Σ A3·L2² of triangle_stretch()).
+// +inf for a flipped or degenerate uv triangle.
+double metric_l2_term(const Eigen::Vector3d q[3], const Eigen::Vector2d uv[3], const Eigen::Matrix3d& m) {
+  const Eigen::Vector3d e0 = q[2] - q[1], e1 = q[2] - q[0], e2 = q[1] - q[0];
+  const double len0 = e0.dot(m * e0), len1 = e1.dot(m * e1), len2 = e2.dot(m * e2), g12 = e2.dot(m * e1);
+  const double a3 = 0.5 * std::sqrt(std::max(0.0, len1 * len2 - g12 * g12));
+  const Eigen::Vector2d u1 = uv[1] - uv[0], u2 = uv[2] - uv[0];
+  const double c = u1.x() * u2.y() - u1.y() * u2.x();
+  if (!(c > 0)) return std::numeric_limits<double>::infinity();
+  const double num = len0 * u1.dot(u2) - len1 * u1.dot(u2 - u1) - len2 * u2.dot(u1 - u2);
+  return a3 * 0.5 * num / (c * c);
+}
+
+// Σ of metric_l2_term() over a patch, each triangle in the mean of its corners' tensors: what the stretch
+// optimization lowers when it runs in the metric, to compare two parameterizations of the same patch.
+double metric_l2_energy(const std::vector<Eigen::Vector3d>& positions,
+                        const std::vector<std::array<int, 3>>& triangles,
+                        const std::vector<Eigen::Vector2d>& uv, const std::vector<Eigen::Matrix3d>& metrics) {
+  double e = 0;
+  for (const auto& t : triangles) {
+    const Eigen::Vector3d q[3] = {positions[t[0]], positions[t[1]], positions[t[2]]};
+    const Eigen::Vector2d p[3] = {uv[t[0]], uv[t[1]], uv[t[2]]};
+    e += metric_l2_term(q, p, (metrics[t[0]] + metrics[t[1]] + metrics[t[2]]) / 3.0);
+  }
+  return e;
+}
+
 // A few global stretch sweeps over the current level of a coarse-to-fine pass (Sander et al. 2002 optimize
 // every level of the hierarchy; local moves alone leave clusters of vertices squeezed into tiny kernels,
 // e.g. L2 stretch 96 instead of 1.3 on one of fandisk's patches).
@@ -281,7 +309,8 @@ void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>
   for (std::size_t p = 0; p < np; ++p) {
     for (int v : m.patches[p].vertices) positions[p].push_back(m.mesh.positions[v]);
   }
-  // Σ A3·L2² over the star of v in patch p (+inf when a triangle is flipped or degenerate).
+  // Σ A3·L2² over the star of v in patch p (+inf when a triangle is flipped or degenerate), in the patch's
+  // metric when it has one (the energy its sweeps lower).
   auto star_energy = [&](std::size_t p, int v) {
     double e = 0.0;
     const auto& patch = m.patches[p];
@@ -290,10 +319,15 @@ void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>
       const Eigen::Vector3d q[3] = {positions[p][tri[0]], positions[p][tri[1]], positions[p][tri[2]]};
       const Eigen::Vector2d uv[3] = {patch.uv[tri[0]], patch.uv[tri[1]], patch.uv[tri[2]]};
       if (orient2d(uv[0], uv[1], uv[2]) <= 0) return std::numeric_limits<double>::infinity();
-      const double l2 = triangle_stretch(q, uv).l2;
-      const double a3 = 0.5 * (q[1] - q[0]).cross(q[2] - q[0]).norm();
       double w = 1.0;
       if (!weights[p].empty()) w = (weights[p][tri[0]] + weights[p][tri[1]] + weights[p][tri[2]]) / 3.0;
+      if (!metrics[p].empty()) {
+        const Eigen::Matrix3d mt = (metrics[p][tri[0]] + metrics[p][tri[1]] + metrics[p][tri[2]]) / 3.0;
+        e += w * metric_l2_term(q, uv, mt);  // A3·(Γ²+γ²)/2 = A3·L2² in the metric
+        continue;
+      }
+      const double l2 = triangle_stretch(q, uv).l2;
+      const double a3 = 0.5 * (q[1] - q[0]).cross(q[2] - q[0]).norm();
       e += w * a3 * l2 * l2;
     }
     return e;
@@ -682,6 +716,7 @@ void linf_pass(const std::vector<Eigen::Vector3d>& positions, const std::vector<
   o.seed = options.seed + 313u * static_cast<unsigned>(p + 1);
   o.vertex.norm = StretchNorm::kLinf;
   o.vertex.vertex_weights = nullptr;  // the L∞ term is not weighted
+  o.vertex.vertex_metrics = nullptr;  // and Euclidean: it lowers the reported (Euclidean) L∞ stretch
   const double n = std::sqrt(area2 / area3);
   o.max_sweeps = 1;
   for (std::size_t sweep = 0; sweep < options.linf_sweeps; ++sweep) {
@@ -742,7 +777,18 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
                                     square_boundary_uv(pw.local.positions, pw.pm.sides, metrics));
     pp.mvc_stretch = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
     seconds.mvc_baseline += seconds_since(t0);
-    if (pw.features.empty() && pp.mvc_stretch.l2 < pp.stretch.l2) {
+    // Which is better: by the reported (Euclidean) L2 stretch, or, when the stretch was optimized in a
+    // curvature metric, by the energy that optimization lowered.
+    const auto better = [&](const std::vector<std::array<int, 3>>& tris_a,
+                            const std::vector<Eigen::Vector2d>& uv_a, double l2_a,
+                            const std::vector<std::array<int, 3>>& tris_b,
+                            const std::vector<Eigen::Vector2d>& uv_b, double l2_b) {
+      if (!metrics) return l2_a < l2_b;
+      return metric_l2_energy(pw.local.positions, tris_a, uv_a, *metrics) <
+             metric_l2_energy(pw.local.positions, tris_b, uv_b, *metrics);
+    };
+    if (pw.features.empty() &&
+        better(pw.local.triangles, mvc.uv, pp.mvc_stretch.l2, pp.triangles, pp.uv, pp.stretch.l2)) {
       t0 = Clock::now();
       StretchOptimizationOptions fallback = options.base_optimization;
       fallback.seed = options.seed + 31u * static_cast<unsigned>(p + 1);
@@ -750,7 +796,8 @@ PatchParameterization parameterize_patch(PatchWork& pw, std::size_t p, const std
       fallback.vertex.vertex_metrics = metrics;
       optimize_stretch(pw.local.positions, pw.local.triangles, mvc.uv, locked, fallback);
       const StretchValues s = mesh_stretch(pw.local.positions, pw.local.triangles, mvc.uv);
-      if (s.l2 < pp.stretch.l2 && count_flipped(pw.local.triangles, mvc.uv) == 0) {
+      if (better(pw.local.triangles, mvc.uv, s.l2, pp.triangles, pp.uv, pp.stretch.l2) &&
+          count_flipped(pw.local.triangles, mvc.uv) == 0) {
         pp.triangles = pw.local.triangles;
         pp.uv = std::move(mvc.uv);
         pp.stretch = s;

@@ -115,9 +115,16 @@ std::vector<double> curvature_sampling_weights(const std::vector<Eigen::Vector3d
 std::vector<Eigen::Matrix3d> curvature_metric_tensors(const std::vector<Eigen::Vector3d>& positions,
                                                       const std::vector<std::array<int, 3>>& triangles,
                                                       double lambda, double max_curvature) {
+  if (!(lambda >= 0) || !std::isfinite(lambda) || !(max_curvature > 0) || !std::isfinite(max_curvature))
+    throw InvalidInput(
+        "curvature_metric_tensors: lambda must be finite and >= 0, max_curvature finite and > 0");
   const std::size_t nv = positions.size();
+  for (const auto& t : triangles)
+    for (int v : t)
+      if (v < 0 || static_cast<std::size_t>(v) >= nv)
+        throw InvalidInput("curvature_metric_tensors: vertex index " + std::to_string(v) + " out of range");
   std::vector<Eigen::Matrix3d> out(nv, Eigen::Matrix3d::Identity());
-  if (nv == 0 || triangles.empty()) return out;
+  if (nv == 0 || triangles.empty() || lambda == 0) return out;
   std::vector<Eigen::Vector3d> normal(nv, Eigen::Vector3d::Zero());
   for (const auto& t : triangles) {
     const Eigen::Vector3d n = (positions[t[1]] - positions[t[0]]).cross(positions[t[2]] - positions[t[0]]);
@@ -129,6 +136,7 @@ std::vector<Eigen::Matrix3d> curvature_metric_tensors(const std::vector<Eigen::V
   for (const auto& t : triangles)
     for (int i : t) lo = lo.cwiseMin(positions[i]), hi = hi.cwiseMax(positions[i]);
   const double diagonal = (hi - lo).norm();
+  if (!(diagonal > 0) || !std::isfinite(diagonal)) return out;  // a point, or positions that are not finite
   std::vector<Eigen::Matrix3d> face_k(triangles.size(), Eigen::Matrix3d::Zero());
   std::vector<double> face_area(triangles.size(), 0);
   std::vector<Eigen::Matrix3d> vk(nv, Eigen::Matrix3d::Zero());

@@ -54,7 +54,9 @@ inline double metric_edge_length(const std::vector<Eigen::Vector3d>& positions,
 /// along its edges, least squares; |S| its eigenvalues made positive; area-weighted to the vertices and
 /// averaged over one ring once), D the bounding-box diagonal, κ·D clamped at `max_curvature`. Linear
 /// interpolation error along a direction of curvature κ grows as κ·h², so uniform samples in the metric |S|
-/// spread the error evenly; λ blends it with the Euclidean metric.
+/// spread the error evenly; λ blends it with the Euclidean metric. λ = 0, no triangles, a zero or non-finite
+/// bounding box: identity tensors.
+/// \throw InvalidInput for λ < 0 or non-finite, max_curvature ≤ 0, or an index out of range.
 std::vector<Eigen::Matrix3d> curvature_metric_tensors(const std::vector<Eigen::Vector3d>& positions,
                                                       const std::vector<std::array<int, 3>>& triangles,
                                                       double lambda, double max_curvature = 200);

@@ -255,7 +255,10 @@ void build_ring(const char* function, int v, const std::vector<int>& ring,
     fail(std::to_string(vertex_weights->size()) + " vertex weights for " + std::to_string(positions.size()) +
          " vertices");
   }
-  if (vertex_metrics && vertex_metrics->size() != positions.size()) fail("vertex metrics mismatch");
+  if (vertex_metrics && vertex_metrics->size() != positions.size()) {
+    fail(std::to_string(vertex_metrics->size()) + " metric tensors for " + std::to_string(positions.size()) +
+         " vertices");
+  }
   if (uv.size() != positions.size()) {
     fail(std::to_string(uv.size()) + " uv coordinates for " + std::to_string(positions.size()) + " vertices");
   }
@@ -373,12 +376,14 @@ StretchOptimizationResult optimize_stretch(const std::vector<Eigen::Vector3d>& p
     throw InvalidInput("optimize_stretch: " + std::to_string(vertex_weights->size()) + " vertex weights for " +
                        std::to_string(nv) + " vertices");
   }
+  if (options.vertex.vertex_metrics && options.vertex.vertex_metrics->size() != nv) {
+    throw InvalidInput("optimize_stretch: " + std::to_string(options.vertex.vertex_metrics->size()) +
+                       " metric tensors for " + std::to_string(nv) + " vertices");
+  }
   std::vector<TriangleMetric> metrics(triangles.size());
   std::vector<double> face_weight(triangles.size(), 1.0);
   for (std::size_t f = 0; f < triangles.size(); ++f) {
     const auto& t = triangles[f];
-    if (options.vertex.vertex_metrics && options.vertex.vertex_metrics->size() != nv)
-      throw InvalidInput("optimize_stretch: vertex metrics mismatch");
     metrics[f] = triangle_metric(positions, options.vertex.vertex_metrics, t[0], t[1], t[2]);
     if (vertex_weights)
       face_weight[f] = ((*vertex_weights)[t[0]] + (*vertex_weights)[t[1]] + (*vertex_weights)[t[2]]) / 3;

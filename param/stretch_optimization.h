@@ -123,7 +123,9 @@ struct StretchOptimizationOptions {
 };
 
 struct StretchOptimizationResult {
-  StretchValues before;  ///< mesh_stretch() of the input (normalized, see stretch.h)
+  /// mesh_stretch() of the input (normalized, see stretch.h). Euclidean even when the optimization ran in
+  /// VertexOptimizationOptions::vertex_metrics, so `after` may then exceed it.
+  StretchValues before;
   StretchValues after;   ///< mesh_stretch() of the output
   std::size_t sweeps = 0;
   std::size_t vertex_moves = 0;      ///< accepted vertex displacements over all sweeps

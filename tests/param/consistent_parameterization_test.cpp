@@ -386,6 +386,14 @@ TEST(ConsistentParameterization, CurvatureMetricKeepsValidSquares) {
       moved = std::max(moved, (metric[0].patches[p].uv[v] - plain[0].patches[p].uv[v]).norm());
   }
   EXPECT_GT(moved, 1e-3) << "the metric moves samples";
+  // with sliding seams (compared in the metric) and the L∞ pass (Euclidean) on top: still valid
+  options.seam_slide_rounds = 2;
+  options.linf_sweeps = 20;
+  const auto both = parameterize_consistently({test::automatic_input(spiked, "spiked")}, options);
+  ASSERT_EQ(both.size(), 1u);
+  expect_valid(both[0], "spiked, curvature metric, sliding seams, L-infinity pass");
+  options.seam_slide_rounds = 0;
+  options.linf_sweeps = 0;
   options.curvature_metric = -0.1;
   EXPECT_THROW(parameterize_consistently({test::automatic_input(spiked, "spiked")}, options), InvalidInput);
   options.curvature_metric = std::nan("");

@@ -152,6 +152,9 @@ TEST(CurvatureMetric, FlatIsEuclideanSphereIsotropicCylinderOnlyAround) {
   }
   for (const auto& m : curvature_metric_tensors(cyl.positions, cyl.triangles, 0.0))
     EXPECT_EQ(m, Eigen::Matrix3d::Identity());
+  EXPECT_THROW(curvature_metric_tensors(cyl.positions, cyl.triangles, -0.1), InvalidInput);
+  EXPECT_THROW(curvature_metric_tensors(cyl.positions, cyl.triangles, std::nan("")), InvalidInput);
+  EXPECT_THROW(curvature_metric_tensors(cyl.positions, {{0, 1, 99999}}, lambda), InvalidInput);
 }
 
 // The metric drives the optimizer: identity tensors leave the Euclidean result (to rounding), and a half of a

@@ -54,7 +54,7 @@ struct ConvertOptions {
   /// λ of the parameterization's anisotropic curvature metric (ParameterizationOptions::curvature_metric;
   /// 0 = Euclidean stretch). 0.03 by default here: +0.20…+0.53 dB on the mean prefix PSNR of the bunny, the
   /// horse, venus and the armadillo (docs/measurements.md, "An anisotropic curvature metric"); the
-  /// remeshing commands default to 0.
+  /// remeshing commands use the same default (ModelArgs::curvature_metric).
   double curvature_metric = 0.03;
   /// Sweeps of the parameterization's L∞ pass (ParameterizationOptions::linf_sweeps; 0 = off).
   std::size_t linf_sweeps = 0;

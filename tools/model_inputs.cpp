@@ -269,8 +269,7 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
          "--curvature-metric", args.curvature_metric,
          "Anisotropic stretch: measure triangles in the metric I + L*D*|S| (S the shape operator, D the "
          "bounding-box diagonal), so directions in which the surface bends get more samples than "
-         "straight ones (around a leg, not along it); 0 = Euclidean (default: 0.03 for convert, which rd "
-         "uses too; 0 for param, gimage, remesh)")
+         "straight ones (around a leg, not along it); 0 = Euclidean (default 0.03)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--linf-sweeps", args.linf_sweeps,
                   "Sweeps of the L-infinity pass after the stretch optimization: lowers each patch's worst "

@@ -22,8 +22,9 @@ namespace {
 
 // Version 1: one joint bit-plane stream for all patches; version 2: a stream per patch (parallel decoding);
 // version 3: version 2 plus local frames and orientation weights; version 4: version 3 plus the lifting
-// update flag (bit 1 of the flags byte); version 5: version 4 plus the filter kCubicLong.
-constexpr std::uint8_t kHeaderVersion = 5;
+// update flag (bit 1 of the flags byte); version 5: version 4 plus the filter kCubicLong; version 6: version
+// 5 with cell frames (see "Local frames" below).
+constexpr std::uint8_t kHeaderVersion = 6;
 constexpr int kMaxTangentialShift = 8;
 constexpr int kMaxLevel = 12;
 constexpr int kMaxTopBitplane = 48;
@@ -235,6 +236,15 @@ std::int64_t round_shift(std::int64_t v, int s) {
   return s == 0 ? v : (v + (std::int64_t{1} << (s - 1))) >> s;
 }
 
+/// Floor halvings of v until every component fits in 30 bits (a cross product of two such stays below 2^63).
+void bound_to_30_bits(std::int64_t* v) {
+  const auto largest = static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}));
+  if (largest >> 30) {  // more than 30 bits
+    const int bits = static_cast<int>(std::bit_width(largest));
+    v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
+  }
+}
+
 /// The frame whose normal is N (any length; identity rows for N = 0).
 Frame make_frame(std::int64_t n0, std::int64_t n1, std::int64_t n2) {
   constexpr std::int32_t one = 1 << kFrameBits;
@@ -269,12 +279,71 @@ Frame make_frame(std::int64_t n0, std::int64_t n1, std::int64_t n2) {
   return f;
 }
 
+// Cell frames (version 6). A version-3 to -5 frame is built per framed sample from its own normal (three
+// integer square roots and nine divisions, 29 M of the bunny's 197 M decoder instructions) and that normal
+// from the finest reconstruction (a whole extra inverse transform per framed step). Version 6 takes the
+// normal from the step's coarse grid instead (no inverse at the step's own spacing) and the frame from a
+// table: the frame of the centre of the normal's cell in a 2^kFrameCellBits × 2^kFrameCellBits octahedral map
+// of directions (a cell spans at most ~2.8°, far below the noise of a normal estimated from coarse samples).
+// Measured as bit-rate neutral (docs/codec-v3.md, "Cell frames").
+constexpr int kFrameCellBits = 6;
+constexpr int kFrameCells = 1 << (2 * kFrameCellBits);
+constexpr std::uint16_t kZeroNormalCell = kFrameCells;  // a zero normal: the identity frame
+constexpr std::uint16_t kUnsetCell = 0xFFFF;            // FrameField::cell: not computed yet
+
+/// The octahedral cell of direction (x, y, z) (any length; kZeroNormalCell for zero): the upper hemisphere
+/// maps to the diamond |u| + |v| ≤ 1 by (x, y) / L1, the lower one folded outside it; cell (U, V) holds
+/// u ∈ [2U/N − 1, 2(U+1)/N − 1). Integer arithmetic only.
+std::uint16_t octahedral_cell(std::int64_t x, std::int64_t y, std::int64_t z) {
+  const auto largest = static_cast<std::uint64_t>(std::max({std::abs(x), std::abs(y), std::abs(z)}));
+  if (largest >> 40) {  // more than 40 bits (garbage): floor halvings to < 2^40
+    const int bits = static_cast<int>(std::bit_width(largest)) - 40;
+    x >>= bits, y >>= bits, z >>= bits;
+  }
+  const std::int64_t l1 = std::abs(x) + std::abs(y) + std::abs(z);
+  if (l1 == 0) return kZeroNormalCell;
+  std::int64_t a = x, b = y;
+  if (z < 0) {
+    a = x >= 0 ? l1 - std::abs(y) : std::abs(y) - l1;
+    b = y >= 0 ? l1 - std::abs(x) : std::abs(x) - l1;
+  }
+  constexpr std::int64_t n = std::int64_t{1} << kFrameCellBits;
+  const std::int64_t u = std::min(((a + l1) * n) / (2 * l1), n - 1),
+                     v = std::min(((b + l1) * n) / (2 * l1), n - 1);
+  return static_cast<std::uint16_t>(v * n + u);
+}
+
+/// The frames of the octahedral cells' centres (and the identity at kZeroNormalCell), built once.
+const std::vector<Frame>& cell_frames() {
+  static const std::vector<Frame> table = [] {
+    constexpr std::int64_t n = std::int64_t{1} << kFrameCellBits;
+    std::vector<Frame> t(static_cast<std::size_t>(kFrameCells) + 1);
+    for (std::int64_t v = 0; v < n; ++v) {
+      for (std::int64_t u = 0; u < n; ++u) {
+        std::int64_t x = 2 * u + 1 - n, y = 2 * v + 1 - n;  // the centre, in units of 1/n
+        const std::int64_t z = n - std::abs(x) - std::abs(y);
+        if (z < 0) {  // the lower hemisphere, unfolded
+          const std::int64_t fx = n - std::abs(y), fy = n - std::abs(x);
+          x = x >= 0 ? fx : -fx;
+          y = y >= 0 ? fy : -fy;
+        }
+        t[static_cast<std::size_t>(v * n + u)] = make_frame(x << 12, y << 12, z * 4096);
+      }
+    }
+    t[kZeroNormalCell] = make_frame(0, 0, 0);
+    return t;
+  }();
+  return table;
+}
+
 /// The local frames of one model: per patch and grid index (filled at the framed positions of the steps
 /// whose frames were computed).
 struct FrameField {
   int level = 0, steps = 0, frame_steps = 0, tangential_shift = 0;
   WaveletFilter filter = WaveletFilter::kCubic;
   bool update = false;  // the wavelet's update step (header version 4)
+  bool cells = false;   // cell frames (header version 6)
+  const Frame* cell_table = nullptr;  // cell_frames() when cells
   const Ownership* own = nullptr;
   std::vector<int> start;                                         // start plane of step k at [k − 1]
   std::size_t samples = 0;  // grid positions per patch
@@ -282,6 +351,18 @@ struct FrameField {
   // [patch][grid index]; left uninitialized (no zero-fill of 24 B per position): only the coded framed
   // positions of computed steps are written (compute()), and only those are read (frame()).
   std::vector<std::unique_ptr<std::array<std::int64_t, 3>[]>> normals;
+  // Version 6 instead of normals and frames: the coarse grid each framed step's normals come from (kept from
+  // the step's hook; steps starting at one plane share one), and the octahedral cell of a position's normal,
+  // computed when its frame is first needed (kUnsetCell before: most positions of a short prefix need none).
+  struct CellGrid {
+    int sh = 0;                     // grid position (i, j) is (i >> sh, j >> sh) here
+    std::size_t sub = 0;            // samples per row
+    bool bounded = false;           // every sample below 2^27 in magnitude: the differences' bound never acts
+    std::vector<std::int32_t> xyz;  // the samples, three values each
+  };
+  std::vector<std::vector<std::shared_ptr<const CellGrid>>> step_grid;  // [patch][k − 1]
+  std::vector<std::vector<const CellGrid*>> step_grid_ptr;              // the same, for cell_at()
+  mutable std::vector<std::unique_ptr<std::uint16_t[]>> cell;           // [patch][grid index]
   std::vector<std::uint8_t> ready;  // [k − 1]: normals of step k computed
   // Frames built so far (an incremental decoder reconstructs many times from the same normals); an entry is
   // valid where built[p][i] is set (the rest stays uninitialized).
@@ -290,8 +371,12 @@ struct FrameField {
 
   /// The frame at a framed position (built when first needed: only non-zero coefficients need one; the
   /// normal of a position never changes once its step is ready).
-  const Frame& frame(std::size_t p, int idx) const {
+  const Frame& frame(std::size_t p, int idx, int gi, int gj) const {
     const auto i = static_cast<std::size_t>(idx);
+    if (cells) {
+      if (cell[p][i] == kUnsetCell) fill_cells(p, std::countr_zero(static_cast<unsigned>(gi | gj)) + 1);
+      return cell_table[cell[p][i]];
+    }
     if (built[p].empty()) {  // first frame of this patch
       frames[p] = uninitialized_array<Frame>(samples);
       built[p].assign(samples, 0);
@@ -331,7 +416,7 @@ struct FrameField {
           for (int i = odd_row ? 0 : d; i <= m; i += odd_row ? d : 2 * d) {
             const std::size_t idx = line + static_cast<std::size_t>(i);
             if (!coded[idx] || (ch[0][idx] | ch[1][idx] | ch[2][idx]) == 0) continue;
-            const Frame& f = frame(p, static_cast<int>(idx));
+            const Frame& f = frame(p, static_cast<int>(idx), i, j);
             const std::int64_t w0 = ch[0][idx],
                                w1 = std::int64_t{ch[1][idx]} * (std::int64_t{1} << tangential_shift),
                                w2 = std::int64_t{ch[2][idx]} * (std::int64_t{1} << tangential_shift);
@@ -364,6 +449,10 @@ struct FrameField {
     for (const auto& [copy, owner] : own->copies) {
       for (int c = 0; c < 3; ++c)
         w[copy / samples][c][copy % samples] = w[owner / samples][c][owner % samples];
+    }
+    if (cells) {
+      compute_cells(plane, min_k, w);
+      return;
     }
     const int s = 1 << (min_k - 1), sub_level = level - (min_k - 1), sub_steps = steps - (min_k - 1);
     const std::size_t sub = (std::size_t{1} << sub_level) + 1;
@@ -412,14 +501,7 @@ struct FrameField {
             }
             // Differences of garbage (a corrupt stream) can reach 2^33: keep the cross product below 2^63.
             // Never active for streams of this encoder (quantized values < 2^25).
-            for (std::int64_t* v : {a, b}) {
-              const auto largest =
-                  static_cast<std::uint64_t>(std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])}));
-              if (largest >> 30) {  // more than 30 bits
-                const int bits = static_cast<int>(std::bit_width(largest));
-                v[0] >>= bits - 30, v[1] >>= bits - 30, v[2] >>= bits - 30;
-              }
-            }
+            bound_to_30_bits(a), bound_to_30_bits(b);
             out[line + static_cast<std::size_t>(i)] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
                                                        a[0] * b[1] - a[1] * b[0]};
           }
@@ -431,19 +513,115 @@ struct FrameField {
     }
   }
 
+  /// Version 6: the grid at spacing 2^min_k (the coarse grid of step min_k, whose details are all still zero)
+  /// is reconstructed from `w` (xyz, seam copies filled) and kept for the steps starting at `plane`
+  /// (cell_at()).
+  void compute_cells(int plane, int min_k, std::vector<PatchCoefficients>& w) {
+    const std::size_t size = (std::size_t{1} << level) + 1;
+    const int s2 = 1 << min_k, sub_level = level - min_k, sub_steps = steps - min_k;
+    const std::size_t sub = (std::size_t{1} << sub_level) + 1;
+    parallel_for(static_cast<int>(w.size()), max_threads, [&](int pi) {
+      const auto p = static_cast<std::size_t>(pi);
+      auto grid = std::make_shared<CellGrid>();
+      grid->sh = min_k;
+      grid->sub = sub;
+      std::int32_t low = 0, high = 0;
+      grid->xyz.resize(3 * sub * sub);
+      std::vector<std::int32_t> g(sub * sub);
+      for (int c = 0; c < 3; ++c) {
+        for (std::size_t y = 0; y < sub; ++y) {
+          const std::int32_t* src = w[p][c].data() + y * static_cast<std::size_t>(s2) * size;
+          std::int32_t* dst = g.data() + y * sub;
+          for (std::size_t x = 0; x < sub; ++x) dst[x] = src[x * static_cast<std::size_t>(s2)];
+        }
+        if (sub_steps > 0) wavelet_inverse(g, sub_level, sub_steps, filter, update, min_k + 1);
+        for (std::size_t q = 0; q < g.size(); ++q) {
+          low = std::min(low, g[q]), high = std::max(high, g[q]);
+          grid->xyz[3 * q + static_cast<std::size_t>(c)] = g[q];
+        }
+      }
+      // Samples below 2^27 in magnitude (every stream of this encoder) keep the differences below 2^30.
+      grid->bounded = low > -(std::int32_t{1} << 27) && high < (std::int32_t{1} << 27);
+      for (int k = min_k; k <= frame_steps; ++k) {
+        if (start[static_cast<std::size_t>(k - 1)] == plane) {
+          step_grid_ptr[p][static_cast<std::size_t>(k - 1)] = grid.get();
+          step_grid[p][static_cast<std::size_t>(k - 1)] = grid;
+        }
+      }
+    });
+    for (int k = min_k; k <= frame_steps; ++k) {
+      if (start[static_cast<std::size_t>(k - 1)] == plane) ready[static_cast<std::size_t>(k - 1)] = 1;
+    }
+  }
+
+  /// Version 6: the octahedral cells of the normals at the coded details of patch p's ready step k, all at
+  /// once when the first is needed (a short prefix needs none of most steps). The normal at detail (i, j)
+  /// (spacing d = 2^(k−1)) is the cross product of differences of the step's coarse grid around it — across
+  /// the coarse cell's sides for a row detail (odd i / d: (i ± d, j), and the sums of (i − d, ·) and
+  /// (i + d, ·) at rows j ± 2d), mirrored for a column detail, along the cell's sides for a centre detail
+  /// ((i ± d, j ± d)), clamped to the patch on the border.
+  void fill_cells(std::size_t p, int k) const {
+    const CellGrid& grid = *step_grid_ptr[p][static_cast<std::size_t>(k - 1)];
+    const int sh = grid.sh, d = 1 << (k - 1), m = 1 << level;
+    const auto sub = static_cast<std::ptrdiff_t>(grid.sub);
+    const std::size_t size = static_cast<std::size_t>(m) + 1;
+    const std::int32_t* const g = grid.xyz.data();
+    const auto at = [&](int x, int y) {
+      return g + 3 * (static_cast<std::ptrdiff_t>(y >> sh) * sub + (x >> sh));
+    };
+    const std::uint8_t* coded = own->coded[p].data();
+    std::uint16_t* out = cell[p].get();
+    for (int j = 0; j <= m; j += d) {
+      const bool odd_row = (j / d) & 1;
+      const int j0 = std::max(j - 2 * d, 0), j1 = std::min(j + 2 * d, m);
+      const std::size_t line = static_cast<std::size_t>(j) * size;
+      for (int i = odd_row ? 0 : d; i <= m; i += odd_row ? d : 2 * d) {
+        if (!coded[line + static_cast<std::size_t>(i)]) continue;
+        std::int64_t a[3], b[3];
+        if (!odd_row) {  // a row detail: (i ± d, j) are coarse samples
+          const std::int32_t *l = at(i - d, j), *r = at(i + d, j), *ll = at(i - d, j0), *lr = at(i + d, j0),
+                             *ul = at(i - d, j1), *ur = at(i + d, j1);
+          for (int c = 0; c < 3; ++c) {
+            a[c] = std::int64_t{r[c]} - l[c];
+            b[c] = std::int64_t{ul[c]} + ur[c] - ll[c] - lr[c];
+          }
+        } else if (!((i / d) & 1)) {  // a column detail: (i, j ± d) are coarse samples
+          const int i0 = std::max(i - 2 * d, 0), i1 = std::min(i + 2 * d, m);
+          const std::int32_t *lo = at(i, j - d), *hi = at(i, j + d), *ll = at(i0, j - d), *lr = at(i1, j - d),
+                             *ul = at(i0, j + d), *ur = at(i1, j + d);
+          for (int c = 0; c < 3; ++c) {
+            a[c] = std::int64_t{lr[c]} + ur[c] - ll[c] - ul[c];
+            b[c] = std::int64_t{hi[c]} - lo[c];
+          }
+        } else {  // a centre detail: the cell's corners (i ± d, j ± d)
+          const std::int32_t *ll = at(i - d, j - d), *lr = at(i + d, j - d), *ul = at(i - d, j + d),
+                             *ur = at(i + d, j + d);
+          for (int c = 0; c < 3; ++c) {
+            a[c] = std::int64_t{lr[c]} + ur[c] - ll[c] - ul[c];
+            b[c] = std::int64_t{ul[c]} + ur[c] - ll[c] - lr[c];
+          }
+        }
+        // Sums of garbage (a corrupt stream) reach 2^35: keep the cross product below 2^63.
+        if (!grid.bounded) bound_to_30_bits(a), bound_to_30_bits(b);
+        out[line + static_cast<std::size_t>(i)] =
+            octahedral_cell(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]);
+      }
+    }
+  }
+
   /// Encoder: the xyz coefficients of the steps starting at `plane` into their frames (n, t1, t2), the
   /// tangential ones shifted.
   void to_frames(int plane, std::vector<PatchCoefficients>& coefs) const {
     for (std::size_t p = 0; p < coefs.size(); ++p) {
       for (int k = 1; k <= frame_steps; ++k) {
         if (start[static_cast<std::size_t>(k - 1)] != plane) continue;
-        for_step(k, [&](int, int, int idx) {
+        for_step(k, [&](int gi, int gj, int idx) {
           if (!own->coded[p][static_cast<std::size_t>(idx)]) return;
           std::int64_t d[3];
           for (int c = 0; c < 3; ++c)
             d[c] = coefs[p][static_cast<std::size_t>(c)][static_cast<std::size_t>(idx)];
           if (d[0] == 0 && d[1] == 0 && d[2] == 0) return;
-          const Frame& f = frame(p, idx);
+          const Frame& f = frame(p, idx, gi, gj);
           for (int r = 0; r < 3; ++r) {
             const std::int64_t v = static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r)]) * d[0] +
                                    static_cast<std::int64_t>(f[static_cast<std::size_t>(3 * r + 1)]) * d[1] +
@@ -465,14 +643,30 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
   ff.tangential_shift = h.tangential_shift;
   ff.filter = h.filter;
   ff.update = h.lifting_update;
+  ff.cells = h.version >= 6;
+  if (ff.cells) ff.cell_table = cell_frames().data();
   ff.own = &own;
   ff.start = h.frame_start;
   ff.ready.assign(static_cast<std::size_t>(h.frame_steps), 0);
   if (h.frame_steps > 0) {
     const std::size_t size = static_cast<std::size_t>(grid_size(h.level));
     ff.samples = size * size;
-    ff.normals.resize(static_cast<std::size_t>(h.num_patches));
-    for (auto& n : ff.normals) n = uninitialized_array<std::array<std::int64_t, 3>>(ff.samples);
+    if (ff.cells) {
+      ff.cell.resize(static_cast<std::size_t>(h.num_patches));
+      for (auto& c : ff.cell) {
+        c = uninitialized_array<std::uint16_t>(ff.samples);
+        std::fill_n(c.get(), ff.samples, kUnsetCell);
+      }
+      ff.step_grid.assign(
+          static_cast<std::size_t>(h.num_patches),
+          std::vector<std::shared_ptr<const FrameField::CellGrid>>(static_cast<std::size_t>(h.frame_steps)));
+      ff.step_grid_ptr.assign(
+          static_cast<std::size_t>(h.num_patches),
+          std::vector<const FrameField::CellGrid*>(static_cast<std::size_t>(h.frame_steps)));
+    } else {
+      ff.normals.resize(static_cast<std::size_t>(h.num_patches));
+      for (auto& n : ff.normals) n = uninitialized_array<std::array<std::int64_t, 3>>(ff.samples);
+    }
     ff.frames.resize(static_cast<std::size_t>(h.num_patches));
     ff.built.resize(static_cast<std::size_t>(h.num_patches));
   }
@@ -643,7 +837,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   for (auto& pc : coefs) {
     for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter, options.lifting_update);
   }
-  h.version = kHeaderVersion;
+  // Version 6 differs from 5 only in how frames are built: without cell frames the stream is version 5's.
+  h.version = options.cell_frames ? kHeaderVersion : 5;
   h.orientation_weights = options.orientation_weights;
   h.lifting_update = options.lifting_update;
   h.frame_steps = std::min(options.frame_steps, h.steps);

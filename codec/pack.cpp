@@ -552,9 +552,11 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     seams_before = &model.geometry.seams;
     // Pack version v ≤ 3 holds codec headers of version v (1: joint streams, 2: per-patch ones, 3: local
     // frames); version 4 (a container change) those of version 3; version 5 those of versions 3 and 4 (4:
-    // the lifting update); version 6 those of versions 3 to 5 (5: the filter kCubicLong).
+    // the lifting update); versions 6 and 7 those of versions 3 to 5 (5: the filter kCubicLong); version 8
+    // those of versions 3 to 6 (6: cell frames).
     const auto codec_version_ok = [&](int v) {
-      return out.version >= 6   ? v >= 3
+      return out.version >= 8   ? v >= 3
+             : out.version >= 6 ? v >= 3 && v <= 5
              : out.version == 5 ? v == 3 || v == 4
              : out.version == 4 ? v == 3
                                 : v == out.version;

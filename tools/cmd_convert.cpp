@@ -41,6 +41,7 @@ struct ConvertArgs {
   int tangential_shift = ConvertOptions{}.tangential_shift;
   bool no_orientation_weights = false;
   bool no_lifting_update = false;
+  bool no_cell_frames = false;
   bool short_filter = false;
   bool fit = false;
   bool choose_loop = false;  ///< --choose-loop: the plain, tip or end loop, whichever prefixes are closest
@@ -163,6 +164,7 @@ int run_convert(const ConvertArgs& args) {
   options.tangential_shift = args.tangential_shift;
   options.orientation_weights = !args.no_orientation_weights;
   options.lifting_update = !args.no_lifting_update;
+  options.cell_frames = !args.no_cell_frames;
   if (args.short_filter) options.filter = codec::WaveletFilter::kCubic;
   options.fit = args.fit;
   options.up = up;
@@ -374,12 +376,16 @@ CommandRunner add_convert_command(CLI::App& app) {
                 "Weigh row/column and diagonal detail bands alike (ablations)");
   cmd->add_flag("--no-lifting-update", args->no_lifting_update,
                 "Code the geometry with the plain interpolating wavelet, without the update step (ablations; "
-                "the pack is still format 7)");
+                "the pack is still format 8)");
+  cmd->add_flag("--no-cell-frames", args->no_cell_frames,
+                "Build the local frames as pack format 7 did (per sample, from the finest reconstruction) "
+                "instead of from the coarse grid and a table of direction cells (ablations; decodes slower; "
+                "the pack is still format 8)");
   cmd->add_flag(
       "--short-filter", args->short_filter,
       "Code the geometry with pack format 5's 4-point wavelet filter on every step and its 2-tap update, "
       "not the 6-point prediction of the coarser steps and the 4-tap update (ablations; the pack is "
-      "still format 7)");
+      "still format 8)");
   cmd->add_flag("--choose-loop", args->choose_loop,
                 "One mesh, two squares: build the pack with the plain loop, with --tip-loop and with --end-loop "
                 "(each when the mesh has tips) and keep the one whose 2, 4, 8 and 16 KB prefixes are closest to "

@@ -119,6 +119,7 @@ codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::s
   write.geometry.tangential_shift = options.tangential_shift;
   write.geometry.orientation_weights = options.orientation_weights;
   write.geometry.lifting_update = options.lifting_update;
+  write.geometry.cell_frames = options.cell_frames;
   write.geometry.filter = options.filter;
   return write;
 }

@@ -42,6 +42,7 @@ struct ConvertOptions {
   int tangential_shift = codec::GeometryCodecOptions{}.tangential_shift;
   bool orientation_weights = codec::GeometryCodecOptions{}.orientation_weights;
   bool lifting_update = codec::GeometryCodecOptions{}.lifting_update;
+  bool cell_frames = codec::GeometryCodecOptions{}.cell_frames;
   /// The geometry's wavelet filter (kCubicLong by default; kCubic for ablations); the normal-mesh
   /// resampling predicts with the same one.
   codec::WaveletFilter filter = codec::GeometryCodecOptions{}.filter;

@@ -368,6 +368,19 @@ std::uint64_t stream_hash(const EncodedGeometry& enc) {
   return h;
 }
 
+/// FNV-1a over the decoded floats' bits.
+std::uint64_t decoded_hash(const DecodedGeometry& dec) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const auto& g : dec.patches) {
+    for (float f : g.values) {
+      std::uint32_t bits;
+      std::memcpy(&bits, &f, 4);
+      for (int b = 0; b < 4; ++b) h = (h ^ ((bits >> (8 * b)) & 0xFF)) * 1099511628211ull;
+    }
+  }
+  return h;
+}
+
 TEST(GeometryCodec, GoldenStreamIsStable) {
   // Integer-valued input with a power-of-two extent: quantization is exact on every platform, so the stream
   // is a fixed byte string. If this fails after an intended format change, bump the header version
@@ -393,7 +406,8 @@ TEST(GeometryCodec, GoldenStreamIsStable) {
   // update: its 6-point prediction needs six evens on a line of step 3, level 6 and up; the wavelet tests
   // pin it bit for bit). With kCubic the streams are the version-4 encoder's, byte for byte (and without
   // the update the version-3 encoder's): hashed with the header's version set back, they give those
-  // versions' hashes.
+  // versions' hashes. With cell frames (version 6, the default) the framed streams and their decoded values
+  // are pinned as well; without frames a version-6 stream is version 5's.
   for (WaveletFilter filter : {WaveletFilter::kCubic, WaveletFilter::kCubicLong}) {
     const bool long_filter = filter == WaveletFilter::kCubicLong;
     for (bool update : {false, true}) {
@@ -405,6 +419,7 @@ TEST(GeometryCodec, GoldenStreamIsStable) {
         o.tangential_shift = v3_tools ? 1 : 0;
         o.orientation_weights = v3_tools;
         o.lifting_update = update;
+        o.cell_frames = false;
         const auto enc = encode_geometry(patches, {}, o);
         ASSERT_EQ(enc.header.step, 1.0);
         ASSERT_EQ(enc.header.version, 5);
@@ -424,19 +439,38 @@ TEST(GeometryCodec, GoldenStreamIsStable) {
           EXPECT_EQ(dec.patches[0].values, patches[0].values);
           EXPECT_EQ(dec.patches[1].values, patches[1].values);
         } else {
-          std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the decoded floats' bits
-          for (const auto& g : dec.patches) {
-            for (float f : g.values) {
-              std::uint32_t bits;
-              std::memcpy(&bits, &f, 4);
-              for (int b = 0; b < 4; ++b) h = (h ^ ((bits >> (8 * b)) & 0xFF)) * 1099511628211ull;
-            }
-          }
+          const std::uint64_t h = decoded_hash(dec);
           const std::uint64_t decoded = long_filter
                                             ? (update ? 0x0a503fa4de4cad5dull : 0x8cf4e5dd7b017e01ull)
                                             : (update ? 0x89a9c7ab6e577f75ull : 0x8cf4e5dd7b017e01ull);
           EXPECT_EQ(h, decoded) << std::hex << "decoded 0x" << h << " filter " << int(filter) << " update "
                                 << update;
+        }
+        o.cell_frames = true;
+        const auto cells = encode_geometry(patches, {}, o);
+        ASSERT_EQ(cells.header.version, 6);
+        if (!v3_tools) {
+          EXPECT_EQ(cells.segments, enc.segments);
+          continue;
+        }
+        const std::uint64_t expected_cells = long_filter
+                                                 ? (update ? 0x3018602c88b7a8abull : 0xec5c17c30cc23b65ull)
+                                                 : (update ? 0x19e610e817cb4ce7ull : 0x08f72b436a7c2516ull);
+        EXPECT_EQ(stream_hash(cells), expected_cells) << std::hex << "cells 0x" << stream_hash(cells)
+                                                      << " filter " << int(filter) << " update " << update;
+        std::vector<std::span<const std::uint8_t>> cell_segs(cells.segments.begin(), cells.segments.end());
+        ASSERT_EQ(decode_geometry(cells.header, cell_segs, {}, dec), Status::kOk);
+        const std::uint64_t h = decoded_hash(dec);
+        const std::uint64_t decoded_cells = long_filter
+                                                ? (update ? 0xd5b814d41cf2c2c5ull : 0x11f1191808cc0453ull)
+                                                : (update ? 0x6cd410e8a2e69b77ull : 0x11f1191808cc0453ull);
+        EXPECT_EQ(h, decoded_cells) << std::hex << "cells decoded 0x" << h << " filter " << int(filter)
+                                    << " update " << update;
+        // Near-lossless like version 5 (the rotation's rounding, tangential components one plane coarser).
+        // Version 5's largest error here is 6 to 8 steps, version 6's 5 to 8.
+        for (std::size_t p = 0; p < 2; ++p) {
+          for (std::size_t i = 0; i < patches[p].values.size(); ++i)
+            EXPECT_LE(std::abs(dec.patches[p].values[i] - patches[p].values[i]), 8.0f) << p << " " << i;
         }
       }
     }

@@ -629,8 +629,8 @@ TEST(Pack, ManifestByteChangesAreRefusedOrReadAsValid) {
 // The committed golden packs (tests/data/golden-pillow.gip written by format version 1, golden-pillow-v2.gip
 // by version 2, golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by
 // version 5: codec header version 4, the lifting update; golden-pillow-v6.gip by version 6: codec header
-// version 5, the filter kCubicLong; golden-pillow-v7.gip by version 7: compact seam tables) must keep
-// decoding to
+// version 5, the filter kCubicLong; golden-pillow-v7.gip by version 7: compact seam tables;
+// golden-pillow-v8.gip by version 8: codec header version 6, cell frames) must keep decoding to
 // the pillow they were made from: decoders of old streams do not silently change.
 class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
 
@@ -643,7 +643,10 @@ TEST_P(GoldenPack, Decodes) {
   PackInfo info;
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   EXPECT_EQ(info.version, version);
-  EXPECT_EQ(info.models.at(0).geometry.version, version >= 6 ? 5 : version >= 5 ? 4 : std::min(version, 3));
+  EXPECT_EQ(info.models.at(0).geometry.version, version >= 8   ? 6
+                                                : version >= 6 ? 5
+                                                : version >= 5 ? 4
+                                                               : std::min(version, 3));
   EXPECT_EQ(info.models.at(0).geometry.filter, version >= 6 ? WaveletFilter::kCubicLong : WaveletFilter::kCubic);
   EXPECT_EQ(info.models.at(0).geometry.lifting_update, version >= 5);
   const PackDecodeResult r = decode_pack(pack);
@@ -675,7 +678,8 @@ INSTANTIATE_TEST_SUITE_P(Versions, GoldenPack,
                                            std::pair<const char*, int>{"golden-pillow-v4.gip", 4},
                                            std::pair<const char*, int>{"golden-pillow-v5.gip", 5},
                                            std::pair<const char*, int>{"golden-pillow-v6.gip", 6},
-                                           std::pair<const char*, int>{"golden-pillow-v7.gip", 7}));
+                                           std::pair<const char*, int>{"golden-pillow-v7.gip", 7},
+                                           std::pair<const char*, int>{"golden-pillow-v8.gip", 8}));
 
 }  // namespace
 }  // namespace geomip::codec

@@ -361,7 +361,7 @@ struct FrameField {
     std::vector<std::int32_t> xyz;  // the samples, three values each
   };
   std::vector<std::vector<std::shared_ptr<const CellGrid>>> step_grid;  // [patch][k − 1]
-  std::vector<std::vector<const CellGrid*>> step_grid_ptr;              // the same, for cell_at()
+  std::vector<std::vector<const CellGrid*>> step_grid_ptr;              // the same, for fill_cells()
   mutable std::vector<std::unique_ptr<std::uint16_t[]>> cell;           // [patch][grid index]
   std::vector<std::uint8_t> ready;  // [k − 1]: normals of step k computed
   // Frames built so far (an incremental decoder reconstructs many times from the same normals); an entry is
@@ -515,7 +515,7 @@ struct FrameField {
 
   /// Version 6: the grid at spacing 2^min_k (the coarse grid of step min_k, whose details are all still zero)
   /// is reconstructed from `w` (xyz, seam copies filled) and kept for the steps starting at `plane`
-  /// (cell_at()).
+  /// (fill_cells()).
   void compute_cells(int plane, int min_k, std::vector<PatchCoefficients>& w) {
     const std::size_t size = (std::size_t{1} << level) + 1;
     const int s2 = 1 << min_k, sub_level = level - min_k, sub_steps = steps - min_k;
@@ -837,7 +837,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   for (auto& pc : coefs) {
     for (auto& ch : pc) wavelet_forward(ch, level, h.steps, h.filter, options.lifting_update);
   }
-  // Version 6 differs from 5 only in how frames are built: without cell frames the stream is version 5's.
+  // Version 6 differs from 5 only in how frames are built: without cell frames the stream is version 5's (and
+  // a stream without frames, such as a normal map's, is version 5's but for this byte).
   h.version = options.cell_frames ? kHeaderVersion : 5;
   h.orientation_weights = options.orientation_weights;
   h.lifting_update = options.lifting_update;

@@ -186,6 +186,31 @@ TEST(Pack, OtherVersionIsUnsupported) {
   EXPECT_EQ(read_pack_header(pack, end), Status::kUnsupportedVersion);
 }
 
+// Pack formats 6 and 7 hold codec headers of versions 3 to 5 only: a format-8 pack whose cell frames (codec
+// header 6) are relabelled format 7 is refused, the same pack with version 5's frames is a valid format 7.
+TEST(Pack, CellFramesNeedFormat8) {
+  for (const bool cells : {true, false}) {
+    PackWriteOptions o = geometry_only();
+    o.geometry.cell_frames = cells;
+    std::vector<std::uint8_t> pack = write_pack({pillow_model(4, "a")}, o);
+    PackInfo info;
+    ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
+    ASSERT_EQ(info.models.at(0).geometry.version, cells ? 6 : 5);
+    const PackDecodeResult as8 = decode_pack(pack);
+    ASSERT_EQ(as8.status, Status::kOk);
+    ASSERT_EQ(kPackVersion, 8);
+    pack[8] = 7;
+    const PackDecodeResult as7 = decode_pack(pack);
+    if (cells) {
+      EXPECT_EQ(as7.status, Status::kCorrupt);
+      EXPECT_TRUE(as7.models.empty());
+    } else {
+      ASSERT_EQ(as7.status, Status::kOk);
+      EXPECT_EQ(as7.models.at(0).geometry[0].values, as8.models.at(0).geometry[0].values);
+    }
+  }
+}
+
 TEST(Pack, TrailingBytesAreTolerated) {
   const std::vector<std::uint8_t> pack = write_pack({pillow_model(4, "a")});
   std::vector<std::uint8_t> longer = pack;

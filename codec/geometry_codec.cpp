@@ -361,7 +361,6 @@ struct FrameField {
     std::vector<std::int32_t> xyz;  // the samples, three values each
   };
   std::vector<std::vector<std::shared_ptr<const CellGrid>>> step_grid;  // [patch][k − 1]
-  std::vector<std::vector<const CellGrid*>> step_grid_ptr;              // the same, for fill_cells()
   mutable std::vector<std::unique_ptr<std::uint16_t[]>> cell;           // [patch][grid index]
   std::vector<std::uint8_t> ready;  // [k − 1]: normals of step k computed
   // Frames built so far (an incremental decoder reconstructs many times from the same normals); an entry is
@@ -543,10 +542,8 @@ struct FrameField {
       // Samples below 2^27 in magnitude (every stream of this encoder) keep the differences below 2^30.
       grid->bounded = low > -(std::int32_t{1} << 27) && high < (std::int32_t{1} << 27);
       for (int k = min_k; k <= frame_steps; ++k) {
-        if (start[static_cast<std::size_t>(k - 1)] == plane) {
-          step_grid_ptr[p][static_cast<std::size_t>(k - 1)] = grid.get();
+        if (start[static_cast<std::size_t>(k - 1)] == plane)
           step_grid[p][static_cast<std::size_t>(k - 1)] = grid;
-        }
       }
     });
     for (int k = min_k; k <= frame_steps; ++k) {
@@ -561,7 +558,7 @@ struct FrameField {
   /// (i + d, ·) at rows j ± 2d), mirrored for a column detail, along the cell's sides for a centre detail
   /// ((i ± d, j ± d)), clamped to the patch on the border.
   void fill_cells(std::size_t p, int k) const {
-    const CellGrid& grid = *step_grid_ptr[p][static_cast<std::size_t>(k - 1)];
+    const CellGrid& grid = *step_grid[p][static_cast<std::size_t>(k - 1)];
     const int sh = grid.sh, d = 1 << (k - 1), m = 1 << level;
     const auto sub = static_cast<std::ptrdiff_t>(grid.sub);
     const std::size_t size = static_cast<std::size_t>(m) + 1;
@@ -660,9 +657,6 @@ FrameField make_frame_field(const GeometryCodecHeader& h, const Ownership& own) 
       ff.step_grid.assign(
           static_cast<std::size_t>(h.num_patches),
           std::vector<std::shared_ptr<const FrameField::CellGrid>>(static_cast<std::size_t>(h.frame_steps)));
-      ff.step_grid_ptr.assign(
-          static_cast<std::size_t>(h.num_patches),
-          std::vector<const FrameField::CellGrid*>(static_cast<std::size_t>(h.frame_steps)));
     } else {
       ff.normals.resize(static_cast<std::size_t>(h.num_patches));
       for (auto& n : ff.normals) n = uninitialized_array<std::array<std::int64_t, 3>>(ff.samples);

@@ -172,21 +172,7 @@ void store_base(const BaseMesh& b, PatchWork& w) {
   for (std::size_t i = 0; i < b.to_patch.size(); ++i) w.uv[b.to_patch[i]] = b.uv[i];
 }
 
-// One triangle's term of the optimizer's L2 energy, A3·(Γ² + γ²)/2, with its 3D lengths and area measured in
-// the metric m (the cotangent form of stretch_optimization.cpp; m = I gives Σ A3·L2² of triangle_stretch()).
-// +inf for a flipped or degenerate uv triangle.
-double metric_l2_term(const Eigen::Vector3d q[3], const Eigen::Vector2d uv[3], const Eigen::Matrix3d& m) {
-  const Eigen::Vector3d e0 = q[2] - q[1], e1 = q[2] - q[0], e2 = q[1] - q[0];
-  const double len0 = e0.dot(m * e0), len1 = e1.dot(m * e1), len2 = e2.dot(m * e2), g12 = e2.dot(m * e1);
-  const double a3 = 0.5 * std::sqrt(std::max(0.0, len1 * len2 - g12 * g12));
-  const Eigen::Vector2d u1 = uv[1] - uv[0], u2 = uv[2] - uv[0];
-  const double c = u1.x() * u2.y() - u1.y() * u2.x();
-  if (!(c > 0)) return std::numeric_limits<double>::infinity();
-  const double num = len0 * u1.dot(u2) - len1 * u1.dot(u2 - u1) - len2 * u2.dot(u1 - u2);
-  return a3 * 0.5 * num / (c * c);
-}
-
-// Σ of metric_l2_term() over a patch, each triangle in the mean of its corners' tensors: what the stretch
+// Σ of triangle_l2_energy() over a patch, each triangle in the mean of its corners' tensors: what the stretch
 // optimization lowers when it runs in the metric, to compare two parameterizations of the same patch.
 double metric_l2_energy(const std::vector<Eigen::Vector3d>& positions,
                         const std::vector<std::array<int, 3>>& triangles,
@@ -195,7 +181,7 @@ double metric_l2_energy(const std::vector<Eigen::Vector3d>& positions,
   for (const auto& t : triangles) {
     const Eigen::Vector3d q[3] = {positions[t[0]], positions[t[1]], positions[t[2]]};
     const Eigen::Vector2d p[3] = {uv[t[0]], uv[t[1]], uv[t[2]]};
-    e += metric_l2_term(q, p, (metrics[t[0]] + metrics[t[1]] + metrics[t[2]]) / 3.0);
+    e += triangle_l2_energy(q, p, (metrics[t[0]] + metrics[t[1]] + metrics[t[2]]) / 3.0);
   }
   return e;
 }
@@ -323,7 +309,7 @@ void slide_seams(ModelParameterization& m, const std::vector<std::vector<double>
       if (!weights[p].empty()) w = (weights[p][tri[0]] + weights[p][tri[1]] + weights[p][tri[2]]) / 3.0;
       if (!metrics[p].empty()) {
         const Eigen::Matrix3d mt = (metrics[p][tri[0]] + metrics[p][tri[1]] + metrics[p][tri[2]]) / 3.0;
-        e += w * metric_l2_term(q, uv, mt);  // A3·(Γ²+γ²)/2 = A3·L2² in the metric
+        e += w * triangle_l2_energy(q, uv, mt);  // A3·(Γ²+γ²)/2 = A3·L2² in the metric
         continue;
       }
       const double l2 = triangle_stretch(q, uv).l2;

@@ -102,6 +102,13 @@ inline void accumulate(double trace, double twice_a2, double area3, double weigh
   }
 }
 
+/// N = 4·A2²·(Γ²+γ²) in the cotangent form, from the 3D squared lengths opposite corners 0, 1, 2 and the uv
+/// edges u1, u2 leaving corner 0.
+inline double cotangent_numerator(double len0_sq, double len1_sq, double len2_sq, const Eigen::Vector2d& u1,
+                                  const Eigen::Vector2d& u2) {
+  return len0_sq * u1.dot(u2) - len1_sq * u1.dot(u2 - u1) - len2_sq * u2.dot(u1 - u2);
+}
+
 /// E(v) with v at `p` (direct formula; +inf if a ring triangle has uv area <= 0).
 double ring_energy(const Eigen::Vector2d& p, const RingTriangle* ring, std::size_t n, const Weights& w) {
   double sum = 0, max_sq = 0;
@@ -110,7 +117,7 @@ double ring_energy(const Eigen::Vector2d& p, const RingTriangle* ring, std::size
     const Eigen::Vector2d u1 = r.p1 - p, u2 = r.p2 - p;
     const double c = cross2(u1, u2);
     if (!(c > 0)) return kInf;
-    const double num = r.len0_sq * u1.dot(u2) - r.len1_sq * u1.dot(u2 - u1) - r.len2_sq * u2.dot(u1 - u2);
+    const double num = cotangent_numerator(r.len0_sq, r.len1_sq, r.len2_sq, u1, u2);
     accumulate(num / (c * c), c, r.area3, r.area3 * r.weight, w, sum, max_sq);
   }
   return 0.5 * w.l2 * sum + w.linf * max_sq;
@@ -295,6 +302,16 @@ RingScratch& ring_scratch() {
 }
 
 }  // namespace
+
+double triangle_l2_energy(const Eigen::Vector3d q[3], const Eigen::Vector2d uv[3],
+                          const Eigen::Matrix3d& metric) {
+  const TriangleMetric t = triangle_metric(q[0], q[1], q[2], metric);
+  const Eigen::Vector2d u1 = uv[1] - uv[0], u2 = uv[2] - uv[0];
+  const double c = cross2(u1, u2);
+  if (!(c > 0)) return kInf;
+  return t.area3 * 0.5 * cotangent_numerator(t.opposite_sq[0], t.opposite_sq[1], t.opposite_sq[2], u1, u2) /
+         (c * c);
+}
 
 double optimize_vertex(int v, const std::vector<int>& ring, const std::vector<Eigen::Vector3d>& positions,
                        const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,

@@ -93,6 +93,13 @@ double optimize_vertex(int v, const std::vector<int>& ring, const std::vector<Ei
                        const std::vector<std::array<int, 3>>& triangles, std::vector<Eigen::Vector2d>& uv,
                        const VertexOptimizationOptions& options, std::mt19937& rng);
 
+/// One triangle's term of the L2 energy the optimizer lowers, A3·(Γ²+γ²)/2, with its 3D lengths and area
+/// measured in the metric `metric` (VertexOptimizationOptions::vertex_metrics: the mean of the corners'
+/// tensors; the identity gives A3·L2² of triangle_stretch()): to compare two parameterizations of one patch
+/// by what an optimization in that metric lowered. +inf for a flipped or degenerate uv triangle.
+double triangle_l2_energy(const Eigen::Vector3d q[3], const Eigen::Vector2d uv[3],
+                          const Eigen::Matrix3d& metric);
+
 /// sqrt(E(v)) of the current uv (same value optimize_vertex returns), for priorities and tests.
 /// \throw InvalidInput as optimize_vertex.
 double local_stretch(int v, const std::vector<int>& ring, const std::vector<Eigen::Vector3d>& positions,

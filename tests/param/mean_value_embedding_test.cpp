@@ -82,7 +82,9 @@ TEST(SquareBoundaryUv, ChordLengthInAMetric) {
       EXPECT_NEAR(p.x(), s / total, 1e-14) << "vertex " << v;
       EXPECT_EQ(p.y(), 0.0);
     }
-    if (q.x() == 0) EXPECT_NEAR(p.y(), q.y(), 1e-15) << "left side, vertex " << v;
+    if (q.x() == 0) {
+      EXPECT_NEAR(p.y(), q.y(), 1e-15) << "left side, vertex " << v;
+    }
   }
   std::vector<Eigen::Matrix3d> short_metrics(3, Eigen::Matrix3d::Identity());
   EXPECT_THROW(square_boundary_uv(g.positions, sides, &short_metrics), InvalidInput);

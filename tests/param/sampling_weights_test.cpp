@@ -188,7 +188,9 @@ TEST(CurvatureMetric, TheOptimizerGivesALongerDirectionMoreParameterLength) {
   double u_mid = 0, v_shift = 0;
   int n_mid = 0;
   for (std::size_t v = 0; v < uv.size(); ++v) {
-    if (locked[v]) EXPECT_EQ(with_metric[v], uv[v]);
+    if (locked[v]) {
+      EXPECT_EQ(with_metric[v], uv[v]);
+    }
     if (std::abs(m.positions[v].x() - 0.5) < 1e-9 && !locked[v]) u_mid += with_metric[v].x(), ++n_mid;
     v_shift = std::max(v_shift, std::abs(with_metric[v].y() - m.positions[v].y()));
   }

@@ -392,7 +392,8 @@ int normals_shading_report(int argc, char** argv);  // normal_shading_report.cpp
 
 int main(int argc, char** argv) {
   if (argc >= 3 && std::strcmp(argv[1], "--normals") == 0) return normals_report(argc, argv);
-  if (argc == 3 && std::strcmp(argv[1], "--normals-shading") == 0) return normals_shading_report(argc, argv);
+  if ((argc == 3 || argc == 5 || argc == 7) && std::strcmp(argv[1], "--normals-shading") == 0)
+    return normals_shading_report(argc, argv);
   if (argc == 4 && std::strcmp(argv[1], "--decode-once") == 0) return decode_once(argv[2], argv[3]);
   if (argc == 3 && std::strcmp(argv[1], "--draco-decode-once") == 0) return draco_decode_once(argv[2]);
   if (argc == 3 && std::strcmp(argv[1], "--pack") == 0) return pack_report(argv[2]);

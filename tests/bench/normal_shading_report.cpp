@@ -7,6 +7,10 @@
 // packs' normal codec (xyz, B bits), decoded in full or from a byte budget of its stream, and compared at
 // every level-10 texel not in a filled hole. Printed per (L, B): the stream bytes and the mean / p95 angle
 // of the full decode, then at stream budgets; and the uncoded level-L map's own error (interpolation only).
+//
+// codec_bench --normals-shading MESH.obj --patches K --level N: the same on the automatic K-patch layout with
+// level-N geometry (what `geomip convert` moves a stretched shape to: 16 patches, level 7), maps of levels
+// N + 1 (convert's default) and N, the reference at level N + 3.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -82,29 +86,52 @@ void shading_error(const PackModelInput& in, const std::vector<Grid3>& reference
 
 }  // namespace
 
-int normals_shading_report(int /*argc*/, char** argv) {
-  const geomip::tools::PreparedModels models = geomip::tools::prepare_models({argv[2]}, "", "codec_bench", true);
+int normals_shading_report(int argc, char** argv) {
+  int patches = 2, level = 8;
+  for (int a = 3; a + 1 < argc; a += 2) {
+    if (std::strcmp(argv[a], "--patches") == 0)
+      patches = std::atoi(argv[a + 1]);
+    else if (std::strcmp(argv[a], "--level") == 0)
+      level = std::atoi(argv[a + 1]);
+    else {
+      std::fprintf(stderr, "codec_bench --normals-shading MESH [--patches K --level N]\n");
+      return 2;
+    }
+  }
+  if (patches < 2 || level < 2 || level + 2 > kReferenceLevel) {
+    std::fprintf(stderr, "codec_bench --normals-shading: --patches K >= 2, --level N in [2, %d]\n",
+                 kReferenceLevel - 2);
+    return 2;
+  }
+  const int reference_level = std::min(level + 3, kReferenceLevel);
+  const geomip::tools::PreparedModels models =
+      geomip::tools::prepare_models({argv[2]}, "", "codec_bench", true, patches);
   geomip::tools::ConvertOptions options;
   options.keep_inputs = true;
-  options.normal_level = kReferenceLevel;
+  options.level = level;
+  options.normal_level = reference_level;
   const PackModelInput in = geomip::tools::convert_models(models, options).inputs.at(0);
   const std::vector<Grid3>& reference = in.normals;
-  std::printf("%s: shading error against the level-%d normal maps (mean° / p95°)\n", argv[2], kReferenceLevel);
-  std::printf("  %-5s %-4s %9s   %-17s %s\n", "level", "bits", "bytes", "full decode", "stream budgets 10K 20K 40K 80K 160K 320K");
-  for (int level : {9, 8}) {
+  std::printf(
+      "%s, %d patches, geometry level %d: shading error against the level-%d normal maps (mean° / p95°)\n",
+      argv[2], patches, level, reference_level);
+  std::printf("  %-5s %-4s %9s   %-17s %s\n", "level", "bits", "bytes", "full decode",
+              "stream budgets 10K 20K 40K 80K 160K 320K 640K");
+  for (int map_level : {level + 1, level}) {
     std::vector<Grid3> maps;
-    for (const Grid3& g : reference) maps.push_back(subsample(g, level));
+    for (const Grid3& g : reference) maps.push_back(subsample(g, map_level));
     double mean = 0, p95 = 0;
     shading_error(in, reference, maps, mean, p95);
-    std::printf("  %-5d %-4s %9s   %6.3f / %6.3f   (uncoded)\n", level, "-", "-", mean, p95);
+    std::printf("  %-5d %-4s %9s   %6.3f / %6.3f   (uncoded)\n", map_level, "-", "-", mean, p95);
     for (int bits : {10, 9, 8, 7, 6}) {
       GeometryCodecOptions codec = PackWriteOptions{}.normal_codec;
       codec.quantization_bits = bits;
       const EncodedGeometry e = encode_geometry(maps, in.seams, codec);
       const std::size_t total = stream_bytes(e);
-      std::printf("  %-5d %-4d %9zu  ", level, bits, total);
-      for (std::size_t budget : {std::size_t{0}, std::size_t{10000}, std::size_t{20000}, std::size_t{40000},
-                                 std::size_t{80000}, std::size_t{160000}, std::size_t{320000}}) {
+      std::printf("  %-5d %-4d %9zu  ", map_level, bits, total);
+      for (std::size_t budget :
+           {std::size_t{0}, std::size_t{10000}, std::size_t{20000}, std::size_t{40000}, std::size_t{80000},
+            std::size_t{160000}, std::size_t{320000}, std::size_t{640000}}) {
         if (budget >= total) break;
         std::vector<Grid3> decoded = decode_budget(e, budget == 0 ? total : budget);
         for (Grid3& g : decoded)

@@ -31,6 +31,7 @@ struct ConvertArgs {
   bool level_given = false;  ///< --level on the command line; else default_grid_level() of the layout
   int normal_level = -1;
   int quantization_bits = 14;
+  int normal_bits = ConvertOptions{}.normal_bits;
   int hole_mask_level = -1;
   bool no_normals = false;
   int normal_mesh_steps = ConvertOptions{}.normal_mesh_steps;
@@ -38,6 +39,7 @@ struct ConvertArgs {
   int normal_mesh_guard = ConvertOptions{}.normal_mesh_fold_guard;
   int frame_steps = ConvertOptions{}.frame_steps;
   bool frame_steps_given = false;  ///< --frame-steps on the command line
+  bool normal_bits_given = false;  ///< --normal-bits on the command line
   int tangential_shift = ConvertOptions{}.tangential_shift;
   bool no_orientation_weights = false;
   bool no_lifting_update = false;
@@ -105,6 +107,11 @@ int run_convert(const ConvertArgs& args) {
   check_level_options(args, level);
   if (args.quantization_bits < 8 || args.quantization_bits > 24)
     throw InvalidInput("--bits " + std::to_string(args.quantization_bits) + " is outside [8, 24]");
+  if (args.normal_bits < 6 || args.normal_bits > 16)
+    throw InvalidInput("--normal-bits " + std::to_string(args.normal_bits) + " is outside [6, 16]");
+  if (args.no_normals && args.normal_bits_given)
+    throw InvalidInput(
+        "--normal-bits sets the normal maps' quantization, and --no-normals writes none: drop one");
   if (args.tangential_shift < 0 || args.tangential_shift > 8)
     throw InvalidInput("--tangential-shift " + std::to_string(args.tangential_shift) + " is outside [0, 8]");
   if (args.normal_mesh_steps > 0 && (args.common.meshes.size() > 1 || !args.common.points.empty()))
@@ -152,6 +159,7 @@ int run_convert(const ConvertArgs& args) {
   options.normal_level = args.normal_level;
   options.normals = !args.no_normals;
   options.quantization_bits = args.quantization_bits;
+  options.normal_bits = args.normal_bits;
   options.hole_mask_level = args.hole_mask_level;
   options.sampling_exponent = args.common.sampling_exponent;
   options.curvature_metric = args.common.curvature_metric;
@@ -345,6 +353,10 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
   cmd->add_option("--bits", args->quantization_bits,
                   "Position quantization bits over the largest bounding-box extent (default 14)");
+  CLI::Option* normal_bits = cmd->add_option(
+      "--normal-bits", args->normal_bits,
+      "Normal-map quantization bits in [6, 16] (default 10; each bit fewer: about 0.8x the normal "
+      "bytes of the whole pack and a coarser shading; streamed prefixes hardly change)");
   cmd->add_option("--hole-mask-level", args->hole_mask_level,
                   "Grid level of the mask of filled holes (default: N; coarser costs fewer bytes)");
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack (for rate–distortion comparisons)");
@@ -410,9 +422,10 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "camera): +x, -x, +y, -y, +z or -z, across the up axis. Default: from the first model's "
                   "shape (docs/streaming.md, \"Upright and front\")")
       ->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
-  return [args, level, frame_steps] {
+  return [args, level, frame_steps, normal_bits] {
     args->level_given = level->count() > 0;
     args->frame_steps_given = frame_steps->count() > 0;
+    args->normal_bits_given = normal_bits->count() > 0;
     return run_convert(*args);
   };
 }

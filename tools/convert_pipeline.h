@@ -34,6 +34,11 @@ struct ConvertOptions {
   int normal_level = -1;      ///< normal map level (-1: N+1, at most 10)
   bool normals = true;        ///< false: geometry-only pack
   int quantization_bits = 14; ///< position quantization over the largest bounding-box extent
+  /// Normal-map quantization bits over the largest extent of the normals' components
+  /// (codec::PackWriteOptions:: normal_codec; 10 by default). Each bit fewer costs about 0.8× the normal
+  /// bytes of a whole pack and raises its shading error (docs/codec-v3.md, "Shading error" and "Normal maps
+  /// of a shape moved to 16 patches"); a streamed prefix is hardly affected (the bottom planes come last).
+  int normal_bits = codec::PackWriteOptions{}.normal_codec.quantization_bits;
   /// Codec tools of the geometry stream (codec::GeometryCodecOptions: local frames of the finest
   /// frame_steps wavelet steps, their tangential components 2^tangential_shift coarser, orientation
   /// weights, the wavelet's lifting update). The defaults are the codec's; the switches exist for ablations

@@ -26,6 +26,8 @@ struct EncodeArgs {
   std::vector<std::string> inputs;
   std::string output;
   int quantization_bits = 14;
+  int normal_bits = codec::PackWriteOptions{}.normal_codec.quantization_bits;
+  bool normal_bits_given = false;
   bool no_normals = false;
   bool json = false;
   bool quiet = false;
@@ -91,6 +93,11 @@ int run_encode(const EncodeArgs& args) {
   check_output_file(args.output);
   if (args.quantization_bits < 8 || args.quantization_bits > 24)
     throw InvalidInput("--bits " + std::to_string(args.quantization_bits) + " is outside [8, 24]");
+  if (args.normal_bits < 6 || args.normal_bits > 16)
+    throw InvalidInput("--normal-bits " + std::to_string(args.normal_bits) + " is outside [6, 16]");
+  if (args.no_normals && args.normal_bits_given)
+    throw InvalidInput(
+        "--normal-bits sets the normal maps' quantization, and --no-normals writes none: drop one");
   std::vector<codec::PackModelInput> models;
   bool any_normals = false;
   for (const std::string& path : geometry_files(args.inputs)) {
@@ -102,6 +109,7 @@ int run_encode(const EncodeArgs& args) {
   codec::PackWriteOptions write;
   write.normals = !args.no_normals;
   write.geometry.quantization_bits = args.quantization_bits;
+  write.normal_codec.quantization_bits = args.normal_bits;
   if (!models.empty()) write.geometry.joint_bytes = geometry_joint_bytes(models.front().geometry.size());
   std::vector<std::uint8_t> pack;
   try {
@@ -144,10 +152,16 @@ CommandRunner add_encode_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "Output pack file (.gip)")->required();
   cmd->add_option("--bits", args->quantization_bits,
                   "Position quantization bits over the largest bounding-box extent (default 14)");
+  CLI::Option* normal_bits =
+      cmd->add_option("--normal-bits", args->normal_bits,
+                      "Normal-map quantization bits in [6, 16] (default 10), as in convert");
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack");
   cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No report");
-  return [args] { return run_encode(*args); };
+  return [args, normal_bits] {
+    args->normal_bits_given = normal_bits->count() > 0;
+    return run_encode(*args);
+  };
 }
 
 }  // namespace geomip::tools

@@ -1542,6 +1542,13 @@ TEST_F(CliPack, EncodeFromGimageDirectory) {
   const Outcome d = geomip("decode -q '" + dir_ + "/x.gip' -o '" + dir_ + "/x.obj'");
   ASSERT_EQ(d.exit_code, 0) << d.err;
   EXPECT_EQ(read_mesh(dir_ + "/x.obj").triangles.size(), 2u * 2 * 16 * 16);
+  // --normal-bits as in convert: a coarser normal quantization, a smaller pack; out of range exits 2.
+  ASSERT_EQ(geomip("encode -q '" + dir_ + "/gi' --normal-bits 7 -o '" + dir_ + "/x7.gip'").exit_code, 0);
+  EXPECT_LT(fs::file_size(dir_ + "/x7.gip"), fs::file_size(dir_ + "/x.gip") * 9 / 10);
+  expect_bad_input("encode -q '" + dir_ + "/gi' --normal-bits 20 -o '" + dir_ + "/bad.gip'", "--normal-bits");
+  expect_bad_input("encode -q '" + dir_ + "/gi' --normal-bits 8 --no-normals -o '" + dir_ + "/bad.gip'",
+                   "--normal-bits");
+  EXPECT_FALSE(fs::exists(dir_ + "/bad.gip"));
 }
 
 // Issue #13: `decode --bytes N` before the first level of detail used to write a 262,144-face mesh of zero

@@ -105,13 +105,8 @@ int run_convert(const ConvertArgs& args) {
   int level =
       args.level_given ? args.level : default_grid_level(static_cast<std::size_t>(args.common.patches));
   check_level_options(args, level);
-  if (args.quantization_bits < 8 || args.quantization_bits > 24)
-    throw InvalidInput("--bits " + std::to_string(args.quantization_bits) + " is outside [8, 24]");
-  if (args.normal_bits < 6 || args.normal_bits > 16)
-    throw InvalidInput("--normal-bits " + std::to_string(args.normal_bits) + " is outside [6, 16]");
-  if (args.no_normals && args.normal_bits_given)
-    throw InvalidInput(
-        "--normal-bits sets the normal maps' quantization, and --no-normals writes none: drop one");
+  check_quantization_switches(args.quantization_bits, args.normal_bits, args.normal_bits_given,
+                              args.no_normals);
   if (args.tangential_shift < 0 || args.tangential_shift > 8)
     throw InvalidInput("--tangential-shift " + std::to_string(args.tangential_shift) + " is outside [0, 8]");
   if (args.normal_mesh_steps > 0 && (args.common.meshes.size() > 1 || !args.common.points.empty()))

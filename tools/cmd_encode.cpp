@@ -91,13 +91,8 @@ GeometryImages load_images(const std::string& geometry_path, bool normals, std::
 int run_encode(const EncodeArgs& args) {
   check_pack_output_name(args.output);
   check_output_file(args.output);
-  if (args.quantization_bits < 8 || args.quantization_bits > 24)
-    throw InvalidInput("--bits " + std::to_string(args.quantization_bits) + " is outside [8, 24]");
-  if (args.normal_bits < 6 || args.normal_bits > 16)
-    throw InvalidInput("--normal-bits " + std::to_string(args.normal_bits) + " is outside [6, 16]");
-  if (args.no_normals && args.normal_bits_given)
-    throw InvalidInput(
-        "--normal-bits sets the normal maps' quantization, and --no-normals writes none: drop one");
+  check_quantization_switches(args.quantization_bits, args.normal_bits, args.normal_bits_given,
+                              args.no_normals);
   std::vector<codec::PackModelInput> models;
   bool any_normals = false;
   for (const std::string& path : geometry_files(args.inputs)) {

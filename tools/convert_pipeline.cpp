@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <string>
 #include <utility>
 
 namespace geomip::tools {
@@ -123,6 +124,15 @@ codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::s
   write.geometry.cell_frames = options.cell_frames;
   write.geometry.filter = options.filter;
   return write;
+}
+
+void check_quantization_switches(int bits, int normal_bits, bool normal_bits_given, bool no_normals) {
+  if (bits < 8 || bits > 24) throw InvalidInput("--bits " + std::to_string(bits) + " is outside [8, 24]");
+  if (normal_bits < 6 || normal_bits > 16)
+    throw InvalidInput("--normal-bits " + std::to_string(normal_bits) + " is outside [6, 16]");
+  if (no_normals && normal_bits_given)
+    throw InvalidInput(
+        "--normal-bits sets the normal maps' quantization, and --no-normals writes none: drop one");
 }
 
 int default_grid_level(std::size_t patches) {

@@ -151,6 +151,10 @@ std::size_t geometry_joint_bytes(std::size_t patches);
 /// quantization, normals, geometry_joint_bytes()).
 codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::size_t patches);
 
+/// The quantization switches of `convert` and `encode`: --bits in [8, 24], --normal-bits in [6, 16] and not
+/// given together with --no-normals. \throw InvalidInput naming the switch.
+void check_quantization_switches(int bits, int normal_bits, bool normal_bits_given, bool no_normals);
+
 /// \throw InvalidInput / SolverFailure from the parameterization; std::invalid_argument never escapes (the
 /// images come from resample_geometry()).
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options);

@@ -10,7 +10,7 @@
 //
 // codec_bench --normals-shading MESH.obj --patches K --level N: the same on the automatic K-patch layout with
 // level-N geometry (what `geomip convert` moves a stretched shape to: 16 patches, level 7), maps of levels
-// N + 1 (convert's default) and N, the reference at level N + 3.
+// N + 1 (convert's default) and N, the reference at level min(N + 3, 10).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

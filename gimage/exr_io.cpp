@@ -137,10 +137,20 @@ std::vector<GeometryImage> finest_grids(const GeometryImageFile& file) {
   for (std::size_t p = 0; p < file.parts.size(); ++p) {
     GeometryImage g;
     g.level = file.info.level;
-    if (g.level < 0 || g.level > kMaxGeometryImageLevel || file.parts[p].empty() ||
-        file.parts[p][0].width != g.size() || file.parts[p][0].height != g.size()) {
-      throw InvalidInput("finest_grids: part " + std::to_string(p) + " is not a (2^" +
-                         std::to_string(g.level) + "+1)² grid");
+    if (g.level < 0 || g.level > kMaxGeometryImageLevel)
+      throw InvalidInput("geomip:level " + std::to_string(g.level) + " is outside [0, " +
+                         std::to_string(kMaxGeometryImageLevel) + "]");
+    if (file.parts[p].empty() || file.parts[p][0].width != g.size() || file.parts[p][0].height != g.size()) {
+      // Name what the file holds: an EXR of another tool has no geomip:level (0 then), a crafted one a wrong
+      // one.
+      const std::string texels = file.parts[p].empty()
+                                     ? std::string("empty")
+                                     : std::to_string(file.parts[p][0].width) + "×" +
+                                           std::to_string(file.parts[p][0].height) + " texels";
+      throw InvalidInput("part " + std::to_string(p) + " is " + texels + ", but the file's geomip:level " +
+                         std::to_string(g.level) + " needs (2^" + std::to_string(g.level) +
+                         "+1)² = " + std::to_string(g.size()) + "×" + std::to_string(g.size()) +
+                         " (not a geometry image written by geomip gimage?)");
     }
     g.values = file.parts[p][0].rgb;
     grids.push_back(std::move(g));
@@ -191,8 +201,8 @@ GeometryImageFile read_geometry_image_exr(const std::string& path) {
   constexpr long long kMaxSide = (1 << kMaxGeometryImageLevel) + 1;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
-    throw IoError("read_geometry_image_exr: " + path + ": " +
-                  (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file"));
+    throw InvalidInput(path + ": " +
+                       (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file"));
   }
   GeometryImageFile file;
   try {
@@ -219,14 +229,14 @@ GeometryImageFile read_geometry_image_exr(const std::string& path) {
       for (auto c = h.channels().begin(); c != h.channels().end(); ++c) ++channels;
       if (channels != 3 || !h.channels().findChannel("R") || !h.channels().findChannel("G") ||
           !h.channels().findChannel("B")) {
-        throw InvalidInput("read_geometry_image_exr: " + path + ": part " + std::to_string(s) + " has " +
-                           std::to_string(channels) + " channels, expected R, G, B");
+        throw InvalidInput(path + ": part " + std::to_string(s) + " has " + std::to_string(channels) +
+                           " channels, expected R, G, B");
       }
       auto read_level = [&](const Imath::Box2i& window, auto&& read) {
         const long long w = 1LL + window.max.x - window.min.x, hgt = 1LL + window.max.y - window.min.y;
         if (w < 1 || hgt < 1 || w > kMaxSide || hgt > kMaxSide) {
-          throw InvalidInput("read_geometry_image_exr: " + path + ": part " + std::to_string(s) + " is " +
-                             std::to_string(w) + "×" + std::to_string(hgt) + " texels, more than a level-" +
+          throw InvalidInput(path + ": part " + std::to_string(s) + " is " + std::to_string(w) + "×" +
+                             std::to_string(hgt) + " texels, more than a level-" +
                              std::to_string(kMaxGeometryImageLevel) + " geometry image");
         }
         ExrMipLevel level;
@@ -267,10 +277,10 @@ GeometryImageFile read_geometry_image_exr(const std::string& path) {
     }
   } catch (const Error&) {
     throw;
-  } catch (const std::exception& e) {
-    throw IoError("read_geometry_image_exr: " + path + ": " + e.what());
+  } catch (const std::exception& e) {  // OpenEXR refusing the bytes: the file is not a readable EXR
+    throw InvalidInput(path + ": not a readable EXR image (" + e.what() + ")");
   }
-  if (file.parts.empty()) throw IoError("read_geometry_image_exr: " + path + ": no image in the file");
+  if (file.parts.empty()) throw InvalidInput(path + ": no image in the file");
   return file;
 }
 

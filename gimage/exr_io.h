@@ -66,13 +66,16 @@ struct GeometryImageFile {
 /// EXR whose parts have channels R, G, B: tiled parts give every MIP level, scanline parts one level).
 /// Attributes that are absent keep GeometryImageFileInfo's defaults. No level larger than a
 /// level-kMaxGeometryImageLevel image is allocated.
-/// \throw IoError when the file is missing, not a regular file, not an EXR or cannot be read (OpenEXR's
-///   message included); InvalidInput when a part's channels are not R, G, B, a level is larger than that
-///   bound, or the adjacency attribute is malformed.
+/// \throw InvalidInput (the user's file: exit 2 in the tools) when the file is missing, not a regular file,
+/// not
+///   an EXR or cannot be read (OpenEXR's message included: truncated or garbage bytes), holds no image, a
+///   part's channels are not R, G, B, a level is larger than that bound, or the adjacency attribute is
+///   malformed.
 GeometryImageFile read_geometry_image_exr(const std::string& path);
 
 /// The finest MIP level of every part of `file` as GeometryImages (what write_geometry_image_exr() wrote).
-/// \throw InvalidInput when a part's finest level is not square of size 2^n + 1 for the file's level n.
+/// \throw InvalidInput when the file's level n is outside [0, kMaxGeometryImageLevel] or a part's finest
+/// level is not square of size 2^n + 1 (the message names both sizes).
 std::vector<GeometryImage> finest_grids(const GeometryImageFile& file);
 
 /// The nested grid of `image` at a coarser level: every 2^(image.level − level)-th sample.

@@ -1093,6 +1093,8 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (ext == "stl" || ext == "stla" || ext == "stlb") return MeshFormat::kStl;
   if (ext == "gltf") return MeshFormat::kGltf;
   if (ext == "glb") return MeshFormat::kGlb;
+  if (ext.empty())
+    throw InvalidInput(path + ": no file extension (geomip reads .obj .ply .off .stl .gltf .glb)");
   throw InvalidInput(path + ": unsupported mesh format '." + ext + "' (geomip reads .obj .ply .off .stl .gltf .glb)");
 }
 

@@ -154,6 +154,22 @@ std::string check_options_against_pack(const Options& opt, const geomip::codec::
            "'s finest grid level is " + std::to_string(finest);
   if (opt.morph && models < 2)
     return "--morph needs at least 2 models; the pack has 1";
+  // A morph between models of different layouts cannot be drawn (the renderer would show the source alone):
+  // an option that cannot be honoured is an error, as `geomip morph` says for the same pack.
+  auto layout_differs = [&](int a, int b) {
+    const auto& ga = info.models[static_cast<std::size_t>(a)].geometry;
+    const auto& gb = info.models[static_cast<std::size_t>(b)].geometry;
+    return ga.level != gb.level || ga.num_patches != gb.num_patches;
+  };
+  if (opt.morph && layout_differs(opt.model, (opt.model + 1) % models))
+    return "--morph: models " + std::to_string(opt.model) + " and " +
+           std::to_string((opt.model + 1) % models) +
+           " do not share a patch layout (a consistent pack comes from geomip convert --points)";
+  if (opt.animate)
+    for (int m = 0; m + 1 < models; ++m)
+      if (layout_differs(m, m + 1))
+        return "--animate: models " + std::to_string(m) + " and " + std::to_string(m + 1) +
+               " do not share a patch layout (a consistent pack comes from geomip convert --points)";
   return {};
 }
 
@@ -316,6 +332,9 @@ int run(const Options& opt) {
           o << "timed out after " << opt.timeout << " s waiting for the pack (" << source.received() << " of "
             << (source.total() ? std::to_string(source.total()) : std::string("?")) << " bytes received)";
           timed_out = o.str();
+          // Exit 3 keeps the last complete level shown: it is written too (--screenshot), as for a pack that
+          // ends early.
+          if (have_models) last_pixels = target.read_rgb();
           break;
         } else if (!have_models) {
           std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -408,8 +427,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Validator(
           [](std::string& v) {
             float t = 0;
-            return CLI::detail::lexical_cast(v, t) && t >= 0.0f && t <= 1.0f ? std::string()
-                                                                               : "t = " + v + " is outside [0, 1]";
+            if (!CLI::detail::lexical_cast(v, t) || !std::isfinite(t)) return "t = " + v + " is not a number";
+            return t >= 0.0f && t <= 1.0f ? std::string() : "t = " + v + " is outside [0, 1]";
           },
           "in [0,1]"));
   app.add_option("--schedule", opt.schedule, "morph schedule")->check(CLI::IsMember({"linear", "wavelet"}));
@@ -426,10 +445,13 @@ int main(int argc, char** argv) {
       ->check(positive("a frame count"));
   app.add_option("--width", opt.width, "framebuffer width")->check(CLI::Range(16, 8192));
   app.add_option("--height", opt.height, "framebuffer height")->check(CLI::Range(16, 8192));
-  app.add_option("--screenshot", opt.screenshot, "headless: write the last frame as PNG");
+  // A window left open never writes its last frame: the headless options need --frames (exit 2 otherwise).
+  app.add_option("--screenshot", opt.screenshot, "headless (needs --frames): write the last frame as PNG")
+      ->needs("--frames");
   app.add_option("--first-screenshot", opt.first_screenshot,
                  "write the first frame that shows a model (streaming: the coarsest level) as PNG");
-  app.add_flag("--bench", opt.bench, "headless: print ms/frame and the decoding's time");
+  app.add_flag("--bench", opt.bench, "headless (needs --frames): print ms/frame and the decoding's time")
+      ->needs("--frames");
   app.add_flag("--decode-each-prefix", opt.decode_each_prefix,
                "for measurements: decode every received prefix from scratch (the viewer before incremental "
                "decoding) instead of each byte once");

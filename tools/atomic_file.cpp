@@ -1,10 +1,13 @@
 #include "tools/atomic_file.h"
 
+#include "codec/status.h"
 #include "mesh/errors.h"
 #include "mesh/mesh_io.h"
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -18,8 +21,47 @@ void check_output_file(const std::string& path) {
   fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
   std::error_code ec;
-  if (!fs::is_directory(dir, ec))  // the user's path, not a failure of the machine: exit 2
-    throw InvalidInput(path + ": output directory '" + dir.string() + "' does not exist");
+  if (fs::is_directory(path, ec)) throw InvalidInput(path + ": is a directory, not a file to write");
+  if (!fs::is_directory(dir, ec)) {  // the user's path, not a failure of the machine: exit 2
+    throw InvalidInput(path + ": output directory '" + dir.string() + "' " +
+                       (fs::exists(dir, ec) ? "is not a directory" : "does not exist"));
+  }
+  // Found now, not after minutes of work when the temporary file cannot be created.
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw InvalidInput(path + ": output directory '" + dir.string() + "' is not writable");
+}
+
+void check_output_is_not_an_input(const std::string& path, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return;
+  for (const std::string& input : inputs) {
+    if (fs::exists(input, ec) && fs::equivalent(path, input, ec))
+      throw InvalidInput("-o " + path + " is the input " + input + ": writing it would destroy the input");
+  }
+}
+
+std::vector<std::string> model_file_names(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::string name = codec::one_line(names[i], 120);  // control bytes and invalid UTF-8 → '?'
+    for (char& c : name)
+      if (c == '/' || c == '\\' || c == '?') c = '_';
+    if (name.empty() || name == "." || name == "..") name = "model" + std::to_string(i);
+    // Unique among those before it (a literal "spot-1" before a second "spot" is stepped over too).
+    std::string unique = name;
+    for (int k = 0; std::find(out.begin(), out.end(), unique) != out.end(); ++k) {
+      unique = name;
+      unique += '-';
+      unique += std::to_string(i);
+      if (k > 0) {
+        unique += '-';
+        unique += std::to_string(k);
+      }
+    }
+    out.push_back(unique);
+  }
+  return out;
 }
 
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
@@ -83,6 +125,11 @@ void check_pack_output_name(const std::string& path) {
   if (mesh_name)
     throw InvalidInput("-o " + path +
                        ": this writes a .gip pack, not a mesh; name it .gip (geomip decode writes meshes)");
+  // Nor like a geometry image: `encode DIR -o DIR/x.geometry.exr` would replace its own input.
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".exr")
+    throw InvalidInput("-o " + path + ": this writes a .gip pack, not an EXR image; name it .gip");
 }
 
 }  // namespace geomip::tools

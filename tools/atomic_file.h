@@ -5,6 +5,7 @@
 #include <functional>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace geomip::tools {
 
@@ -14,13 +15,24 @@ namespace geomip::tools {
 /// \throw IoError when the directory is not writable or the disk is full.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
-/// Checks, before any work, that a pack output is not named like a mesh (x.obj, x.glb, ...): a .gip pack
-/// under a mesh's extension would be opened as a mesh by other tools. \throw InvalidInput naming `path`.
+/// Checks, before any work, that a pack output is not named like a mesh (x.obj, x.glb, ...) or an EXR image:
+/// a .gip pack under such an extension would be opened as one by other tools. \throw InvalidInput naming
+/// `path`.
 void check_pack_output_name(const std::string& path);
 
-/// Checks, before any work, that `path` can be written: not empty, its directory exists.
-/// \throw InvalidInput naming the missing directory.
+/// Checks, before any work, that `path` can be written: not empty, not an existing directory, its directory
+/// exists, is a directory and is writable. \throw InvalidInput naming what is in the way.
 void check_output_file(const std::string& path);
+
+/// Checks, before any work, that the output `path` is none of `inputs` (the same file under any name): an
+/// output written over an input would destroy the data it came from. Inputs that do not exist are skipped.
+/// \throw InvalidInput naming both.
+void check_output_is_not_an_input(const std::string& path, const std::vector<std::string>& inputs);
+
+/// File-name parts for models whose names come from files (a pack's manifest, a mesh's stem): each name made
+/// safe (no '/', '\\', control bytes or invalid UTF-8, which become '_'; "", "." and ".." become "model<i>")
+/// and made unique (a repeated name gets "-<i>", i its index), in the order given.
+std::vector<std::string> model_file_names(const std::vector<std::string>& names);
 
 /// Checks, before any work, that `dir` can be made an output directory: not empty, and neither it nor a
 /// parent exists as something other than a directory.

@@ -291,7 +291,7 @@ int run_convert(const ConvertArgs& args) {
                                      ? nlohmann::json(converted.two_squares_l2_stretch)
                                      : nlohmann::json(nullptr)},
                                 {"seconds", seconds_since(t_start)}}
-                     .dump(2)
+                     .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
   } else if (report) {
     std::printf("convert %zu model(s) → %s: %zu bytes (header and manifest %zu, %zu chunks), level %d%s\n",
@@ -353,7 +353,9 @@ CommandRunner add_convert_command(CLI::App& app) {
       "Normal-map quantization bits in [6, 16] (default 10; each bit fewer: about 0.8x the normal "
       "bytes of the whole pack and a coarser shading; streamed prefixes hardly change)");
   cmd->add_option("--hole-mask-level", args->hole_mask_level,
-                  "Grid level of the mask of filled holes (default: N; coarser costs fewer bytes)");
+                  "Grid level in [0, 10] of the mask of filled holes (default: N; coarser costs fewer bytes; "
+                  "one above the grid level N is taken as N)")
+      ->check(CLI::Range(0, 10));
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack (for rate–distortion comparisons)");
   cmd->add_option("--normal-mesh", args->normal_mesh_steps,
                   "Normal-mesh resampling: move the samples of the finest STEPS wavelet steps onto the surface "

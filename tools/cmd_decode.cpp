@@ -1,13 +1,14 @@
 // geomip decode PACK [--bytes N] [--level K] [--draco[=BITS]] -o MESH: decodes a .gip pack (or only its first
 // N bytes, as if only they had arrived) and writes each model as a mesh (glTF optionally Draco-compressed).
 #include "codec/pack.h"
+#include "codec/status.h"
 #include "mesh/errors.h"
 #include "mesh/gltf_io.h"
 #include "mesh/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
-#include "tools/pack_models.h"
 #include "tools/pack_file.h"
+#include "tools/pack_models.h"
 
 #include <nlohmann/json.hpp>
 
@@ -57,12 +58,14 @@ MeshFormat format_of(const std::string& path) {
 
 int run_decode(const DecodeArgs& args) {
   check_output_file(args.output);
+  check_output_is_not_an_input(args.output, {args.pack});
   const MeshFormat format = format_of(args.output);
   const bool gltf = format == MeshFormat::kGltf || format == MeshFormat::kGlb;
   if (args.draco != 0 && !gltf)
     throw InvalidInput("--draco compresses glTF output: -o must end in .glb or .gltf, not " + args.output);
   if (args.draco < 0 || args.draco > 30)
-    throw InvalidInput("--draco=" + std::to_string(args.draco) + ": position bits must be in 1..30");
+    throw InvalidInput((args.draco < 0 ? std::string("--draco") : "--draco=" + std::to_string(args.draco)) +
+                       ": position bits must be in 1..30");
   const std::vector<std::uint8_t> bytes = read_pack_file(args.pack);
   std::size_t manifest_end = 0;
   const codec::Status header = codec::read_pack_header(bytes, manifest_end);
@@ -88,15 +91,22 @@ int run_decode(const DecodeArgs& args) {
                  : std::string()) +
           ")");
     }
+    if (manifest_end == 0)  // the fixed header itself is cut: its manifest size is not known yet
+      throw InvalidInput(args.pack + ": the pack is truncated inside its header (the file has " +
+                         std::to_string(bytes.size()) + " bytes)");
     throw InvalidInput(args.pack + ": the pack is truncated inside its manifest (the file has " +
                        std::to_string(bytes.size()) + " bytes, the manifest alone needs " +
                        std::to_string(manifest_end) + ")");
   }
   if (decoded.status == codec::Status::kTruncated && !prefix_asked) {
-    throw InvalidInput(args.pack + ": the pack is truncated (" + std::to_string(bytes.size()) + " of " +
-                       std::to_string(decoded.info.file_size()) +
-                       " bytes); to decode the coarser model it holds, ask for it with --bytes " +
-                       std::to_string(bytes.size()));
+    const std::uint64_t first = first_level_bytes(decoded.info);
+    throw InvalidInput(
+        args.pack + ": the pack is truncated (" + std::to_string(bytes.size()) + " of " +
+        std::to_string(decoded.info.file_size()) + " bytes); " +
+        (bytes.size() < first
+             ? "it holds no level of detail (the first needs " + std::to_string(first) + " bytes)"
+             : "to decode the coarser model it holds, ask for it with --bytes " +
+                   std::to_string(bytes.size())));
   }
   if (decoded.status != codec::Status::kOk && decoded.status != codec::Status::kTruncated) {
     throw InvalidInput(args.pack + ": " + std::string(codec::status_message(decoded.status)));
@@ -119,14 +129,19 @@ int run_decode(const DecodeArgs& args) {
     throw InvalidInput("--level " + std::to_string(args.level) + " is above the pack's level " +
                        std::to_string(grid_level));
 
-  // One model → OUTPUT is the mesh file; several → OUTPUT's stem gets each model's name.
-  std::vector<std::string> paths;
+  // One model → OUTPUT is the mesh file; several → OUTPUT's stem gets each model's name, made safe and unique
+  // (the names come from the pack: a crafted one must not lead outside OUTPUT's directory, and two models
+  // of the same name must not overwrite each other).
+  std::vector<std::string> paths, names;
+  for (const auto& model : decoded.models) names.push_back(model.name);
+  const std::vector<std::string> file_names = model_file_names(names);
   const std::filesystem::path out(args.output);
-  for (const auto& model : decoded.models) {
-    paths.push_back(decoded.models.size() == 1
-                        ? args.output
-                        : (out.parent_path() / (out.stem().string() + "." + model.name + out.extension().string()))
-                              .string());
+  for (std::size_t m = 0; m < decoded.models.size(); ++m) {
+    paths.push_back(
+        decoded.models.size() == 1
+            ? args.output
+            : (out.parent_path() / (out.stem().string() + "." + file_names[m] + out.extension().string()))
+                  .string());
   }
   const QuadSplit quad_split = args.quad_split == "fixed" ? QuadSplit::kFixed : QuadSplit::kShorter;
   nlohmann::json j_models = nlohmann::json::array();
@@ -160,9 +175,9 @@ int run_decode(const DecodeArgs& args) {
                         {"geometry_passes", decoded.models[m].geometry_passes}});
     if (!args.quiet && !args.json) {
       std::printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",
-                  decoded.models[m].name.c_str(), paths[m].c_str(), written.num_triangles(),
-                  args.level < 0 ? grid_level : args.level, decoded.models[m].detail_level,
-                  decoded.models[m].geometry_passes);
+                  codec::one_line(decoded.models[m].name).c_str(), codec::one_line(paths[m]).c_str(),
+                  written.num_triangles(), args.level < 0 ? grid_level : args.level,
+                  decoded.models[m].detail_level, decoded.models[m].geometry_passes);
     }
   }
   if (args.json) {
@@ -174,7 +189,7 @@ int run_decode(const DecodeArgs& args) {
                                 {"chunks", decoded.info.chunks.size()},
                                 {"decode_ms", decode_ms},
                                 {"models", j_models}}
-                     .dump(2)
+                     .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
   } else if (!args.quiet) {
     std::printf("%zu of %llu bytes used, %zu of %zu chunks complete, decoded in %.1f ms\n", decoded.bytes_used,

@@ -62,12 +62,24 @@ std::vector<std::string> geometry_files(const std::vector<std::string>& inputs) 
   return files;
 }
 
+// finest_grids() with the file named in its message.
+std::vector<GeometryImage> grids_of(const GeometryImageFile& file, const std::string& path) {
+  try {
+    return finest_grids(file);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(path + ": " + e.what());
+  }
+}
+
 GeometryImages load_images(const std::string& geometry_path, bool normals, std::string& name) {
   const GeometryImageFile file = read_geometry_image_exr(geometry_path);
   if (file.info.kind != "geometry")
     throw InvalidInput(geometry_path + ": holds '" + file.info.kind + "', not geometry (give the .geometry.exr)");
   GeometryImages images;
-  images.geometry = finest_grids(file);
+  images.geometry = grids_of(file, geometry_path);
+  if (file.info.level < 1)  // convert's range: a level-0 image (2×2 samples) has no wavelet step to code
+    throw InvalidInput(geometry_path + ": a level-" + std::to_string(file.info.level) +
+                       " geometry image; a pack needs level 1 or finer (as geomip convert --level)");
   images.adjacency = file.info.adjacency;
   if (images.adjacency.size() != 4 * images.geometry.size())
     throw InvalidInput(geometry_path + ": its patch adjacency does not list 4 sides per patch");
@@ -80,7 +92,7 @@ GeometryImages load_images(const std::string& geometry_path, bool normals, std::
     std::error_code ec;
     if (fs::exists(normals_path, ec)) {
       const GeometryImageFile n = read_geometry_image_exr(normals_path);
-      images.normals = finest_grids(n);
+      images.normals = grids_of(n, normals_path);
       if (images.normals.size() != images.geometry.size())
         throw InvalidInput(normals_path + ": a different number of patches than " + geometry_path);
     }
@@ -93,14 +105,25 @@ int run_encode(const EncodeArgs& args) {
   check_output_file(args.output);
   check_quantization_switches(args.quantization_bits, args.normal_bits, args.normal_bits_given,
                               args.no_normals);
+  const std::vector<std::string> files = geometry_files(args.inputs);
+  std::vector<std::string> inputs = files;  // the geometry files and the normal maps beside them
+  for (const std::string& path : files)
+    if (ends_with(path, kGeometrySuffix))
+      inputs.push_back(path.substr(0, path.size() - std::string(kGeometrySuffix).size()) + ".normals.exr");
+  check_output_is_not_an_input(args.output, inputs);
   std::vector<codec::PackModelInput> models;
   bool any_normals = false;
-  for (const std::string& path : geometry_files(args.inputs)) {
+  for (const std::string& path : files) {
     std::string name;
     const GeometryImages images = load_images(path, !args.no_normals, name);
     any_normals = any_normals || !images.normals.empty();
     models.push_back(pack_model_input(name, images, nullptr, !args.no_normals));
   }
+  // Names become file names on decode: distinct, safe ones (a geometry image's source_mesh is file data).
+  std::vector<std::string> names;
+  for (const auto& m : models) names.push_back(m.name);
+  const std::vector<std::string> unique = model_file_names(names);
+  for (std::size_t i = 0; i < models.size(); ++i) models[i].name = unique[i];
   codec::PackWriteOptions write;
   write.normals = !args.no_normals;
   write.geometry.quantization_bits = args.quantization_bits;
@@ -124,7 +147,7 @@ int run_encode(const EncodeArgs& args) {
                                 {"chunks", info.chunks.size()},
                                 {"models", models.size()},
                                 {"normals", any_normals && !args.no_normals}}
-                     .dump(2)
+                     .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
   } else if (!args.quiet) {
     std::printf("encode %zu model(s) → %s: %zu bytes (manifest %zu, %zu chunks)%s\n", models.size(),

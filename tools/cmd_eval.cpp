@@ -70,6 +70,7 @@ int run_eval(EvalArgs args) {
     if (!path->empty() && mesh_format_from_path(*path) != MeshFormat::kPly)
       throw InvalidInput(*path + ": an error map is written as PLY (.ply)");
     if (!path->empty()) check_output_file(*path);
+    if (!path->empty()) check_output_is_not_an_input(*path, {args.original, args.approx});
   }
   const TriMesh original = read_mesh(args.original);
   const TriMesh approx = read_mesh(args.approx);
@@ -123,7 +124,7 @@ int run_eval(EvalArgs args) {
     if (args.options.error_maps) j["error_map_scale_pct"] = 100 * scale / d.bbox_diagonal;
     j["seed"] = args.options.seed;
     j["seconds"] = seconds;
-    std::cout << j.dump(2) << "\n";
+    std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     return kExitOk;
   }
   auto row = [&](const char* name, const OneSidedDistance& s) {
@@ -159,10 +160,13 @@ CommandRunner add_eval_command(CLI::App& app) {
       "bounding-box diagonal, PSNR = 20·log10(diagonal / RMS) (inf for identical surfaces; JSON null)");
   cmd->add_option("original", args->original, "Reference mesh: .obj .ply .off .stl")->required();
   cmd->add_option("approx", args->approx, "Approximating mesh, same coordinate frame")->required();
+  // Bounded: each sample is a closest-point query and 56 bytes, so 10^8 is minutes and ~6 GB already.
   cmd->add_option("--samples", args->options.face_samples,
-                  "Area-uniform face samples on each surface (default: 10 per face, 10k..1M)");
+                  "Area-uniform face samples on each surface, in [1, 10^8] (default: 10 per face, 10k..1M)")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{100000000}));
   cmd->add_option("--edge-samples", args->options.edge_samples,
-                  "Samples spaced by length along each surface's edges (default 0)");
+                  "Samples spaced by length along each surface's edges, in [0, 10^8] (default 0)")
+      ->check(CLI::Range(std::size_t{0}, std::size_t{100000000}));
   cmd->add_flag("--no-vertices", args->no_vertices, "Do not sample the meshes' vertices");
   cmd->add_option("--seed", args->options.seed, "Seed of the random face samples (same seed, same result)");
   cmd->add_option("--threads", args->options.threads, "Worker threads (default: all cores)");

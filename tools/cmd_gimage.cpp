@@ -113,7 +113,9 @@ int run_gimage(const GimageArgs& args) {
     }
   }
   if (args.common.json) {
-    std::cout << nlohmann::json{{"models", summary}, {"param_seconds", param_seconds}}.dump(2) << "\n";
+    std::cout << nlohmann::json{{"models", summary}, {"param_seconds", param_seconds}}.dump(
+                     2, ' ', false, nlohmann::json::error_handler_t::replace)
+              << "\n";
   } else if (!args.common.quiet) {
     std::printf("parameterization %.2f s\n", param_seconds);
   }

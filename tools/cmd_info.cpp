@@ -1,6 +1,7 @@
 // geomip info MESH|PACK... [--json]: topology and size of mesh files, counted on the triangles as read; for a
 // .gip pack, its models (levels, the viewer's frame) and chunk table (what a viewer receives, in order).
 #include "codec/pack.h"
+#include "codec/status.h"
 #include "mesh/errors.h"
 #include "mesh/mesh_io.h"
 #include "mesh/mesh_topology.h"
@@ -120,6 +121,15 @@ void print_pack(const nlohmann::json& j) {
       static_cast<unsigned long long>(j["bytes"].get<std::uint64_t>()),
       static_cast<unsigned long long>(j["manifest_bytes"].get<std::uint64_t>()),
       static_cast<unsigned long long>(j["first_level_bytes"].get<std::uint64_t>()));
+  if (j.contains("bytes_laid_out")) {
+    const auto laid_out = j["bytes_laid_out"].get<std::uint64_t>(), have = j["bytes"].get<std::uint64_t>();
+    std::printf(
+        laid_out > have
+            ? "  truncated: the manifest lays out %llu bytes; the chunks past byte %llu are missing\n"
+            : "  the manifest lays out %llu bytes; the %llu bytes past them are not part of the pack\n",
+        static_cast<unsigned long long>(laid_out),
+        static_cast<unsigned long long>(laid_out > have ? have : have - laid_out));
+  }
   for (std::size_t m = 0; m < j["models"].size(); ++m) {
     const auto& mj = j["models"][m];
     const std::string up = mj["up"].get<std::string>();
@@ -127,8 +137,9 @@ void print_pack(const nlohmann::json& j) {
                                            : "up " + up + ", front " + mj["front"].get<std::string>() +
                                                  ", camera side " + mj["camera_side"].get<std::string>();
     std::printf("  model %zu '%s': %d patches of (2^%d+1)^2 samples, %d geometry passes%s%s; %s\n", m,
-                mj["name"].get<std::string>().c_str(), mj["patches"].get<int>(), mj["level"].get<int>(),
-                mj["geometry_passes"].get<int>(), mj["normals"].get<bool>() ? ", normal maps" : "",
+                codec::one_line(mj["name"].get<std::string>()).c_str(), mj["patches"].get<int>(),
+                mj["level"].get<int>(), mj["geometry_passes"].get<int>(),
+                mj["normals"].get<bool>() ? ", normal maps" : "",
                 mj["hole_mask"].get<bool>() ? ", hole mask" : "", frame.c_str());
   }
   std::printf("  chunks (file order): model kind pass bytes -> cumulative\n");
@@ -158,7 +169,10 @@ int run_info(const InfoArgs& args) {
       std::cout << path << "\n" << topology_to_text(report);
     }
   }
-  if (args.json) std::cout << (all.size() == 1 ? all[0] : all).dump(2) << "\n";
+  if (args.json)
+    std::cout
+        << (all.size() == 1 ? all[0] : all).dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+        << "\n";
   return kExitOk;
 }
 

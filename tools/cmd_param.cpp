@@ -154,7 +154,9 @@ int run_param(const ParamArgs& args) {
     nlohmann::json j = param_json(result[i], paths[i], inputs[i]);
     if (!inputs[i].layout_quads.empty()) j["layout_quads"] = inputs[i].layout_quads;  // corners: partition_points
     j["seconds"]["total_all_models"] = seconds;
-    write_file_atomically(stem + ".param.json", [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+    write_file_atomically(stem + ".param.json", [&](std::ostream& out) {
+      out << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+    });
     if (args.common.json) {
       summary.push_back({{"mesh", paths[i]}, {"obj", stem + ".param.obj"}, {"json", stem + ".param.json"},
                          {"patches", j["patches"].size()}, {"flipped_triangles", j["flipped_triangles"]}});
@@ -169,7 +171,9 @@ int run_param(const ParamArgs& args) {
     }
   }
   if (args.common.json) {
-    std::cout << nlohmann::json{{"models", summary}, {"seconds", seconds}}.dump(2) << "\n";
+    std::cout << nlohmann::json{{"models", summary}, {"seconds", seconds}}.dump(
+                     2, ' ', false, nlohmann::json::error_handler_t::replace)
+              << "\n";
   } else if (!args.common.quiet) {
     std::printf("%.2f s\n", seconds);
   }

@@ -455,7 +455,7 @@ int run_rd(const RdArgs& args) {
                                       {"two_squares_l2_stretch", moved->first}};
     j["points"] = nlohmann::json::array();
     for (const RdPoint& p : all) j["points"].push_back(point_to_json(p));
-    std::cout << j.dump(2) << "\n";
+    std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     return kExitOk;
   }
   if (args.quiet) return kExitOk;

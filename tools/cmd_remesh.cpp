@@ -51,8 +51,14 @@ int run_remesh(const RemeshArgs& args) {
   }
   if (args.fit && !uniform) throw InvalidInput("--fit moves the uniform remesh's samples: give --level K too");
   if (args.draco != 0 && !args.glb) throw InvalidInput("--draco compresses the GLB: give --glb too");
-  if (args.draco < 0 || args.draco > 30)
-    throw InvalidInput("--draco=" + std::to_string(args.draco) + ": position bits must be in 1..30");
+  if (args.draco < 0 ||
+      args.draco > 30)  // CLI11 reads --draco=0 as the flag's "off" (-1): say no number then
+    throw InvalidInput((args.draco < 0 ? std::string("--draco") : "--draco=" + std::to_string(args.draco)) +
+                       ": position bits must be in 1..30");
+  if ((args.glb || args.ply) && !uniform)
+    throw InvalidInput(
+        std::string(args.glb ? "--glb" : "--ply") +
+        " writes the uniform remesh: give --level K too (the adaptive remesh is written as OBJ)");
   if (adaptive && (args.max_depth < 0 || args.max_depth > kMaxGeometryImageLevel)) {
     throw InvalidInput("--max-depth " + std::to_string(args.max_depth) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
@@ -191,7 +197,7 @@ int run_remesh(const RemeshArgs& args) {
   if (args.common.json) {
     nlohmann::json j{{"models", summary}, {"param_seconds", param_seconds}};
     if (adaptive) j["adaptive_tree_seconds"] = adaptive_tree_seconds;
-    std::cout << j.dump(2) << "\n";
+    std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   } else if (!args.common.quiet) {
     std::printf("parameterization %.2f s\n", param_seconds);
     if (adaptive) {
@@ -219,11 +225,12 @@ CommandRunner add_remesh_command(CLI::App& app) {
                   "Adaptive remesh (paper §4, eq. 4-6) with error bound EPS (fraction of the bounding-box "
                   "diagonal): DIR/<stem>.adaptive.obj, one face list for a consistent set")
       ->check(non_negative_number());
-  cmd->add_option("--max-depth", args->max_depth,
-                  "Adaptive: maximum quadtree depth N in [0, 10] (default 8)");
+  cmd->add_option("--max-depth", args->max_depth, "Adaptive: maximum quadtree depth N in [0, 10] (default 8)")
+      ->needs("--adaptive");
   cmd->add_flag("--measure-samples", args->measure_samples,
                 "Adaptive: measure each quad's geometry image samples too, not only the mesh vertices in it "
-                "(stricter than the paper's eq. 4-5)");
+                "(stricter than the paper's eq. 4-5)")
+      ->needs("--adaptive");
   cmd->add_flag("--fit,!--no-fit", args->fit,
                 "Uniform remesh: move every sample along its normal so that the remesh is a least-squares fit of "
                 "the surface, not its interpolant (gimage/fit.h; same faces, seams welded); --no-fit: samples on "

@@ -86,7 +86,7 @@ int run_repair(const RepairArgs& args) {
     j["reoriented"] = result.reoriented;
     j["removed_components"] = result.removed_components;
     j["removed_component_faces"] = result.removed_component_faces;
-    std::cout << j.dump(2) << "\n";
+    std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   } else if (!args.quiet) {
     std::cout << "repair " << args.input << ": " << summary(result) << "\n"
               << "wrote " << args.output << ": " << after.vertices << " vertices, " << after.faces << " faces, "

@@ -6,6 +6,7 @@
 #include "mesh/mesh_topology.h"
 #include "param/partition_points.h"
 #include "param/quad_layout.h"
+#include "tools/atomic_file.h"
 #include "tools/correspondence.h"
 
 #include <algorithm>
@@ -251,6 +252,11 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
     paths.push_back(spec.mesh);
     models.originals.push_back(repaired ? input : TriMesh{});
   }
+  // Two meshes of the same stem (a/spot.obj, b/spot.obj) get distinct names: outputs are named after them.
+  std::vector<std::string> names;
+  for (const auto& in : inputs) names.push_back(in.name);
+  const std::vector<std::string> unique = model_file_names(names);
+  for (std::size_t i = 0; i < inputs.size(); ++i) inputs[i].name = unique[i];
   return models;
 }
 

@@ -165,7 +165,16 @@ TEST_F(Exr, FailedWriteLeavesNothing) {
   std::size_t files = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++files;
   EXPECT_EQ(files, 1u);  // no temporary left behind
-  EXPECT_THROW(read_geometry_image_exr(dir_ + "/nope.exr"), IoError);
+  // The user's files, not the machine's failures (exit 2 in the tools): missing, truncated, garbage, empty.
+  EXPECT_THROW(read_geometry_image_exr(dir_ + "/nope.exr"), InvalidInput);
+  std::vector<char> bytes(size);
+  std::ifstream(good, std::ios::binary).read(bytes.data(), static_cast<std::streamsize>(size));
+  const std::string cut = dir_ + "/cut.exr", garbage = dir_ + "/garbage.exr", empty = dir_ + "/empty.exr";
+  std::ofstream(cut, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(size / 2));
+  std::ofstream(garbage, std::ios::binary) << std::string(1000, '\x5a');
+  std::ofstream(empty, std::ios::binary).flush();
+  for (const std::string& bad : {cut, garbage, empty})
+    EXPECT_THROW(read_geometry_image_exr(bad), InvalidInput) << bad;
 }
 
 TEST(ExrAdjacencyText, RoundTripsAndRejectsGarbage) {

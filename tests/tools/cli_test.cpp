@@ -1551,6 +1551,84 @@ TEST_F(CliPack, EncodeFromGimageDirectory) {
   EXPECT_FALSE(fs::exists(dir_ + "/bad.gip"));
 }
 
+// Model names come from files (a mesh's stem, a pack's manifest) and become file names on decode: two models
+// of the same name get two files, and a crafted name (a path, control bytes) neither leads outside the output
+// directory nor reaches the terminal raw.
+TEST_F(CliPack, ModelNamesBecomeSafeDistinctFileNames) {
+  const std::string long_name = "spot_with_a_long_name";  // 21 bytes, as the crafted names below
+  fs::copy_file(spot_, dir_ + "/" + long_name + ".obj");
+  ASSERT_EQ(geomip("gimage -q '" + dir_ + "/" + long_name + ".obj' --level 3 -o '" + dir_ + "/gi'").exit_code,
+            0);
+  const std::string pack = dir_ + "/two.gip";
+  ASSERT_EQ(geomip("encode -q --no-normals '" + dir_ + "/gi' '" + dir_ + "/gi' -o '" + pack + "'").exit_code,
+            0);
+  fs::create_directories(dir_ + "/o/s/x.a");
+  Outcome r = geomip("decode '" + pack + "' -o '" + dir_ + "/o/s/x.obj'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ + "/o/s/x." + long_name + ".obj"));
+  EXPECT_TRUE(fs::exists(dir_ + "/o/s/x." + long_name + "-1.obj")) << r.out;
+
+  // The same pack with its names replaced in the manifest (same lengths) and the manifest's CRC made anew.
+  std::string bytes = slurp(pack);
+  const std::size_t first = bytes.find(long_name), second = bytes.find(long_name, first + 1);
+  ASSERT_NE(second, std::string::npos);
+  bytes.replace(first, 21, "a/../../../escaped_xx");
+  bytes.replace(second, 21, "\x1b[31mred\x07____________");  // ESC [31m red BEL, 12 underscores
+  std::size_t at = 10, manifest_size = 0;  // magic (8), version u16, varint size, CRC32 u32, manifest
+  for (int shift = 0;; shift += 7) {
+    const auto b = static_cast<unsigned char>(bytes[at++]);
+    manifest_size |= static_cast<std::size_t>(b & 0x7f) << shift;
+    if (!(b & 0x80)) break;
+  }
+  const std::uint32_t crc =
+      codec::crc32({reinterpret_cast<const std::uint8_t*>(bytes.data()) + at + 4, manifest_size});
+  for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>((crc >> (8 * k)) & 0xff);
+  const std::string crafted = file("crafted.gip", bytes);
+  fs::remove_all(dir_ + "/o");
+  fs::create_directories(dir_ + "/o/s/x.a");
+  r = geomip("decode '" + crafted + "' -o '" + dir_ + "/o/s/x.a/../x.obj'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ + "/escaped_xx.obj"));
+  std::set<std::string> written;
+  for (const auto& e : fs::recursive_directory_iterator(dir_ + "/o"))
+    if (e.is_regular_file()) written.insert(fs::relative(e.path(), dir_ + "/o").string());
+  EXPECT_EQ(written,
+            (std::set<std::string>{"s/x.a_.._.._.._escaped_xx.obj", "s/x._[31mred_____________-1.obj"}));
+  for (const std::string& text : {r.out, geomip("info '" + crafted + "'").out})
+    EXPECT_EQ(text.find_first_of("\x1b\x07"), std::string::npos) << text;
+  // info --json stays valid JSON with the names as they are (escaped).
+  r = geomip("info --json '" + crafted + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["models"][0]["name"], "a/../../../escaped_xx");
+}
+
+// Outputs that would destroy an input, or that cannot be written at all, are refused before any work (exit
+// 2).
+TEST_F(CliPack, OutputsOverInputsAndDirectoriesExitTwoBeforeAnyWork) {
+  ASSERT_EQ(geomip("gimage -q '" + spot_ + "' --level 3 -o '" + dir_ + "/gi'").exit_code, 0);
+  const std::string exr = dir_ + "/gi/spot.geometry.exr";
+  const auto exr_bytes = slurp(exr);
+  expect_bad_input("encode -q '" + dir_ + "/gi' -o '" + exr + "'", exr);
+  EXPECT_EQ(slurp(exr), exr_bytes);
+  fs::create_directories(dir_ + "/adir.gip");
+  expect_bad_input("convert -q '" + spot_ + "' --level 3 -o '" + dir_ + "/adir.gip'", dir_ + "/adir.gip");
+  const std::string pack = dir_ + "/spot.gip";
+  ASSERT_EQ(geomip("encode -q '" + dir_ + "/gi' -o '" + pack + "'").exit_code, 0);
+  expect_bad_input("decode -q '" + pack + "' -o '" + pack + "/x.obj'",
+                   pack);  // a file where a directory goes
+  ASSERT_EQ(geomip("decode -q '" + pack + "' -o '" + dir_ + "/m.ply'").exit_code, 0);
+  const auto ply = slurp(dir_ + "/m.ply");
+  expect_bad_input("eval '" + spot_ + "' '" + dir_ + "/m.ply' --error-map '" + dir_ + "/m.ply'",
+                   dir_ + "/m.ply");
+  EXPECT_EQ(slurp(dir_ + "/m.ply"), ply);
+  // Bad geometry images: garbage, truncated, an EXR that is no geometry image: exit 2, one line naming it.
+  const std::string cut = file("cut.geometry.exr", exr_bytes.substr(0, exr_bytes.size() / 2));
+  const std::string junk = file("junk.geometry.exr", std::string(500, 'x'));
+  expect_bad_input("encode -q '" + cut + "' -o '" + dir_ + "/b.gip'", cut);
+  expect_bad_input("encode -q '" + junk + "' -o '" + dir_ + "/b.gip'", junk);
+  EXPECT_FALSE(fs::exists(dir_ + "/b.gip"));
+}
+
 // Issue #13: `decode --bytes N` before the first level of detail used to write a 262,144-face mesh of zero
 // extent (exit 0), and a file cut inside its manifest was reported as "477418 of 0 bytes".
 TEST_F(CliPack, PrefixesWithoutALevelOfDetailExitTwoWithoutOutput) {

@@ -843,23 +843,51 @@ TEST_F(ViewPackTest, StallsAndRateLimitsAreCancelledAtTheTimeout) {
   EXPECT_NE(r.err.find("timed out"), std::string::npos) << r.err;
   EXPECT_LT(r.seconds, 2 + 5.0) << "ended, not hung (was 17.6 s)";
   std::cout << "file --limit-rate 1000 --timeout 2: exit after " << r.seconds << " s\n";
+  // Exit 3 at the timeout keeps the last level shown, and --screenshot writes it (it used to write nothing).
+  // A level-4 pack's first level is in its first few hundred bytes, long before the timeout at 1000 bytes/s;
+  // the whole pack needs longer.
+  const fs::path small = pack_file(4), png = work_dir() / "timed_out.png";
+  ASSERT_GT(fs::file_size(small), 5000u);
+  fs::remove(png);
+  const ViewRun t = view_measured(small.string() + " " + size_args() +
+                                  " --timeout 2 --limit-rate 1000 --screenshot " + png.string());
+  EXPECT_EQ(t.code, 3) << t.err;
+  ASSERT_TRUE(fs::exists(png)) << t.err;
+  const auto covered = image_coverage(load(png));
+  EXPECT_GT(std::count(covered.begin(), covered.end(), 1), 100) << "the model is drawn";
 }
 
 TEST_F(ViewPackTest, OutOfRangeOptionsExitTwoWithOneLine) {
   const fs::path golden = fs::path(GEOMIP_SOURCE_DIR) / "tests/data/golden-pillow-v2.gip";  // 2 models, level 5
   const fs::path single = work_dir() / "one_model.gip";
   if (!fs::exists(single)) write_file(single.filename().string(), codec::write_pack({pack_input(4, 0)}));
+  const fs::path mixed = work_dir() / "levels_4_and_5.gip";
+  if (!fs::exists(mixed))
+    write_file(mixed.filename().string(), codec::write_pack({pack_input(4, 0), pack_input(5, 1)}));
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {golden.string() + " --morph 1.5", "--morph"},  {golden.string() + " --morph -0.25", "--morph"},
-      {golden.string() + " --model 2", "--model"},    {golden.string() + " --model 7 --morph 0.5", "--model"},
-      {golden.string() + " --level 6", "--level"},    {golden.string() + " --level -1", "--level"},
+      {golden.string() + " --morph 1.5", "--morph"},
+      {golden.string() + " --morph -0.25", "--morph"},
+      {golden.string() + " --model 2", "--model"},
+      {golden.string() + " --model 7 --morph 0.5", "--model"},
+      {golden.string() + " --level 6", "--level"},
+      {golden.string() + " --level -1", "--level"},
       {single.string() + " --morph 0.5", "--morph"},
+      {golden.string() + " --morph abc", "--morph"},
+      // models of different layouts: the morph cannot be drawn (it used to show the first model, exit 0)
+      {mixed.string() + " --morph 0.5", "--morph"},
+      {mixed.string() + " --animate", "--animate"},
   };
   for (const auto& [args, option] : cases) {
     const ViewRun r = view_measured(args + " " + size_args());
     EXPECT_EQ(r.code, 2) << args << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
     EXPECT_NE(r.err.find(option), std::string::npos) << args << ": " << r.err;
+  }
+  // Headless outputs without --frames: a window that stays open would never write them.
+  for (const char* option : {" --screenshot x.png", " --bench"}) {
+    const ViewRun r = view_measured(golden.string() + option);
+    EXPECT_EQ(r.code, 2) << option << ": " << r.err;
+    EXPECT_NE(r.err.find("--frames"), std::string::npos) << option << ": " << r.err;
   }
   // in range: fine
   const ViewRun ok = view_measured(golden.string() + " --model 1 --level 5 --morph 1 " + size_args());

@@ -53,9 +53,12 @@ export class GeomipDecoder {
     this.handle_ = core._gip_create();
   }
 
-  /// Appends the next bytes of the file (a Uint8Array or ArrayBuffer).
+  /// Appends the next bytes of the file (a Uint8Array, another typed array or DataView, or an ArrayBuffer).
   push(bytes) {
-    const view = bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes);
+    this.check_();
+    const view = bytes instanceof Uint8Array ? bytes :
+        ArrayBuffer.isView(bytes) ? new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength) :
+                                    new Uint8Array(bytes);
     if (view.length === 0) return;
     const at = this.core_._gip_reserve(this.handle_, view.length);
     if (at === 0) throw new RangeError('geomip: more than 2 GiB pushed');
@@ -63,15 +66,23 @@ export class GeomipDecoder {
     this.core_._gip_commit(this.handle_, view.length, view.length);
   }
 
-  /// Bytes received so far.
-  get size() { return this.core_._gip_size(this.handle_); }
+  /// Bytes received so far (0 after dispose()).
+  get size() { return this.handle_ ? this.core_._gip_size(this.handle_) : 0; }
+
+  check_() {
+    if (!this.handle_) throw new GeomipError('invalid-argument', 'this decoder was disposed');
+  }
 
   /// Bytes the header/manifest need before layout() can answer (20, then where the manifest ends).
-  needed() { return this.core_._gip_needed(this.handle_); }
+  needed() {
+    this.check_();
+    return this.core_._gip_needed(this.handle_);
+  }
 
   /// The pack's layout once header + manifest have arrived: { manifestEnd, fileSize, chunks: [{ model, kind,
   /// pass, offset, size }] }; null while they have not; throws GeomipError when they are not a pack's.
   layout() {
+    this.check_();
     const c = this.core_, h = this.handle_;
     const status = kStatus[c._gip_read_info(h)];
     if (status === 'truncated') return null;
@@ -89,6 +100,7 @@ export class GeomipDecoder {
   /// Decodes every byte received so far into grids (see the top of this file). options.normals (default
   /// true): decode the normal maps too.
   decode(options = {}) {
+    this.check_();
     const c = this.core_, h = this.handle_;
     const status = kStatus[c._gip_decode(h, options.normals === false ? 0 : 1)];
     const models = [];
@@ -128,6 +140,7 @@ export class GeomipDecoder {
   /// none), normals (Float32Array [patch·nsize²+…]·3), holeLevel (−1 none), holes (Uint8Array
   /// [patch·4^L+j·2^L+i]), detailLevel }.
   scene(options = {}) {
+    this.check_();
     const c = this.core_, h = this.handle_;
     const status = kStatus[c._gip_decode_scene(h, options.bands ?? 1, options.align === false ? 0 : 1)];
     const models = [];

@@ -8,7 +8,9 @@
 // URL parameters: pack=URL (required); morph=T (0..1, fixed morph time between model `from` and model `to`;
 // default: a slider, at 0), from=I, to=J (models, default 0 and 1); schedule=linear|wavelet (wavelet: 4
 // bands); stop=N or stop=P% (stop fetching after N bytes / P % of the file: a prefix, on purpose);
-// first=N (bytes of the first chunk range, default 16384); hud=0 hides the text (for screenshots).
+// first=N (bytes of the first chunk range, default 16384); timeout=S (seconds without a byte before a stalled
+// server ends the stream, default 20); hud=0 hides the text (for screenshots). A parameter that is not a
+// number in its range is an error line, nothing is fetched.
 // For tests and scripts, window.geomipViewer holds the state: { phase: 'loading'|'done'|'error', bytes,
 // fileSize, level, levels (each refinement: bytes, level), models, message, draws, decodes, decodeMs (time
 // spent decoding), requests, camera }.
@@ -42,6 +44,7 @@ if (!gl) fail('this browser has no WebGL2');
 else renderer = new Renderer(gl);
 
 function fail(message) {
+  if (state.bytes === 0) statusLine.textContent = '';  // not "loading…" beside the error
   state.phase = 'error';
   state.message = message;
   errorLine.textContent = message;
@@ -101,6 +104,7 @@ slider.addEventListener('input', () => { view.t = Number(slider.value); redraw()
 
 // ---- streaming -----------------------------------------------------------------------------------------
 class StreamError extends Error {}
+class UsageError extends Error {}  // a URL parameter the pack cannot honour: said alone
 
 /// GET `url` bytes [begin, end) (end = null: to the end), pushing the body into the decoder as it arrives.
 /// `onBytes(bytes)` after each piece. A server that ignores Range (200) sends the whole file: the bytes before `begin` are skipped and the
@@ -112,6 +116,8 @@ async function fetchRange(url, decoder, begin, end, onBytes) {
   } catch (e) {
     throw new StreamError(`cannot fetch ${url}: ${e.message} (a bad URL, the server down, or no CORS headers)`);
   }
+  if (response.status === 416 && begin === 0)  // Range Not Satisfiable at byte 0: the file is empty
+    throw new StreamError(`${url} is empty: not a geomip pack`);
   if (response.status !== 206 && response.status !== 200)
     throw new StreamError(`cannot fetch ${url}: HTTP ${response.status} ${response.statusText}`.trim());
   const whole = response.status === 200;
@@ -121,21 +127,94 @@ async function fetchRange(url, decoder, begin, end, onBytes) {
   for (;;) {
     let chunk;
     try {
-      chunk = await reader.read();
+      chunk = await readWithin(reader, url, decoder);
     } catch (e) {
+      if (e instanceof StreamError) throw e;
       throw new StreamError(`the stream of ${url} broke off at ${decoder.size.toLocaleString('en')} bytes (${e.message})`);
     }
     if (chunk.done) break;
     let bytes = chunk.value;
     if (skip > 0) { const n = Math.min(skip, bytes.length); bytes = bytes.subarray(n); skip -= n; }
     if (!whole && end !== null && decoder.size + bytes.length > end) bytes = bytes.subarray(0, end - decoder.size);
-    if (bytes.length > 0) { decoder.push(bytes); onBytes(bytes); }
-    if (stopAt !== null && decoder.size >= stopAt) { reader.cancel(); break; }
+    // A server without Range sends everything at once, in pieces of any size: the bytes go in up to the
+    // header, then up to the manifest's end, so that a file that is no pack is not read to its end and a
+    // body longer than the pack (or stop=) is cut at its size.
+    let notPack = false;
+    while (bytes.length > 0) {
+      let n = bytes.length;
+      if (whole && packLimit === Infinity) {
+        try {
+          const need = decoder.size < 20 ? 20 : decoder.needed();
+          const layout = decoder.size >= need ? decoder.layout() : null;
+          if (layout)
+            packLimit = limitFor(layout);
+          else
+            n = Math.min(n, Math.max(1, need - decoder.size));
+        } catch (e) {
+          if (!(e instanceof GeomipError)) throw e;
+          notPack = true;  // the caller says what is wrong with it
+          break;
+        }
+      }
+      n = Math.min(n, Math.max(0, packLimit - decoder.size));
+      if (n === 0) break;
+      decoder.push(bytes.subarray(0, n));
+      onBytes(bytes.subarray(0, n));
+      bytes = bytes.subarray(n);
+    }
+    if (notPack || decoder.size >= packLimit || (stopAt !== null && decoder.size >= stopAt) || corrupt) {
+      reader.cancel().catch(() => {});
+      break;
+    }
   }
   return whole;
 }
 
 let stopAt = null;
+
+/// The URL parameters that are numbers, checked before anything is fetched: '' or one line for the page.
+function checkParams() {
+  const number = (name, ok, what) => {
+    const v = params.get(name);
+    if (v === null) return '';
+    const x = Number(v.endsWith('%') && name === 'stop' ? v.slice(0, -1) : v);
+    return v.trim() !== '' && Number.isFinite(x) && ok(x) ? '' : `${name}=${v}: ${what}`;
+  };
+  return number('morph', (x) => x >= 0 && x <= 1, 'a morph time in [0, 1]') ||
+      number('from', (x) => Number.isInteger(x) && x >= 0, 'a model index (0, 1, ...)') ||
+      number('to', (x) => Number.isInteger(x) && x >= 0, 'a model index (0, 1, ...)') ||
+      number('stop', (x) => x > 0, 'a byte count or a percentage above 0') ||
+      number('first', (x) => Number.isInteger(x) && x >= 1, 'a byte count of at least 1') ||
+      number('timeout', (x) => x > 0, 'seconds above 0');
+}
+
+// A server that stops sending (the connection open, no bytes) ends the stream after this many seconds without
+// a byte (timeout=S, default 20), as geomip-view's --timeout: the last good level stays.
+const stallSeconds = Number(params.get('timeout') ?? 20);
+
+/// reader.read(), or a StreamError when no byte arrives for stallSeconds.
+function readWithin(reader, url, decoder) {
+  let timer;
+  const stalled = new Promise((_, reject) => {
+    timer = setTimeout(() => {
+      // Rejected before the cancel, which resolves the pending read (done) and would win the race.
+      reject(new StreamError(
+          `the server of ${url} sent nothing for ${stallSeconds} s after ` +
+          `${decoder.size.toLocaleString('en')} bytes`));
+      reader.cancel().catch(() => {});
+    }, stallSeconds * 1000);
+  });
+  return Promise.race([reader.read(), stalled]).finally(() => clearTimeout(timer));
+}
+
+/// The most bytes worth reading: the pack's size once its manifest is known (a server that sends more, or
+/// never ends its body, is cut there), less with stop=; Infinity before.
+let packLimit = Infinity;
+function limitFor(layout) {
+  const stop = params.get('stop');
+  if (stop) stopAt = stop.endsWith('%') ? Math.floor(layout.fileSize * parseFloat(stop) / 100) : Number(stop);
+  return Math.min(layout.fileSize, stopAt ?? Infinity);
+}
 
 /// Scene decodes off the main thread (decode-worker.js) when module workers are available, else on it.
 class SceneSource {
@@ -169,6 +248,7 @@ class SceneSource {
 }
 
 let requestedChunks = -1;
+let statusName = '';  // "<file>: ", the status line's prefix
 let inFlight = null;
 let again = false;
 let corrupt = null;
@@ -188,6 +268,11 @@ function refine(source, layout) {
     const { scene, size, ms } = result;
     state.decodeMs += ms;
     ++state.decodes;
+    // Recorded before anything else: a corrupt first chunk leaves no model to show, and must still be said.
+    if (scene.status === 'corrupt' && !corrupt)
+      corrupt = new StreamError(
+          `a chunk of the pack is corrupt (CRC) after ${scene.bytesUsed.toLocaleString('en')} bytes`);
+    showStatus(statusName);
     if (scene.models.length === 0) return;
     renderer?.setModels(scene.models);
     if (!cameraMoved)
@@ -197,9 +282,8 @@ function refine(source, layout) {
     state.levels.push({ bytes: size, level: state.level });
     state.names = scene.models.map((m) => m.name);
     if (scene.models.length > 1) slider.hidden = false;
+    showStatus(statusName);
     redraw();
-    if (scene.status === 'corrupt' && !corrupt)
-      corrupt = new StreamError(`a chunk of the pack is corrupt (CRC) after ${scene.bytesUsed.toLocaleString('en')} bytes`);
   }).finally(() => {
     inFlight = null;
     if (again) { again = false; refine(source, layout); }
@@ -218,7 +302,7 @@ async function settle(source, layout) {
 async function stream(url) {
   const decoder = await createDecoder();
   const source = new SceneSource(decoder);
-  const name = `${url.split('/').pop()}: `;
+  const name = statusName = `${url.split('/').pop()}: `;
   let layout = null;
   const onBytes = (bytes) => {
     source.push(bytes);
@@ -243,11 +327,14 @@ async function stream(url) {
     if (!layout)
       throw new StreamError(`${url} ended after ${decoder.size} bytes, inside the pack's header or manifest`);
     state.fileSize = layout.fileSize;
-    const stop = params.get('stop');
-    if (stop) stopAt = stop.endsWith('%') ? Math.floor(layout.fileSize * parseFloat(stop) / 100) : Number(stop);
-    const limit = Math.min(layout.fileSize, stopAt ?? Infinity);
+    const numModels = layout.chunks.reduce((n, c) => Math.max(n, c.model + 1), 0);
+    for (const name of ['from', 'to'])
+      if (params.has(name) && Number(params.get(name)) >= numModels)
+        throw new UsageError(
+            `${name}=${params.get(name)}: the pack has ${numModels} model${numModels === 1 ? '' : 's'}`);
+    const limit = packLimit = limitFor(layout);
     let span = Number(params.get('first') ?? 16384);
-    while (!whole && decoder.size < limit) {
+    while (!whole && decoder.size < limit && !corrupt) {
       const begin = decoder.size, end = Math.min(limit, begin + span);
       whole = await fetchRange(url, decoder, begin, end, onBytes);
       if (!whole && decoder.size < end)
@@ -256,6 +343,10 @@ async function stream(url) {
       span *= 2;
     }
     state.bytes = decoder.size;
+    if (corrupt) {
+      await settle(source, layout);
+      throw corrupt;
+    }
     if (decoder.size < layout.fileSize && stopAt === null)
       throw new StreamError(`the stream of ${url} ended at ${decoder.size.toLocaleString('en')} of ` +
                             `${layout.fileSize.toLocaleString('en')} bytes`);
@@ -268,11 +359,24 @@ async function stream(url) {
     state.bytes = decoder.size;
     try { await settle(source, layout); } catch (_) { /* the error below is the one to show */ }
     showStatus(name);
-    if (e instanceof StreamError) fail(`${e.message}; showing ${state.level >= 0 ? `level ${state.level}` : 'nothing'}`);
+    if (e instanceof UsageError)
+      fail(e.message);
+    else if (e instanceof StreamError)
+      fail(`${e.message}; showing ${state.level >= 0 ? `level ${state.level}` : 'nothing'}`);
     else fail(`error: ${e.message}`);
   }
 }
 
 const pack = params.get('pack');
+let packUrl = null;
+try {
+  if (pack) packUrl = new URL(pack, location.href).href;
+} catch (_) {
+  fail(`pack=${pack} is not a URL`);
+}
+const badParam = checkParams();
 if (!pack) fail('no pack given: open index.html?pack=URL');
-else if (renderer) stream(new URL(pack, location.href).href);
+else if (badParam)
+  fail(badParam);
+else if (renderer && packUrl)
+  stream(packUrl);

@@ -299,7 +299,20 @@ try {
   damaged[Math.floor(bunnyBytes * 0.6)] ^= 0x5a;
   mkdirSync(path.join(tmp, 'damaged'));
   writeFileSync(path.join(tmp, 'damaged', 'bunny.gip'), damaged);
+  // and one with a byte flipped in its first chunk (no level to show: the page must still say why)
+  const firstChunk = await (async () => {
+    const d = await createDecoder();
+    d.push(readFileSync(path.join(root, bunny)));
+    const at = d.layout().manifestEnd;
+    d.dispose();
+    return at;
+  })();
+  const damagedFirst = Buffer.from(readFileSync(path.join(root, bunny)));
+  damagedFirst[firstChunk + 1] ^= 0x5a;
+  writeFileSync(path.join(tmp, 'damaged', 'first.gip'), damagedFirst);
   const damagedServer = await startRangeServer('--root', path.join(tmp, 'damaged'));
+  const endless = await startRangeServer('--no-ranges', '--endless');
+  const stallsEarly = await startRangeServer('--stall-after', '2000', '--stall-seconds', '30');
   browser = await puppeteer.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium', headless: true,
     args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--disable-dev-shm-usage',
@@ -454,16 +467,29 @@ try {
     ['a file that is not a pack', `/web/index.html`, /not a geomip pack/, false],
     ['a server killed mid-stream', `http://127.0.0.1:${killed}/${bunny}`, /ended at|broke off/, true],
     ['a corrupt chunk', `http://127.0.0.1:${damagedServer}/bunny.gip`, /corrupt \(CRC\)/, true],
+    ['a corrupt first chunk', `http://127.0.0.1:${damagedServer}/first.gip`, /corrupt \(CRC\).*showing nothing/, false],
+    ['a server that stalls (timeout=2)', `http://127.0.0.1:${stallsEarly}/${bunny}`, /sent nothing for 2 s/, true, '&timeout=2'],
+    ['a pack URL that is no URL', 'http://[bad', /is not a URL/, false],
+    ['morph=abc', `/${bunny}`, /^morph=abc: a morph time in \[0, 1\]$/, false, '&morph=abc'],
+    ['from=5 on a one-model pack', `/${bunny}`, /^from=5: the pack has 1 model$/, false, '&from=5'],
   ];
-  for (const [what, pack, pattern, keeps] of errorCases) {
+  for (const [what, pack, pattern, keeps, extra = ''] of errorCases) {
     // small ranges, so that complete responses arrive before the server dies (a browser may drop the
     // bytes of a response that breaks off)
-    const page = await open(pageUrl(pack, '&first=1024'));
+    const page = await open(pageUrl(pack, `&first=1024${extra}`));
     const s = await stateOf(page);
     const line = await page.evaluate(() => document.getElementById('error').textContent);
     const drawn = count(drawnMask(await canvasPixels(page))) / area;
     check(s.phase === 'error' && pattern.test(line) && !line.includes('\n'), `${what}: "${line}"`);
     if (keeps) check(s.level >= 0 && drawn >= 0.01, `${what}: level ${s.level} still drawn (${(100 * drawn).toFixed(1)} % of the view)`);
+    await page.close();
+  }
+  // 8. a server without Range whose body never ends: read up to the pack's size, then shown whole
+  {
+    const page = await open(pageUrl(`http://127.0.0.1:${endless}/${bunny}`));
+    const s = await stateOf(page);
+    check(s.phase === 'done' && s.bytes === bunnyBytes && s.requests.length === 1,
+          `no Range, an endless body: ${s.phase}, ${s.bytes} of ${bunnyBytes} bytes read in ${s.requests.length} request(s)`);
     await page.close();
   }
 } catch (e) {

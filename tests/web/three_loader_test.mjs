@@ -43,38 +43,39 @@ function checkAgainstNative(label, pack, bytes, m, positions, index) {
   let same = bits.length === n.geometry.length;
   for (let i = 0; same && i < bits.length; ++i) same = bits[i] === n.geometry[i];
   check(same, `${label}: ${positions.length / 3} vertices (native: ${n.patches} × ${size}²), positions bit-identical to native at ${bytes} bytes`);
-  let quads = 0;
+  const quads = [];  // [p, i, j] of every quad outside the hole mask, in the loader's order
   const res = n.holeLevel >= 0 ? 1 << n.holeLevel : 0;
   for (let p = 0; p < n.patches; ++p)
     for (let j = 0; j + 1 < size; ++j)
       for (let i = 0; i + 1 < size; ++i) {
         const masked = res && n.holes[p][Math.min(res - 1, Math.floor((j + 0.5) / (size - 1) * res)) * res +
                                          Math.min(res - 1, Math.floor((i + 0.5) / (size - 1) * res))];
-        if (!masked) ++quads;
+        if (!masked) quads.push([p, i, j]);
       }
   const inRange = index.every((v) => v < positions.length / 3);
-  check(index.length === quads * 6 && inRange,
-        `${label}: ${index.length / 3} triangles = 2 × ${quads} quads outside the hole mask, indices in range`);
-  // Each quad's two triangles share its shorter diagonal (ties either way), and both keep the grid's orientation.
+  check(index.length === quads.length * 6 && inRange,
+        `${label}: ${index.length / 3} triangles = 2 × ${quads.length} quads outside the hole mask, indices in range`);
+  // The split of geomip decode (gimage/uniform_remesh.h): each quad along its shorter diagonal, the layout's
+  // rule (a–c when i + j + p is even) at ties and at the four corner quads of a patch, where two patches'
+  // quads can share three vertices (without it two triangles are duplicated across the seam: a fin).
   const d2 = (u, v) => {
     let s = 0;
     for (let k = 0; k < 3; ++k) s += (positions[3 * u + k] - positions[3 * v + k]) ** 2;
     return s;
   };
-  let longer = 0, badShape = 0;
-  for (let t = 0; t + 5 < index.length; t += 6) {
-    const [a, b, c] = index.slice(t, t + 3), [e, f, g] = index.slice(t + 3, t + 6);
-    // (a, b, c), (a, c, d): diagonal a–c, other b–d; (a, b, d), (b, c, d): diagonal b–d, other a–c.
-    if (a === e && c === f) {
-      if (d2(a, c) > d2(b, g)) ++longer;
-    } else if (b === e && c === g) {
-      if (d2(b, c) > d2(a, f)) ++longer;
-    } else {
-      ++badShape;
-    }
-  }
-  check(longer === 0 && badShape === 0,
-        `${label}: every quad split along its shorter diagonal (${longer} along the longer, ${badShape} not a quad)`);
+  let wrong = 0, badShape = 0;
+  quads.forEach(([p, i, j], q) => {
+    const a = p * size * size + j * size + i, b = a + 1, c = a + size + 1, d = a + size;
+    const t = index.slice(6 * q, 6 * q + 6);
+    const alongAc = t.join() === [a, b, c, a, c, d].join(), alongBd = t.join() === [a, b, d, b, c, d].join();
+    if (!alongAc && !alongBd) { ++badShape; return; }
+    const corner = (i === 0 || i === size - 2) && (j === 0 || j === size - 2);
+    const diff = d2(a, c) - d2(b, d);
+    const want = corner || diff === 0 ? (i + j + p) % 2 === 0 : diff < 0;
+    if (alongAc !== want) ++wrong;
+  });
+  check(wrong === 0 && badShape === 0,
+        `${label}: every quad split as geomip decode splits it (${wrong} otherwise, ${badShape} not a quad)`);
 }
 
 for (const spec of specs) {
@@ -119,6 +120,51 @@ for (const spec of specs) {
   let unit = 0;
   for (let i = 0; i < normal.length; i += 3) if (Math.abs(Math.hypot(normal[i], normal[i + 1], normal[i + 2]) - 1) < 0.01) ++unit;
   check(unit === normal.length / 3, `${label}: ${unit} of ${normal.length / 3} normals of unit length`);
+}
+// Streams that end early, corrupt chunks and a model past the pack's: onError, `done` never true; parse()
+// of a prefix says what it is. The first pack serves for all.
+{
+  const [pack] = specs[0].split(':');
+  const bytes = readFileSync(pack);
+  const flipped = Uint8Array.from(bytes);
+  flipped[bytes.length - 10] ^= 0x40;  // in the last chunk: the levels before it stay
+  const cases = [
+    { name: 'truncated', body: bytes.subarray(0, Math.floor(bytes.length * 0.6)), error: /ended at/ },
+    { name: 'corrupt', body: flipped, error: /corrupt/ },
+    { name: 'model 9', body: bytes, model: 9, error: /out of range/ },
+  ];
+  for (const c of cases) {
+    const server = http.createServer((req, res) => {
+      res.writeHead(200, { 'Content-Type': 'application/octet-stream' });  // no Content-Length
+      res.end(c.body);
+    });
+    await new Promise((r) => server.listen(0, '127.0.0.1', r));
+    const loader = new GeomipLoader();
+    loader.model = c.model ?? 0;
+    let sawDone = false;
+    const error = await new Promise((resolve) => {
+      loader.load(`http://127.0.0.1:${server.address().port}/p.gip`, (geometry) => {
+        sawDone ||= geometry.userData.geomip.done;
+        geometry.addEventListener('refine', (e) => { sawDone ||= e.done; });
+      }, undefined, resolve);
+      setTimeout(() => resolve(null), 20000);
+    });
+    server.close();
+    check(error !== null && c.error.test(error.message) && !sawDone,
+          `${pack} ${c.name}: onError (${error?.message}), never done`);
+  }
+  const prefix = await new GeomipLoader().parse(bytes.subarray(0, Math.floor(bytes.length * 0.6)));
+  const info = prefix.userData.geomip;
+  check(!info.done && info.total === bytes.length && info.status === 'truncated',
+        `${pack}: parse() of a prefix: done ${info.done}, total ${info.total} of ${bytes.length}, ${info.status}`);
+  const u = info.upright;  // a rotation: orthonormal columns, no translation
+  let orthonormal = u[15] === 1 && u[12] === 0 && u[13] === 0 && u[14] === 0;
+  for (let a = 0; a < 3; ++a)
+    for (let b = 0; b < 3; ++b) {
+      const dot = u[4 * a] * u[4 * b] + u[4 * a + 1] * u[4 * b + 1] + u[4 * a + 2] * u[4 * b + 2];
+      orthonormal &&= Math.abs(dot - (a === b ? 1 : 0)) < 1e-9;
+    }
+  check(orthonormal, `${pack}: userData.geomip.upright is a rotation`);
 }
 console.log(failures === 0 ? 'three_loader_test: all checks passed' : `three_loader_test: ${failures} check(s) failed`);
 process.exit(failures === 0 ? 0 : 1);

@@ -371,6 +371,19 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
   if (options.draco_position_bits < 0 || options.draco_position_bits > 30)
     throw InvalidInput("write_gltf: Draco position bits must be in 1..30 (0 = no Draco), got " +
                        std::to_string(options.draco_position_bits));
+  {  // the node's rotation: orthonormal rows, determinant +1
+    const auto& r = options.node_rotation;
+    double worst = 0;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        const double dot = r[3 * a] * r[3 * b] + r[3 * a + 1] * r[3 * b + 1] + r[3 * a + 2] * r[3 * b + 2];
+        worst = std::max(worst, std::abs(dot - (a == b ? 1.0 : 0.0)));
+      }
+    const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                       r[2] * (r[3] * r[7] - r[4] * r[6]);
+    if (!(worst <= 1e-6) || !(std::abs(det - 1) <= 1e-6))
+      throw InvalidInput("write_gltf: the node rotation is not a rotation");
+  }
 
   tinygltf::Model model;
   model.asset.version = "2.0";
@@ -438,6 +451,14 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
   model.meshes.emplace_back().primitives.push_back(prim);
   tinygltf::Node node;
   node.mesh = 0;
+  const auto& r = options.node_rotation;
+  if (r != std::array<double, 9>{1, 0, 0, 0, 1, 0, 0, 0, 1}) {
+    node.matrix.assign(16, 0.0);  // column-major
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 3; ++col)
+        node.matrix[static_cast<std::size_t>(4 * col + row)] = r[3 * row + col];
+    node.matrix[15] = 1;
+  }
   model.nodes.push_back(node);
   model.scenes.emplace_back().nodes.push_back(0);
   model.defaultScene = 0;

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <iosfwd>
 #include <string>
 #include <string_view>
@@ -36,6 +37,11 @@ struct GltfWriteOptions {
   /// 0: plain accessors. 1..30: KHR_draco_mesh_compression with positions quantized to this many bits over
   /// the bounding box (normals 10 bits, texture coordinates 12), Draco's edgebreaker at compression level 7.
   int draco_position_bits = 0;
+  /// Row-major 3×3 rotation put on the scene's node (glTF's `matrix`), so that viewers show the mesh turned
+  /// while its positions stay as given: e.g. a pack's view frame, up +Y and front +Z as glTF has them. The
+  /// identity (default) writes no matrix. \throw InvalidInput when it is not a rotation (orthonormal,
+  /// determinant +1, within 1e-6).
+  std::array<double, 9> node_rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};
 };
 
 /// Writes `mesh` (positions as float32) with `attributes` as glTF 2.0 to `out`. Does not open or rename

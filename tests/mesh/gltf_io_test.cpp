@@ -43,6 +43,43 @@ TEST(GltfIo, RoundTripIsExactInFloatForGlbAndJson) {
   }
 }
 
+// A node rotation (a pack's view frame) is written as the node's matrix: positions stay as given, a reader
+// that applies node transforms (ours) sees them turned; a matrix that is no rotation is refused.
+TEST(GltfIo, NodeRotationTurnsTheSceneNotThePositions) {
+  const TriMesh torus = float_rounded(test::torus(12, 7));
+  GltfWriteOptions o;
+  o.node_rotation = {0, 0, 1, 0, 1, 0, -1, 0, 0};  // row-major: (x, y, z) ↦ (z, y, −x)
+  std::ostringstream out;
+  write_gltf(torus, {}, out, o);
+  const std::string bytes = out.str();
+  std::uint32_t json_bytes = 0;
+  std::memcpy(&json_bytes, bytes.data() + 12, 4);
+  const auto json = nlohmann::json::parse(bytes.substr(20, json_bytes));
+  const std::vector<double> column_major = {0, 0, -1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 1};
+  EXPECT_EQ(json["nodes"][0]["matrix"].get<std::vector<double>>(), column_major);
+  const auto accessor =
+      json["accessors"][json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].get<int>()];
+  double max_x = -HUGE_VAL;
+  for (const auto& p : torus.positions) max_x = std::max(max_x, p.x());
+  EXPECT_FLOAT_EQ(accessor["max"][0].get<double>(), max_x) << "positions as given";
+  const TriMesh back = read_gltf_from_memory(bytes, "torus", "");
+  ASSERT_EQ(back.positions.size(), torus.positions.size());
+  for (std::size_t v = 0; v < torus.positions.size(); ++v) {
+    const Eigen::Vector3d& p = torus.positions[v];
+    EXPECT_LT((back.positions[v] - Eigen::Vector3d(p.z(), p.y(), -p.x())).norm(), 1e-6) << v;
+  }
+  // Identity: no matrix at all; a scale or a mirror: refused.
+  std::ostringstream plain;
+  write_gltf(torus, {}, plain, {});
+  EXPECT_EQ(plain.str().find("\"matrix\""), std::string::npos);
+  for (const std::array<double, 9>& bad : {std::array<double, 9>{2, 0, 0, 0, 2, 0, 0, 0, 2},
+                                           std::array<double, 9>{-1, 0, 0, 0, 1, 0, 0, 0, 1}}) {
+    o.node_rotation = bad;
+    std::ostringstream sink;
+    EXPECT_THROW(write_gltf(torus, {}, sink, o), InvalidInput);
+  }
+}
+
 // glTF splits vertices at texture seams; geomip reads positions only, so a torus written with every
 // triangle's corners duplicated (a "triangle soup", as per-face attributes force) reads back welded: the same
 // vertices and topology as the torus itself.

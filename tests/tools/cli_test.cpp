@@ -1734,6 +1734,23 @@ TEST_F(CliPack, ConvertUpStoresAFrameAndLeavesDecodedMeshesAlone) {
   ASSERT_EQ(geomip("decode -q '" + framed + "' -o '" + dir_ + "/framed.obj'").exit_code, 0);
   ASSERT_EQ(geomip("decode -q '" + plain + "' -o '" + dir_ + "/plain.obj'").exit_code, 0);
   EXPECT_EQ(slurp(dir_ + "/framed.obj"), slurp(dir_ + "/plain.obj"));
+  // glTF: the same positions, and the frame as the node's rotation (glTF's +Y up): a viewer stands it up.
+  const auto glb_json = [&](const std::string& pack) {
+    const std::string glb = dir_ + "/x.glb";
+    EXPECT_EQ(geomip("decode -q '" + pack + "' -o '" + glb + "'").exit_code, 0);
+    const std::string bytes = slurp(glb);
+    std::uint32_t json_bytes = 0;
+    std::memcpy(&json_bytes, bytes.data() + 12, 4);
+    return nlohmann::json::parse(bytes.substr(20, json_bytes));
+  };
+  const auto framed_glb = glb_json(framed), plain_glb = glb_json(plain);
+  EXPECT_FALSE(plain_glb["nodes"][0].contains("matrix"));
+  ASSERT_TRUE(framed_glb["nodes"][0].contains("matrix"));
+  const auto m = framed_glb["nodes"][0]["matrix"].get<std::vector<double>>();  // column-major
+  const double scale = std::hypot(n[0], n[1], n[2]);
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) EXPECT_NEAR(m[4 * col + row], n[4 * row + col] / scale, 1e-12);
+  EXPECT_EQ(framed_glb["accessors"], plain_glb["accessors"]) << "positions as decoded, bounds included";
   const std::string bad = dir_ + "/bad.gip";
   const Outcome r = geomip("convert -q '" + spot_ + "' --level 3 --up w -o '" + bad + "'");
   EXPECT_EQ(r.exit_code, 2) << r.err;

@@ -158,7 +158,7 @@ CommandRunner add_eval_command(CLI::App& app) {
       "Metro-style surface distance between ORIGINAL and APPROX: both sampled (vertices + area-uniform face "
       "samples), exact closest-point distances both ways; symmetric Hausdorff and RMS in % of ORIGINAL's "
       "bounding-box diagonal, PSNR = 20·log10(diagonal / RMS) (inf for identical surfaces; JSON null)");
-  cmd->add_option("original", args->original, "Reference mesh: .obj .ply .off .stl")->required();
+  cmd->add_option("original", args->original, "Reference mesh: .obj .ply .off .stl .gltf .glb")->required();
   cmd->add_option("approx", args->approx, "Approximating mesh, same coordinate frame")->required();
   // Bounded: each sample is a closest-point query and 56 bytes, so 10^8 is minutes and ~6 GB already.
   cmd->add_option("--samples", args->options.face_samples,

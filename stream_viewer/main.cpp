@@ -393,7 +393,7 @@ static CLI::Validator non_negative(const std::string& what) {
         double x = 0;
         return CLI::detail::lexical_cast(v, x) && x >= 0 ? std::string() : v + " is negative (" + what + ")";
       },
-      "≥ 0");
+      ">= 0");  // ASCII: CLI11 pads its help columns by bytes
 }
 
 /// The same for options that must be > 0.

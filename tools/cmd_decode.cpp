@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -91,8 +92,16 @@ int run_decode(const DecodeArgs& args) {
   const std::vector<std::uint8_t> bytes = read_pack_file(args.pack);
   std::size_t manifest_end = 0;
   const codec::Status header = codec::read_pack_header(bytes, manifest_end);
-  if (header == codec::Status::kCorrupt || (header == codec::Status::kTruncated && bytes.size() < 8))
-    throw InvalidInput(args.pack + ": not a geomip pack (no GEOMIPK header)");
+  if (header == codec::Status::kCorrupt || (header == codec::Status::kTruncated && bytes.size() < 8)) {
+    // The magic is there but the rest of the header is not what its version field promises: say so, not
+    // "no header" (a version field set to 1–3 on a newer pack reads as a 20-byte header of the old layout).
+    const bool magic = bytes.size() >= 8 && std::memcmp(bytes.data(), "GEOMIPK\x1a", 8) == 0;
+    throw InvalidInput(args.pack +
+                       (magic ? ": a corrupt geomip pack header (version " +
+                                    std::to_string(bytes.size() >= 10 ? bytes[8] | bytes[9] << 8 : 0) +
+                                    " with the layout of another version, or damaged sizes)"
+                              : ": not a geomip pack (no GEOMIPK header)"));
+  }
   codec::PackDecodeOptions options;
   if (args.bytes >= 0) options.max_bytes = static_cast<std::size_t>(args.bytes);
   const auto t0 = std::chrono::steady_clock::now();

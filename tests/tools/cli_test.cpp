@@ -1851,10 +1851,15 @@ TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {
   flipped_bytes[bytes.size() - 3] ^= 0x20;
   const std::string flipped = file("flipped.gip", flipped_bytes);
   const std::string garbage = file("garbage.gip", "this is not a pack at all");
+  std::string old_version_bytes = bytes;  // the magic, but a version field whose header layout does not fit
+  old_version_bytes[8] = 2;
+  old_version_bytes[9] = 0;
+  const std::string old_version = file("old-version.gip", old_version_bytes);
   const std::string out = dir_ + "/out.obj";
   expect_bad_input("decode '" + truncated + "' -o '" + out + "'", truncated);
   expect_bad_input("decode '" + flipped + "' -o '" + out + "'", flipped);
   expect_bad_input("decode '" + garbage + "' -o '" + out + "'", garbage);
+  expect_bad_input("decode '" + old_version + "' -o '" + out + "'", "corrupt geomip pack header (version 2");
   expect_bad_input("decode '" + dir_ + "/missing.gip' -o '" + out + "'", dir_ + "/missing.gip");
   expect_bad_input("decode '" + pack + "' --bytes 10 -o '" + out + "'", pack);  // inside the manifest
   EXPECT_FALSE(fs::exists(out));

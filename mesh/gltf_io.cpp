@@ -1,6 +1,7 @@
 #include "mesh/gltf_io.h"
 
 #include "mesh/errors.h"
+#include "mesh/view_frame.h"
 
 // Debian ships TinyGLTF as a shared library (libtinygltf); only its declarations are needed here. Images are
 // never decoded (geomip reads geometry), so the stb image headers are not needed either.
@@ -371,19 +372,8 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
   if (options.draco_position_bits < 0 || options.draco_position_bits > 30)
     throw InvalidInput("write_gltf: Draco position bits must be in 1..30 (0 = no Draco), got " +
                        std::to_string(options.draco_position_bits));
-  {  // the node's rotation: orthonormal rows, determinant +1
-    const auto& r = options.node_rotation;
-    double worst = 0;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        const double dot = r[3 * a] * r[3 * b] + r[3 * a + 1] * r[3 * b + 1] + r[3 * a + 2] * r[3 * b + 2];
-        worst = std::max(worst, std::abs(dot - (a == b ? 1.0 : 0.0)));
-      }
-    const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
-                       r[2] * (r[3] * r[7] - r[4] * r[6]);
-    if (!(worst <= 1e-6) || !(std::abs(det - 1) <= 1e-6))
-      throw InvalidInput("write_gltf: the node rotation is not a rotation");
-  }
+  if (!is_rotation(options.node_rotation))
+    throw InvalidInput("write_gltf: the node rotation is not a rotation");
 
   tinygltf::Model model;
   model.asset.version = "2.0";

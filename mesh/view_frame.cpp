@@ -326,4 +326,25 @@ std::array<double, 16> view_normalization(const TriMesh& mesh, const Eigen::Matr
   return m;
 }
 
+bool is_rotation(const std::array<double, 9>& r, double tolerance) {
+  double worst = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      worst = std::max(worst, std::abs(r[3 * a] * r[3 * b] + r[3 * a + 1] * r[3 * b + 1] +
+                                       r[3 * a + 2] * r[3 * b + 2] - (a == b ? 1.0 : 0.0)));
+  const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                     r[2] * (r[3] * r[7] - r[4] * r[6]);
+  return worst <= tolerance && std::abs(det - 1) <= tolerance;  // false for NaN too
+}
+
+std::array<double, 9> frame_rotation(const std::array<double, 16>& n) {
+  const std::array<double, 9> identity{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const double scale = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!(scale > 0) || !std::isfinite(scale)) return identity;
+  std::array<double, 9> r{};
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) r[3 * row + col] = n[4 * row + col] / scale;
+  return is_rotation(r) ? r : identity;
+}
+
 }  // namespace geomip

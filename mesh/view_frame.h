@@ -64,4 +64,11 @@ Eigen::Matrix3d upright_rotation(const TriMesh& mesh, UpAxis up,
 /// for an empty or degenerate mesh).
 std::array<double, 16> view_normalization(const TriMesh& mesh, const Eigen::Matrix3d& rotation);
 
+/// True when row-major `r` is a rotation: orthonormal rows and determinant +1, each within `tolerance`.
+bool is_rotation(const std::array<double, 9>& r, double tolerance = 1e-6);
+
+/// The rotation R of a view_normalization() (its 3×3 is R / e), row-major; the identity when the 3×3 is not
+/// a positively scaled rotation (no frame stored, or a hand-made matrix).
+std::array<double, 9> frame_rotation(const std::array<double, 16>& normalization);
+
 }  // namespace geomip

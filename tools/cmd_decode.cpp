@@ -5,6 +5,7 @@
 #include "mesh/errors.h"
 #include "mesh/gltf_io.h"
 #include "mesh/mesh_io.h"
+#include "mesh/view_frame.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/pack_file.h"
@@ -57,26 +58,6 @@ MeshFormat format_of(const std::string& path) {
   } catch (const InvalidInput&) {
   }
   throw InvalidInput("-o " + path + ": the extension must be .obj, .ply, .off, .gltf or .glb");
-}
-
-// The rotation of a model's view frame (`geomip convert --up`: up +y, front +z, glTF's convention),
-// row-major: the normalization's 3×3 over its scale. The identity when the pack stores no frame, or when its
-// 3×3 is not a scaled rotation (a hand-made pack).
-std::array<double, 9> frame_rotation(const std::array<double, 16>& n) {
-  const double scale = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  std::array<double, 9> r{1, 0, 0, 0, 1, 0, 0, 0, 1};
-  if (!(scale > 0) || !std::isfinite(scale)) return r;
-  std::array<double, 9> q{};
-  for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 3; ++col) q[3 * row + col] = n[4 * row + col] / scale;
-  double worst = 0;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b)
-      worst = std::max(worst, std::abs(q[3 * a] * q[3 * b] + q[3 * a + 1] * q[3 * b + 1] +
-                                       q[3 * a + 2] * q[3 * b + 2] - (a == b ? 1.0 : 0.0)));
-  const double det = q[0] * (q[4] * q[8] - q[5] * q[7]) - q[1] * (q[3] * q[8] - q[5] * q[6]) +
-                     q[2] * (q[3] * q[7] - q[4] * q[6]);
-  return worst <= 1e-6 && std::abs(det - 1) <= 1e-6 ? q : r;
 }
 
 int run_decode(const DecodeArgs& args) {

@@ -247,6 +247,22 @@ TEST(ViewFrame, NormalizationMapsTheRotatedBoxToTheCentredUnitBox) {
   EXPECT_NEAR(hi.y() - lo.y(), 1.4 / 2.0, 1e-12) << "y is the animal's height (1.4 of its length 2)";
 }
 
+// frame_rotation() takes the rotation back out of a normalization (what decode's glTF node carries).
+TEST(ViewFrame, FrameRotationUndoesTheNormalizationsScale) {
+  TriMesh m = animal();
+  const Eigen::Matrix3d r = upright_rotation(m, UpAxis::kZ);
+  const std::array<double, 9> back = frame_rotation(view_normalization(m, r));
+  EXPECT_TRUE(is_rotation(back));
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) EXPECT_NEAR(back[3 * row + col], r(row, col), 1e-12);
+  const std::array<double, 9> identity{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  std::array<double, 16> sheared{1, 0.5, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  EXPECT_EQ(frame_rotation(sheared), identity) << "not a scaled rotation";
+  std::array<double, 16> mirrored{-2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1};
+  EXPECT_EQ(frame_rotation(mirrored), identity) << "determinant −1";
+  EXPECT_EQ(frame_rotation(std::array<double, 16>{}), identity) << "zero scale";
+}
+
 TEST(ViewFrame, DegenerateMeshesGiveAFrameWithoutNaN) {
   TriMesh empty;
   EXPECT_TRUE(ground_direction(empty).isApprox(-Eigen::Vector3d::UnitY()));

@@ -70,13 +70,19 @@ int run_morph(const MorphArgs& args) {
 
   make_output_directory(args.output);
   const auto schedule = wavelet ? morph::MorphSchedule::kWavelet : morph::MorphSchedule::kLinear;
-  // The morph's two ends choose the quad split together: every frame gets the same face list.
-  const std::vector<const codec::DecodedModel*> ends{&decoded.models[args.from], &decoded.models[args.to]};
+  // Every frame gets the same face list, and it is `geomip decode`'s for this pack: the quad split is chosen
+  // by all the models of the morph's layout together, as decode chooses it (so attributes carry between a
+  // morph frame and a decoded model by face index).
+  std::vector<const codec::DecodedModel*> same_layout;
+  for (const auto& model : decoded.models)
+    if (model.geometry.size() == frame.geometry.size() &&
+        model.geometry.front().level == frame.geometry.front().level)
+      same_layout.push_back(&model);
   for (int k = 0; k < args.frames; ++k) {
     const float t = args.frames == 1 ? 0.0f : static_cast<float>(k) / static_cast<float>(args.frames - 1);
     const auto positions = morph::evaluate_morph(a, b, t, schedule);
     for (std::size_t p = 0; p < positions.size(); ++p) frame.geometry[p].values = positions[p];
-    const TriMesh mesh = decoded_mesh(frame, args.level, {.chosen_by = ends});
+    const TriMesh mesh = decoded_mesh(frame, args.level, {.chosen_by = same_layout});
     char name[32];
     std::snprintf(name, sizeof name, "morph_%04d.obj", k);
     const std::string path = (std::filesystem::path(args.output) / name).string();

@@ -114,6 +114,36 @@ TEST_F(MorphCommandTest, FramesShareConnectivityAndInterpolateTheModels) {
   EXPECT_GT(wavelet_gap, 1e-3) << "the wavelet schedule's midpoint differs";
 }
 
+// A morph's frames carry `geomip decode`'s face list for the same pack, also when the pack holds models
+// besides the morph's two ends (the quad split is chosen by every model of the layout, as decode chooses it;
+// it used to be chosen by the two ends alone, so faces differed and attributes could not carry over by
+// index).
+TEST_F(MorphCommandTest, FramesHaveDecodesFaceListInAPackOfThree) {
+  codec::PackModelInput stretched = testing::pack_input(5, 1);
+  stretched.name = "stretched";
+  for (auto& patch : stretched.geometry)
+    for (std::size_t i = 0; i < patch.values.size(); i += 3) patch.values[i] *= 4.0f;
+  const auto bytes =
+      codec::write_pack({testing::pack_input(5, 0), testing::pack_input(5, 1), std::move(stretched)});
+  std::ofstream(dir_ / "three.gip", std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  const std::string log = " > " + (dir_ / "log3.txt").string() + " 2>&1";
+  fs::create_directories(dir_ / "d3");
+  ASSERT_EQ(std::system((std::string(GEOMIP_BINARY) + " morph " + (dir_ / "three.gip").string() +
+                         " --frames 2 --from 0 --to 1 -o " + (dir_ / "m3").string() + log)
+                            .c_str()),
+            0);
+  ASSERT_EQ(std::system((std::string(GEOMIP_BINARY) + " decode " + (dir_ / "three.gip").string() + " -o " +
+                         (dir_ / "d3" / "x.obj").string() + log)
+                            .c_str()),
+            0);
+  const Obj frame = read_obj(dir_ / "m3" / "morph_0000.obj");
+  const Obj decoded = read_obj(dir_ / "d3" / "x.ellipsoid.obj");
+  ASSERT_FALSE(frame.faces.empty());
+  EXPECT_EQ(frame.faces, decoded.faces);
+  EXPECT_EQ(read_obj(dir_ / "d3" / "x.stretched.obj").faces, decoded.faces) << "decode: one face list";
+}
+
 TEST_F(MorphCommandTest, BadModelIndexIsBadInput) {
   EXPECT_EQ(morph("--frames 2 --to 7 -o " + (dir_ / "x").string()), 2);
 }

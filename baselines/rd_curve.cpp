@@ -93,6 +93,18 @@ double envelope_at(const std::vector<RdPoint>& front, std::size_t bytes) {
   return best;
 }
 
+double envelope_interpolated(const std::vector<RdPoint>& front, std::size_t bytes) {
+  const auto above = std::upper_bound(front.begin(), front.end(), bytes,
+                                      [](std::size_t b, const RdPoint& p) { return b < p.bytes; });
+  if (above == front.begin()) return -std::numeric_limits<double>::infinity();
+  const RdPoint& lo = *(above - 1);
+  if (above == front.end() || lo.bytes == bytes || lo.bytes == 0) return lo.psnr_db;
+  const RdPoint& hi = *above;
+  const double t = (std::log(static_cast<double>(bytes)) - std::log(static_cast<double>(lo.bytes))) /
+                   (std::log(static_cast<double>(hi.bytes)) - std::log(static_cast<double>(lo.bytes)));
+  return lo.psnr_db + t * (hi.psnr_db - lo.psnr_db);
+}
+
 void write_rd_csv(std::ostream& out, const std::vector<RdPoint>& points) {
   out << "method,bytes,psnr_db,hausdorff_pct,decode_ms,rms_pct,faces,vertices,quantization_bits,source\n";
   for (const RdPoint& p : points)

@@ -3,7 +3,9 @@
 // A point is one coded mesh: its size in bytes and the distortion of its decoded mesh against the original
 // (PSNR and Hausdorff distance of gimage/surface_distance.h). The envelope of several parameter sweeps (for
 // example decimation × quantization) is the set of points no other point beats in both size and quality: the
-// best any choice of parameters achieves, read off as a staircase (`envelope_at`).
+// best any choice of parameters achieves, read off as a staircase (`envelope_at`: what one coded file within
+// a budget gives) or interpolated in log(bytes) between its points (`envelope_interpolated`: the usual
+// reading of a baseline's curve, and the one geomip is compared against).
 #pragma once
 
 #include <cstddef>
@@ -36,6 +38,12 @@ std::vector<RdPoint> upper_envelope(const std::vector<RdPoint>& points);
 /// when none is that small. `front` may be any set of points (not necessarily a front, in any order);
 /// non-decreasing in `bytes`.
 double envelope_at(const std::vector<RdPoint>& front, std::size_t bytes);
+
+/// The front read between its points: PSNR linear in log(bytes) between the two points of `front` whose bytes
+/// bracket `bytes` (exactly a point's PSNR at its bytes); below the smallest point −infinity, above the
+/// largest the largest point's PSNR. `front` must be an upper envelope (upper_envelope()'s output: sorted by
+/// bytes, PSNR increasing); never below envelope_at() of the same front. O(log n).
+double envelope_interpolated(const std::vector<RdPoint>& front, std::size_t bytes);
 
 /// Writes `points` as CSV: header `method,bytes,psnr_db,hausdorff_pct,decode_ms,rms_pct,faces,vertices,
 /// quantization_bits,source` and one row per point, in order. PSNR +infinity is written as `inf`.

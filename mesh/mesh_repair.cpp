@@ -9,6 +9,7 @@
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
 
@@ -227,6 +228,36 @@ RepairResult repair_mesh(const TriMesh& input, const RepairOptions& options) {
     out.triangles.push_back(t);
   }
   report(options, "done", 1.0);
+  return result;
+}
+
+std::optional<SelfIntersections> count_self_intersections(const TriMesh& mesh) {
+  std::vector<Point> points;
+  points.reserve(mesh.num_vertices());
+  for (const auto& p : mesh.positions) points.emplace_back(p.x(), p.y(), p.z());
+  std::vector<std::array<std::size_t, 3>> polygons;
+  polygons.reserve(mesh.num_triangles());
+  for (const auto& t : mesh.triangles) {
+    const std::array<std::size_t, 3> f{std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])};
+    if (f[0] >= points.size() || f[1] >= points.size() || f[2] >= points.size())
+      throw InvalidInput("count_self_intersections: a triangle index is out of range");
+    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2] ||
+        CGAL::collinear(points[f[0]], points[f[1]], points[f[2]]))
+      continue;
+    polygons.push_back(f);
+  }
+  if (polygons.empty() || !PMP::is_polygon_soup_a_polygon_mesh(polygons)) return std::nullopt;
+  SurfaceMesh sm;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
+  std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> pairs;
+  PMP::self_intersections(sm, std::back_inserter(pairs));
+  std::vector<SurfaceMesh::Face_index> faces;
+  faces.reserve(2 * pairs.size());
+  for (const auto& [a, b] : pairs) faces.push_back(a), faces.push_back(b);
+  std::sort(faces.begin(), faces.end());
+  SelfIntersections result;
+  result.pairs = pairs.size();
+  result.faces = static_cast<std::size_t>(std::unique(faces.begin(), faces.end()) - faces.begin());
   return result;
 }
 

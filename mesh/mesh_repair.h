@@ -4,6 +4,9 @@
 
 #include "mesh/mesh.h"
 
+#include <cstddef>
+#include <optional>
+
 namespace geomip {
 
 struct RepairOptions {
@@ -48,5 +51,18 @@ struct RepairResult {
 /// The surviving original vertices keep their positions and their relative order; new vertices are appended.
 /// \throw InvalidInput when `mesh` has no triangles, or non-finite coordinates.
 RepairResult repair_mesh(const TriMesh& mesh, const RepairOptions& options = {});
+
+/// Triangles of a mesh that cross other triangles of it (self-intersections: booleans, 3D printing and
+/// physics engines refuse such meshes; `geomip info --self-intersections`).
+struct SelfIntersections {
+  std::size_t pairs = 0;  ///< pairs of triangles that intersect other than in the edge or vertex they share
+  std::size_t faces = 0;  ///< distinct triangles in at least one such pair
+};
+
+/// Counts the self-intersections of `mesh` with CGAL's exact predicates (PMP::self_intersections; boxes
+/// first, O(n log n + k)). Faces with a repeated vertex or zero area are left out (analyze_topology() counts
+/// those). Empty when the other faces do not form a polygon mesh (non-manifold edges or vertices, or
+/// inconsistent orientation: `geomip repair` first), where "crossing" has no single answer.
+std::optional<SelfIntersections> count_self_intersections(const TriMesh& mesh);
 
 }  // namespace geomip

@@ -102,6 +102,39 @@ TEST(MeshRepair, LargestComponentOnlyKeepsTheBiggerPieceAndItsVertexOrder) {
 
 TEST(MeshRepair, RejectsEmptyMesh) { EXPECT_THROW(repair_mesh(TriMesh{}), InvalidInput); }
 
+TEST(SelfIntersections, CountsCrossingTrianglesAndNothingOnACleanSurface) {
+  const TriMesh ball = test::sphere(3);
+  const auto clean = count_self_intersections(ball);
+  ASSERT_TRUE(clean.has_value());
+  EXPECT_EQ(clean->pairs, 0u);
+  EXPECT_EQ(clean->faces, 0u);
+
+  // One vertex pushed through the surface to the far side: its umbrella crosses the triangles there.
+  TriMesh folded = ball;
+  folded.positions[0] = -1.5 * folded.positions[0];
+  const auto fold = count_self_intersections(folded);
+  ASSERT_TRUE(fold.has_value());
+  EXPECT_GT(fold->pairs, 0u);
+  EXPECT_GE(fold->faces, 2u);
+  EXPECT_LE(fold->faces, 2 * fold->pairs);
+
+  // Two overlapping balls in one mesh: the crossing runs along a circle, on both of them.
+  TriMesh two = ball;
+  for (std::size_t v = 0; v < ball.positions.size(); ++v)
+    two.positions.push_back(ball.positions[v] + Eigen::Vector3d(0.5, 0, 0));
+  const int n = static_cast<int>(ball.positions.size());
+  for (const auto& t : ball.triangles) two.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+  const auto overlap = count_self_intersections(two);
+  ASSERT_TRUE(overlap.has_value());
+  EXPECT_GT(overlap->faces, 20u);
+
+  // A pinch (two tetrahedra sharing one vertex) is no polygon mesh: not counted rather than guessed.
+  EXPECT_FALSE(count_self_intersections(test::pinched_tetrahedra()).has_value());
+  TriMesh bad = ball;
+  bad.triangles[0][1] = 1 << 30;
+  EXPECT_THROW(count_self_intersections(bad), InvalidInput);
+}
+
 TEST(MeshRepairReal, BunnyBecomesClosedGenusZeroOfAboutThePapersSize) {
   GEOMIP_REQUIRE_SHARED_MESH(path, "bunny.obj");
   const TriMesh bunny = read_mesh(path);

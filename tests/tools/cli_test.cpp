@@ -125,6 +125,36 @@ TEST_F(Cli, InfoJsonHasTheDocumentedKeys) {
   EXPECT_EQ(j["manifold"], true);
 }
 
+// `info --self-intersections`: the bundled mesh has none; two overlapping tetrahedra in one file cross; a
+// non-manifold file is "not counted" (null), not a guess.
+TEST_F(Cli, InfoCountsSelfIntersections) {
+  const std::string mesh = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
+  Outcome r = geomip("info --json --self-intersections '" + mesh + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["self_intersections"]["pairs"], 0);
+  EXPECT_FALSE(geomip("info --json '" + mesh + "'").out.find("self_intersections") != std::string::npos)
+      << "counted only when asked (it costs seconds on large meshes)";
+  const std::string tet = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+  const std::string two = file("two.obj",
+                               "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                               "v 0.2 0.2 0.2\nv 1.2 0.2 0.2\nv 0.2 1.2 0.2\nv 0.2 0.2 1.2\n" +
+                                   tet + "f 5 7 6\nf 5 6 8\nf 6 7 8\nf 7 5 8\n");
+  r = geomip("info --json --self-intersections '" + two + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["self_intersections"]["pairs"].get<int>(), 0);
+  EXPECT_GE(j["self_intersections"]["faces"].get<int>(), 4);
+  r = geomip("info --self-intersections '" + two + "'");
+  EXPECT_NE(r.out.find("self-intersections: "), std::string::npos) << r.out;
+  const std::string pinch =
+      file("pinch.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv -1 0 0\nv 0 -1 0\nv 0 0 -1\n" + tet +
+                            "f 1 5 6\nf 1 6 7\nf 1 7 5\nf 5 7 6\n");
+  r = geomip("info --json --self-intersections '" + pinch + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(nlohmann::json::parse(r.out)["self_intersections"].is_null()) << r.out;
+}
+
 TEST_F(Cli, BadInputsExitTwoWithOneLine) {
   const std::string missing = dir_ + "/missing.obj";
   expect_bad_input("info '" + missing + "'", missing);

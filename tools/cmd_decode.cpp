@@ -33,6 +33,7 @@ struct DecodeArgs {
   int level = -1;
   int draco = 0;  // glTF output: Draco position bits, 0 = no Draco
   std::string quad_split = "shorter";
+  bool untangle = true;
   bool json = false;
   bool quiet = false;
 };
@@ -157,16 +158,23 @@ int run_decode(const DecodeArgs& args) {
   }
   const QuadSplit quad_split = args.quad_split == "fixed" ? QuadSplit::kFixed : QuadSplit::kShorter;
   nlohmann::json j_models = nlohmann::json::array();
+  // The grids as decoded choose the quad split, also when their folds are opened before writing: the face
+  // list stays what it was (the web loader's and `--no-untangle`'s), the same for every model of a layout.
+  std::vector<codec::DecodedModel> as_decoded;
+  if (args.untangle) as_decoded = decoded.models;
+  const std::vector<codec::DecodedModel>& choosers = args.untangle ? as_decoded : decoded.models;
   for (std::size_t m = 0; m < decoded.models.size(); ++m) {
     // The models of the same layout (a consistent pack: all of them) choose the quad split together, so they
     // keep one face list (as far as their hole masks agree).
     std::vector<const codec::DecodedModel*> same_layout;
-    for (const auto& other : decoded.models) {
+    for (const auto& other : choosers) {
       if (other.geometry.size() == decoded.models[m].geometry.size() &&
           other.geometry.front().level == decoded.models[m].geometry.front().level)
         same_layout.push_back(&other);
     }
     const QuadSplitOptions split{.split = quad_split, .chosen_by = same_layout};
+    UntangleStats untangled;
+    if (args.untangle) untangled = untangle_decoded_model(decoded.models[m], split);
     // glTF carries per-patch texture coordinates and the normal maps' normals (seams not welded); the
     // other formats get the welded mesh.
     const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level, split) : TexturedMesh{};
@@ -187,6 +195,12 @@ int run_decode(const DecodeArgs& args) {
                         {"faces", written.num_triangles()},
                         {"detail_level", decoded.models[m].detail_level},
                         {"geometry_passes", decoded.models[m].geometry_passes}});
+    if (args.untangle)
+      j_models.back()["untangle"] = {{"folded_before", untangled.folded_before},
+                                     {"folded_after", untangled.folded_after},
+                                     {"moved", untangled.moved},
+                                     {"max_move", untangled.max_move},
+                                     {"sweeps", untangled.sweeps}};
     if (!args.quiet && !args.json) {
       std::printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",
                   codec::one_line(decoded.models[m].name).c_str(), codec::one_line(paths[m]).c_str(),
@@ -235,6 +249,12 @@ CommandRunner add_decode_command(CLI::App& app) {
                   "chooses together, so they share one face list) or fixed (the layout's rule, as geomip remesh)")
       ->check(CLI::IsMember({"shorter", "fixed"}))
       ->capture_default_str();
+  cmd->add_flag(
+      "--untangle,!--no-untangle", args->untangle,
+      "Open the decoded grids' folds before writing (default; samples of triangles that face against "
+      "the surface around them slide along the decoded surface: 41-100 % fewer self-intersecting "
+      "faces, PSNR within 0.25 dB); --no-untangle writes the grids as decoded, as geomip rd measures "
+      "them");
   cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No report");
   return [args] { return run_decode(*args); };

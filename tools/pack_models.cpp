@@ -4,6 +4,8 @@
 #include "mesh/errors.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace geomip::tools {
 
@@ -48,11 +50,33 @@ std::vector<Eigen::Vector3d> grid_positions(const UniformRemeshResult& remesh, c
   return positions;
 }
 
-/// decoded_mesh() with `weld` choosing whether seams are welded (the model's seams) or not (every patch its
-/// own vertices; the quads split as in the welded mesh: each split depends only on the quad's corners);
-/// `origin`, if given, receives each output vertex's first grid sample.
-TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld, const QuadSplitOptions& split,
-                          std::vector<GridSample>* origin) {
+/// The point of triangle (a, b, c) closest to p (Ericson, Real-Time Collision Detection, §5.1.5).
+Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                    const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+  const double denom = va + vb + vc;
+  if (!(std::abs(denom) > 0)) return a;  // degenerate triangle
+  return a + ab * (vb / denom) + ac * (vc / denom);
+}
+
+/// The level-`level` grids of `model` as one mesh before any hole mask: `remesh`'s numbering (seams welded
+/// when `weld`), its positions the model's samples, its quads split as `split` says.
+UniformRemeshResult grid_mesh(const codec::DecodedModel& model, int level, bool weld,
+                              const QuadSplitOptions& split) {
   if (model.geometry.empty()) throw InvalidInput("decoded_mesh: the model has no patches");
   const int grid_level = model.geometry.front().level;
   if (level < 0) level = grid_level;
@@ -87,6 +111,17 @@ TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld
     }
     split_along_shorter_diagonals(remesh, level, views);
   }
+  return remesh;
+}
+
+/// decoded_mesh() with `weld` choosing whether seams are welded (the model's seams) or not (every patch its
+/// own vertices; the quads split as in the welded mesh: each split depends only on the quad's corners);
+/// `origin`, if given, receives each output vertex's first grid sample.
+TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld,
+                          const QuadSplitOptions& split, std::vector<GridSample>* origin) {
+  if (model.geometry.empty()) throw InvalidInput("decoded_mesh: the model has no patches");
+  if (level < 0) level = model.geometry.front().level;
+  UniformRemeshResult remesh = grid_mesh(model, level, weld, split);
 
   const int n = (1 << level) + 1;
   std::vector<GridSample> first(origin ? remesh.mesh.positions.size() : 0, GridSample{-1, 0, 0});
@@ -144,6 +179,153 @@ TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld
 }
 
 }  // namespace
+
+UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplitOptions& split,
+                                     const UntangleOptions& options) {
+  UntangleStats stats;
+  if (model.geometry.empty()) return stats;
+  const int level = model.geometry.front().level;
+  UniformRemeshResult remesh = grid_mesh(model, level, /*weld=*/true, split);
+  std::vector<Eigen::Vector3d>& x = remesh.mesh.positions;
+  const std::vector<std::array<int, 3>>& tris = remesh.mesh.triangles;
+  const std::size_t nv = x.size();
+
+  // Vertex → triangles and vertex → neighbours (compressed rows).
+  std::vector<int> tri_start(nv + 1, 0), tri_of;
+  for (const auto& t : tris)
+    for (int v : t) ++tri_start[static_cast<std::size_t>(v) + 1];
+  for (std::size_t v = 0; v < nv; ++v) tri_start[v + 1] += tri_start[v];
+  tri_of.resize(static_cast<std::size_t>(tri_start[nv]));
+  {
+    std::vector<int> fill(tri_start.begin(), tri_start.end() - 1);
+    for (std::size_t t = 0; t < tris.size(); ++t)
+      for (int v : tris[t])
+        tri_of[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<int>(t);
+  }
+  auto face_normal = [&](std::size_t t) {  // area-weighted (twice the area)
+    const auto& f = tris[t];
+    return Eigen::Vector3d((x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]));
+  };
+
+  // The reference normal: the area-weighted vertex normals smoothed over `options.normal_rings` rings, so the
+  // few triangles of a fold do not turn it (a fold is a handful of triangles; the surface around it is not).
+  std::vector<Eigen::Vector3d> ref(nv, Eigen::Vector3d::Zero()), next(nv), face_sum(tris.size());
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    const Eigen::Vector3d n = face_normal(t);
+    for (int v : tris[t]) ref[static_cast<std::size_t>(v)] += n;
+  }
+  for (int ring = 0; ring < options.normal_rings; ++ring) {
+    for (auto& n : ref) n.normalize();               // a zero vector stays zero
+    for (std::size_t t = 0; t < tris.size(); ++t) {  // per triangle: the sum of its corners' normals
+      const auto& f = tris[t];
+      face_sum[t] = ref[f[0]] + ref[f[1]] + ref[f[2]];
+    }
+    for (std::size_t v = 0; v < nv; ++v) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int k = tri_start[v]; k < tri_start[v + 1]; ++k)
+        sum += face_sum[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])];
+      next[v] = sum;
+    }
+    ref.swap(next);
+  }
+  for (auto& n : ref) {
+    const double length = n.norm();
+    n = length > 0 ? Eigen::Vector3d(n / length) : Eigen::Vector3d::Zero();
+  }
+  auto folded = [&](std::size_t t) {
+    const auto& f = tris[t];
+    const Eigen::Vector3d r = ref[f[0]] + ref[f[1]] + ref[f[2]];
+    return face_normal(t).dot(r) < 0;
+  };
+
+  // Vertices of folded triangles move towards their neighbours' centroid within the reference tangent plane
+  // (the surface stays where it is, the fold opens), sweep after sweep, the set growing with any triangle a
+  // move folds; what tangential moves cannot open gets the whole step in the last sweeps.
+  std::vector<char> active(nv, 0), fold(tris.size(), 0);
+  std::vector<std::size_t> set;
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    if (!folded(t)) continue;
+    fold[t] = 1;
+    ++stats.folded_before;
+    for (int v : tris[t])
+      if (!active[static_cast<std::size_t>(v)])
+        active[static_cast<std::size_t>(v)] = 1, set.push_back(static_cast<std::size_t>(v));
+  }
+  const std::vector<Eigen::Vector3d> start = x;
+  for (int sweep = 0; sweep < options.max_sweeps && !set.empty(); ++sweep) {
+    for (std::size_t v : set) {
+      bool touches_fold = false;  // only the samples of a triangle still folded move
+      for (int k = tri_start[v]; k < tri_start[v + 1] && !touches_fold; ++k)
+        touches_fold = fold[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])] != 0;
+      if (!touches_fold) continue;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int count = 0;
+      for (int k = tri_start[v]; k < tri_start[v + 1]; ++k)
+        for (int w : tris[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])])
+          if (static_cast<std::size_t>(w) != v) sum += x[static_cast<std::size_t>(w)], ++count;
+      if (count == 0) continue;
+      Eigen::Vector3d d = sum / count - x[v];
+      d -= d.dot(ref[v]) * ref[v];
+      Eigen::Vector3d moved = x[v] + options.step * d;
+      {
+        // Back onto the decoded surface as it was (its triangles around v, two rings): the fold opens along
+        // the surface instead of leaving it.
+        double best = std::numeric_limits<double>::infinity();
+        Eigen::Vector3d on = moved;
+        for (int k = tri_start[v]; k < tri_start[v + 1]; ++k)
+          for (int w : tris[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])])
+            for (int k2 = tri_start[static_cast<std::size_t>(w)];
+                 k2 < tri_start[static_cast<std::size_t>(w) + 1]; ++k2) {
+              const auto t2 = static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k2)]);
+              const auto& f = tris[t2];
+              const Eigen::Vector3d q = closest_on_triangle(moved, start[f[0]], start[f[1]], start[f[2]]);
+              const double dist = (q - moved).squaredNorm();
+              if (dist < best) best = dist, on = q;
+            }
+        moved = on;
+      }
+      x[v] = moved;
+    }
+    // Re-check the triangles around the set; grow it by the vertices of any folded one.
+    std::size_t remaining = 0;
+    const std::size_t size = set.size();
+    for (std::size_t s = 0; s < size; ++s) {
+      const std::size_t v = set[s];
+      for (int k = tri_start[v]; k < tri_start[v + 1]; ++k) {
+        const auto t = static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)]);
+        fold[t] = folded(t);
+        if (!fold[t]) continue;
+        for (int w : tris[t])
+          if (!active[static_cast<std::size_t>(w)])
+            active[static_cast<std::size_t>(w)] = 1, set.push_back(static_cast<std::size_t>(w));
+      }
+    }
+    for (std::size_t v : set)
+      for (int k = tri_start[v]; k < tri_start[v + 1]; ++k)
+        remaining += fold[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])];
+    stats.sweeps = sweep + 1;
+    if (remaining == 0) break;
+  }
+  for (std::size_t t = 0; t < tris.size(); ++t) stats.folded_after += folded(t) ? 1 : 0;
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (x[v] == start[v]) continue;
+    ++stats.moved;
+    stats.max_move = std::max(stats.max_move, (x[v] - start[v]).norm());
+  }
+
+  // Back into every patch's grid (a seam sample into each patch that has it: they stay bit-identical).
+  const int n = (1 << level) + 1;
+  for (std::size_t p = 0; p < model.geometry.size(); ++p) {
+    float* values = model.geometry[p].values.data();
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const std::size_t q = static_cast<std::size_t>(j) * n + i;
+        const Eigen::Vector3d& v = x[static_cast<std::size_t>(remesh.grid_vertex[p][q])];
+        for (int c = 0; c < 3; ++c) values[3 * q + c] = static_cast<float>(v[c]);
+      }
+  }
+  return stats;
+}
 
 TriMesh decoded_mesh(const codec::DecodedModel& model, int level, const QuadSplitOptions& split) {
   return decoded_mesh_impl(model, level, /*weld=*/true, split, nullptr);

@@ -40,6 +40,32 @@ struct QuadSplitOptions {
 ///   of another patch count or grid level.
 TriMesh decoded_mesh(const codec::DecodedModel& model, int level = -1, const QuadSplitOptions& split = {});
 
+struct UntangleOptions {
+  int normal_rings = 20;  ///< rings over which the reference normals are averaged
+  int max_sweeps = 100;   ///< sweeps over the folded samples at most
+  double step = 0.5;      ///< fraction of the way to the neighbours' centroid per sweep
+};
+
+struct UntangleStats {
+  std::size_t folded_before = 0, folded_after = 0;  ///< triangles facing against their reference normal
+  std::size_t moved = 0;                            ///< samples moved (seam samples once)
+  double max_move = 0;                              ///< the largest move, model units
+  int sweeps = 0;
+};
+
+/// Opens the folds of a decoded model's finest grids in place. A triangle of the welded level-N mesh (quads
+/// split as `split` says, as decoded_mesh() splits them) is folded when it faces against the area-weighted
+/// vertex normals averaged over `normal_rings` rings around it (wider than a fold). Each sweep moves every
+/// sample of a folded triangle half-way towards its neighbours' centroid within that normal's tangent plane,
+/// then onto the nearest point of the decoded surface as it was (its triangles two rings around): the fold
+/// opens along the surface, so the distance to the original mesh barely changes. Sweeps stop when no
+/// triangle is folded or after `max_sweeps`; some folds stay (their nearest surface is the fold). Seam
+/// samples move once, into every patch that has them (bit-identical across seams, as decoded).
+/// Measured (docs/measurements.md, "Folds and self-intersections in decoded meshes"): self-intersecting
+/// faces −41…−100 % on spot, bunny and horse at 8.8 KB and whole packs, PSNR −0.12…+0.23 dB. O(rings · F).
+UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplitOptions& split = {},
+                                     const UntangleOptions& options = {});
+
 /// A mesh with per-vertex attributes for texture-mapped formats (glTF).
 struct TexturedMesh {
   TriMesh mesh;

@@ -62,7 +62,8 @@ struct UntangleStats {
 /// triangle is folded or after `max_sweeps`; some folds stay (their nearest surface is the fold). Seam
 /// samples move once, into every patch that has them (bit-identical across seams, as decoded).
 /// Measured (docs/measurements.md, "Folds and self-intersections in decoded meshes"): self-intersecting
-/// faces −41…−100 % on spot, bunny and horse at 8.8 KB and whole packs, PSNR −0.12…+0.23 dB. O(rings · F).
+/// faces −27…−100 % on spot, bunny, horse and cow at 8.8 KB and whole packs, PSNR −0.41…+0.23 dB. O(rings ·
+/// F).
 UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplitOptions& split = {},
                                      const UntangleOptions& options = {});
 

@@ -182,7 +182,7 @@ void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const R
       << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << pw << "\" height=\"" << ph
       << "\" fill=\"none\" stroke=\"black\"/>\n"
       << labels << "<text x=\"" << left + pw / 2 << "\" y=\"" << H - 12
-      << "\" text-anchor=\"middle\">size (KB, log scale)</text>\n"
+      << "\" text-anchor=\"middle\">size (kB = 1000 bytes, log scale)</text>\n"
       << "<text transform=\"translate(18," << top + ph / 2
       << ") rotate(-90)\" text-anchor=\"middle\">PSNR (dB)</text>\n";
 

@@ -506,7 +506,8 @@ CommandRunner add_rd_command(CLI::App& app) {
       "rd",
       "Rate-distortion baselines of MESH: Draco (cl 10) at Q = 6..16 on the full mesh, Draco Q = 7..13 on "
       "QEM-decimated copies (500..40k faces) and their upper envelope, meshoptimizer's codec; PSNR and "
-      "Hausdorff of each decoded mesh vs MESH (as `geomip eval`). Writes DIR/rd.csv and DIR/rd.svg");
+      "Hausdorff of each decoded mesh vs MESH (as `geomip eval`), and geomip's own geometry-only pack at "
+      "many prefixes. Writes DIR/rd.csv, DIR/rd.svg and the pack DIR/<stem>.gip");
   cmd->add_option("mesh", args->mesh, "Original mesh (.obj .ply .off .stl), used as it is (not repaired)")
       ->required();
   cmd->add_option("-o,--output", args->output, "Output directory (created if missing)")->required();

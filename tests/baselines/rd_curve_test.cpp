@@ -190,7 +190,7 @@ TEST(RdFiles, SvgIsBalancedAndHasEverySeries) {
   EXPECT_EQ(svg.find("a<b"), std::string::npos);  // escaped everywhere
   EXPECT_NE(svg.find("<polyline"), std::string::npos);
   EXPECT_NE(svg.find("PSNR (dB)"), std::string::npos);
-  EXPECT_NE(svg.find("size (KB, log scale)"), std::string::npos);
+  EXPECT_NE(svg.find("size (kB = 1000 bytes, log scale)"), std::string::npos);
   EXPECT_EQ(svg.find("nan"), std::string::npos);
   EXPECT_EQ(svg.find("inf"), std::string::npos);
   // 7 + 5 + 1 + 1 plotted points and one legend marker per series (4).

@@ -159,7 +159,8 @@ class RecordingImporter final : public OpenMesh::IO::BaseImporter {
 // non-manifold faces).
 class TriMeshExporter final : public OpenMesh::IO::BaseExporter {
  public:
-  explicit TriMeshExporter(const TriMesh& mesh) : mesh_(mesh) {}
+  explicit TriMeshExporter(const TriMesh& mesh, const std::vector<Eigen::Vector3f>* normals = nullptr)
+      : mesh_(mesh), normals_(normals) {}
 
   Vec3f point(VertexHandle vh) const override {
     const auto& p = mesh_.positions[vh.idx()];
@@ -194,10 +195,20 @@ class TriMeshExporter final : public OpenMesh::IO::BaseExporter {
   // The PLY writer walks the kernel's custom properties unconditionally: give it an empty kernel.
   const OpenMesh::BaseKernel* kernel() override { return &empty_kernel_; }
 
-  // Attributes geomip does not write.
-  Vec3f normal(VertexHandle) const override { return Vec3f(0, 0, 0); }
-  Vec3d normald(VertexHandle) const override { return Vec3d(0, 0, 0); }
+  // Vertex normals when given (WriteMeshOptions::vertex_normals), else none.
+  Vec3f normal(VertexHandle vh) const override {
+    if (normals_ == nullptr) return Vec3f(0, 0, 0);
+    const Eigen::Vector3f& n = (*normals_)[static_cast<std::size_t>(vh.idx())];
+    return Vec3f(n.x(), n.y(), n.z());
+  }
+  Vec3d normald(VertexHandle vh) const override {
+    const Vec3f n = normal(vh);
+    return Vec3d(n[0], n[1], n[2]);
+  }
   bool is_normal_double() const override { return false; }
+  bool has_vertex_normals() const override { return normals_ != nullptr; }
+
+  // Attributes geomip does not write.
   Vec3uc color(VertexHandle) const override { return Vec3uc(0, 0, 0); }
   Vec4uc colorA(VertexHandle) const override { return Vec4uc(0, 0, 0, 0); }
   Vec3ui colori(VertexHandle) const override { return Vec3ui(0, 0, 0); }
@@ -232,6 +243,7 @@ class TriMeshExporter final : public OpenMesh::IO::BaseExporter {
 
  private:
   const TriMesh& mesh_;
+  const std::vector<Eigen::Vector3f>* normals_;
   OpenMesh::BaseKernel empty_kernel_;
 };
 
@@ -1188,16 +1200,24 @@ void write_mesh(const TriMesh& mesh, std::ostream& out, MeshFormat format, const
   silence_openmesh();
   if (format == MeshFormat::kStl) throw InvalidInput("write_mesh: STL output is not supported (use OBJ or PLY)");
   if (mesh.triangles.empty()) throw InvalidInput("write_mesh: the mesh has no triangles");
+  if (!options.vertex_normals.empty() && options.vertex_normals.size() != mesh.positions.size())
+    throw InvalidInput("write_mesh: " + std::to_string(options.vertex_normals.size()) + " normals for " +
+                       std::to_string(mesh.positions.size()) + " vertices");
   if (format == MeshFormat::kGltf || format == MeshFormat::kGlb) {
     GltfWriteOptions gltf;
     gltf.binary = format == MeshFormat::kGlb;
     MeshAttributes attributes;  // smooth shading in glTF viewers: area-weighted vertex normals
-    for (const auto& n : vertex_normals(mesh)) attributes.normals.push_back(n.cast<float>());
+    if (!options.vertex_normals.empty())
+      attributes.normals = options.vertex_normals;
+    else
+      for (const auto& n : vertex_normals(mesh)) attributes.normals.push_back(n.cast<float>());
     write_gltf(mesh, attributes, out, gltf);
     return;
   }
-  TriMeshExporter exporter(mesh);
+  const bool normals = !options.vertex_normals.empty();
+  TriMeshExporter exporter(mesh, normals ? &options.vertex_normals : nullptr);
   OpenMesh::IO::Options io_options;
+  if (normals) io_options += OpenMesh::IO::Options::VertexNormal;
   if (format == MeshFormat::kPly && options.binary) {
     io_options += OpenMesh::IO::Options::Binary;
     io_options += OpenMesh::IO::Options::LSB;

@@ -13,6 +13,7 @@
 #include <iosfwd>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace geomip {
 
@@ -55,12 +56,16 @@ struct WriteMeshOptions {
   bool binary = true;
   /// Significant digits for text formats; 9 round-trips float32 coordinates exactly.
   int precision = 9;
+  /// Per-vertex normals to write with the mesh (OBJ `vn` with `v//vn` corners, PLY nx/ny/nz, OFF as NOFF;
+  /// glTF: these instead of the area-weighted ones), one per vertex; empty: none (glTF: computed).
+  std::vector<Eigen::Vector3f> vertex_normals;
 };
 
 /// Writes `mesh` to `out` in `format` (OBJ, PLY, OFF, or glTF/GLB with area-weighted vertex normals
 /// (vertex_normals()) for smooth shading). Writes every triangle as it is: no manifold
 /// requirement. Does not open or rename files: tools/ write to a temporary file and rename (atomic output).
-/// \throw InvalidInput for STL (not written) or an empty mesh, IoError when the stream fails.
+/// \throw InvalidInput for STL (not written), an empty mesh or a `vertex_normals` of the wrong size, IoError
+///   when the stream fails.
 void write_mesh(const TriMesh& mesh, std::ostream& out, MeshFormat format, const WriteMeshOptions& options = {});
 
 }  // namespace geomip

@@ -178,7 +178,11 @@ int run_decode(const DecodeArgs& args) {
     // glTF carries per-patch texture coordinates and the normal maps' normals (seams not welded); the
     // other formats get the welded mesh.
     const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level, split) : TexturedMesh{};
-    const TriMesh mesh = gltf ? TriMesh{} : decoded_mesh(decoded.models[m], args.level, split);
+    // OBJ/PLY/OFF: the welded mesh, with the normal maps' normals per vertex when the pack has them.
+    WriteMeshOptions write_options;
+    const TriMesh mesh = gltf ? TriMesh{}
+                              : decoded_mesh_with_map_normals(decoded.models[m], args.level, split,
+                                                              write_options.vertex_normals);
     const TriMesh& written = gltf ? textured.mesh : mesh;
     write_file_atomically(paths[m], [&](std::ostream& o) {
       if (gltf)
@@ -187,7 +191,7 @@ int run_decode(const DecodeArgs& args) {
                     .draco_position_bits = args.draco,
                     .node_rotation = frame_rotation(decoded.info.models[m].normalization)});
       else
-        write_mesh(mesh, o, format);
+        write_mesh(mesh, o, format, write_options);
     });
     j_models.push_back({{"name", decoded.models[m].name},
                         {"mesh", paths[m]},

@@ -331,6 +331,48 @@ TriMesh decoded_mesh(const codec::DecodedModel& model, int level, const QuadSpli
   return decoded_mesh_impl(model, level, /*weld=*/true, split, nullptr);
 }
 
+namespace {
+
+// Whether `model`'s normal maps can give every level-`level` sample a normal: one per patch, at that level
+// or finer, none still all zero (its passes not arrived yet).
+bool has_normal_maps(const codec::DecodedModel& model, int level) {
+  return model.normals.size() == model.geometry.size() &&
+         std::all_of(model.normals.begin(), model.normals.end(), [&](const codec::Grid3& g) {
+           return g.level >= level &&
+                  std::any_of(g.values.begin(), g.values.end(), [](float x) { return x != 0; });
+         });
+}
+
+// The normal map texel of level-`level` sample `s` (not normalized).
+Eigen::Vector3d map_normal(const codec::DecodedModel& model, const GridSample& s, int level) {
+  const codec::Grid3& map = model.normals[static_cast<std::size_t>(s.patch)];
+  const int stride = 1 << (map.level - level);
+  const float* t =
+      map.values.data() + 3 * (static_cast<std::size_t>(s.j * stride) * map.size() + s.i * stride);
+  return Eigen::Vector3d(t[0], t[1], t[2]);
+}
+
+// Unit length; a zero normal (a prefix before the normal maps arrive) falls back to +z rather than NaN.
+Eigen::Vector3f unit_or_z(const Eigen::Vector3d& n) {
+  const double length = n.norm();
+  return length > 0 ? Eigen::Vector3f((n / length).cast<float>()) : Eigen::Vector3f(0, 0, 1);
+}
+
+}  // namespace
+
+TriMesh decoded_mesh_with_map_normals(const codec::DecodedModel& model, int level,
+                                      const QuadSplitOptions& split, std::vector<Eigen::Vector3f>& normals) {
+  std::vector<GridSample> origin;
+  TriMesh mesh = decoded_mesh_impl(model, level, /*weld=*/true, split, &origin);
+  if (level < 0) level = model.geometry.front().level;
+  normals.clear();
+  if (!has_normal_maps(model, level)) return mesh;
+  normals.reserve(origin.size());
+  // A seam sample's texels are bit-identical in every patch that has it (the codec codes them once).
+  for (const GridSample& s : origin) normals.push_back(unit_or_z(map_normal(model, s, level)));
+  return mesh;
+}
+
 TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level, const QuadSplitOptions& split) {
   std::vector<GridSample> origin;
   TexturedMesh result;
@@ -338,35 +380,15 @@ TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level, 
   const int grid_level = model.geometry.front().level;
   if (level < 0) level = grid_level;
   const double intervals = static_cast<double>(1 << level);
-  const bool has_normal_maps = model.normals.size() == model.geometry.size() &&
-                               std::all_of(model.normals.begin(), model.normals.end(),
-                                           [&](const codec::Grid3& g) {
-                                             // A map still all zero: its passes have not arrived yet.
-                                             return g.level >= level &&
-                                                    std::any_of(g.values.begin(), g.values.end(),
-                                                                [](float x) { return x != 0; });
-                                           });
+  const bool maps = has_normal_maps(model, level);
   const std::vector<Eigen::Vector3d> geometry_normals =
-      has_normal_maps ? std::vector<Eigen::Vector3d>() : vertex_normals(result.mesh);
+      maps ? std::vector<Eigen::Vector3d>() : vertex_normals(result.mesh);
   result.attributes.uv.reserve(origin.size());
   result.attributes.normals.reserve(origin.size());
   for (std::size_t v = 0; v < origin.size(); ++v) {
     const GridSample& s = origin[v];
     result.attributes.uv.emplace_back(static_cast<float>(s.i / intervals), static_cast<float>(s.j / intervals));
-    Eigen::Vector3d n;
-    if (has_normal_maps) {
-      const codec::Grid3& map = model.normals[static_cast<std::size_t>(s.patch)];
-      const int stride = 1 << (map.level - level);
-      const float* t = map.values.data() + 3 * (static_cast<std::size_t>(s.j * stride) * map.size() + s.i * stride);
-      n = Eigen::Vector3d(t[0], t[1], t[2]);
-    } else {
-      n = geometry_normals[v];
-    }
-    // Decoded normal-map texels are not exactly unit (quantized); a zero one (a prefix before the normal
-    // maps arrive) falls back to +z rather than NaN.
-    const double length = n.norm();
-    result.attributes.normals.push_back(length > 0 ? Eigen::Vector3f((n / length).cast<float>())
-                                                   : Eigen::Vector3f(0, 0, 1));
+    result.attributes.normals.push_back(unit_or_z(maps ? map_normal(model, s, level) : geometry_normals[v]));
   }
   return result;
 }

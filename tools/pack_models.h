@@ -67,6 +67,13 @@ struct UntangleStats {
 UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplitOptions& split = {},
                                      const UntangleOptions& options = {});
 
+/// decoded_mesh() and, in `normals`, each of its vertices' unit normal from the decoded normal maps at its
+/// sample (for OBJ/PLY/OFF output: `vn`, nx/ny/nz); `normals` is left empty when the model has no normal maps
+/// complete to `level` (a geometry-only pack, or a prefix before they arrive: +z where a texel is still
+/// zero).
+TriMesh decoded_mesh_with_map_normals(const codec::DecodedModel& model, int level,
+                                      const QuadSplitOptions& split, std::vector<Eigen::Vector3f>& normals);
+
 /// A mesh with per-vertex attributes for texture-mapped formats (glTF).
 struct TexturedMesh {
   TriMesh mesh;

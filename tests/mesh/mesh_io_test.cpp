@@ -62,6 +62,30 @@ TEST_F(MeshIo, RoundTripsEveryWritableFormatExactly) {
   }
 }
 
+// Vertex normals go out with the mesh in every text/binary format and the positions read back unchanged; a
+// normal list of the wrong size is refused before anything is written.
+TEST_F(MeshIo, WritesVertexNormalsAndRefusesAWrongCount) {
+  const TriMesh mesh = test::tetrahedron();
+  WriteMeshOptions o;
+  for (const auto& n : vertex_normals(mesh)) o.vertex_normals.push_back(n.cast<float>());
+  for (const MeshFormat f : {MeshFormat::kObj, MeshFormat::kPly, MeshFormat::kOff}) {
+    std::ostringstream out;
+    write_mesh(mesh, out, f, o);
+    const TriMesh back = read_mesh_from_memory(out.str(), f, "normals");
+    EXPECT_EQ(back.triangles, mesh.triangles);
+    ASSERT_EQ(back.positions.size(), mesh.positions.size());
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+      EXPECT_LT((back.positions[v] - mesh.positions[v]).norm(), 1e-6);
+  }
+  std::ostringstream obj;
+  write_mesh(mesh, obj, MeshFormat::kObj, o);
+  EXPECT_NE(obj.str().find("vn "), std::string::npos);
+  o.vertex_normals.pop_back();
+  std::ostringstream bad;
+  EXPECT_THROW(write_mesh(mesh, bad, MeshFormat::kObj, o), InvalidInput);
+  EXPECT_TRUE(bad.str().empty());
+}
+
 TEST_F(MeshIo, KeepsNonManifoldFacesAsRead) {
   // Three triangles on one edge: OpenMesh's own half-edge importer would drop one of them.
   TriMesh m;

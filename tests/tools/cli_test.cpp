@@ -1324,6 +1324,48 @@ TEST_F(CliPack, DecodeOpensFoldsKeepingFacesAndDistance) {
   EXPECT_EQ(g.genus, 0);
 }
 
+// A pack with normal maps decodes to OBJ/PLY/OFF with the maps' normals per vertex (OBJ `vn` and `v//vn`,
+// PLY nx/ny/nz, NOFF): unit, one per vertex, facing as the surface does; a geometry-only pack writes none.
+TEST_F(CliPack, DecodeWritesTheNormalMapsNormalsInEveryFormat) {
+  const std::string pack = dir_ + "/spot.gip", bare = dir_ + "/bare.gip";
+  ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 -o '" + pack + "'").exit_code, 0);
+  ASSERT_EQ(geomip("convert -q '" + spot_ + "' --level 4 --no-normals -o '" + bare + "'").exit_code, 0);
+  ASSERT_EQ(geomip("decode -q '" + pack + "' -o '" + dir_ + "/n.obj'").exit_code, 0);
+  const std::string obj = slurp(dir_ + "/n.obj");
+  std::istringstream lines(obj);
+  std::string line;
+  std::vector<Eigen::Vector3d> normals;
+  std::size_t corners_with_normal = 0, faces = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("vn ", 0) == 0) {
+      Eigen::Vector3d n;
+      std::istringstream(line.substr(3)) >> n.x() >> n.y() >> n.z();
+      normals.push_back(n);
+    } else if (line.rfind("f ", 0) == 0) {
+      ++faces;
+      corners_with_normal += static_cast<std::size_t>(std::count(line.begin(), line.end(), '/')) / 2;
+    }
+  }
+  const TriMesh mesh = read_mesh(dir_ + "/n.obj");
+  ASSERT_EQ(normals.size(), mesh.num_vertices());
+  EXPECT_EQ(corners_with_normal, 3 * faces);
+  const std::vector<Eigen::Vector3d> geometric = vertex_normals(mesh);
+  std::size_t agree = 0;
+  for (std::size_t v = 0; v < normals.size(); ++v) {
+    EXPECT_NEAR(normals[v].norm(), 1.0, 1e-4) << v;
+    agree += normals[v].dot(geometric[v]) > 0.5 ? 1 : 0;
+  }
+  EXPECT_GT(agree, 95 * normals.size() / 100) << "the maps' normals face as the surface does";
+  for (const char* ext : {"ply", "off"}) {
+    ASSERT_EQ(geomip("decode -q '" + pack + "' -o '" + dir_ + "/n." + ext + "'").exit_code, 0) << ext;
+    EXPECT_EQ(read_mesh(dir_ + "/n." + ext).positions, mesh.positions) << ext;
+  }
+  EXPECT_NE(slurp(dir_ + "/n.ply").find("property float nx"), std::string::npos);
+  EXPECT_EQ(slurp(dir_ + "/n.off").rfind("NOFF", 0), 0u);
+  ASSERT_EQ(geomip("decode -q '" + bare + "' -o '" + dir_ + "/b.obj'").exit_code, 0);
+  EXPECT_EQ(slurp(dir_ + "/b.obj").find("\nvn "), std::string::npos) << "no normal maps, no normals";
+}
+
 // decode --quad-split: shorter (default) and fixed give the same vertices, watertight genus-0 meshes of the
 // same size with different diagonals, and the shorter split is closer to the mesh; the models of a consistent
 // pack share one face list; a bad value exits 2 with one line and nothing written.

@@ -11,6 +11,7 @@
 #include "tools/pack_file.h"
 #include "tools/pack_models.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -29,6 +30,35 @@ struct MorphArgs {
   bool no_align = false;
   bool quiet = false;
 };
+
+// `into`'s hole mask becomes the union of its own and `other`'s, at the finer of their two mask levels (a
+// coarse mask quad covers 2^d × 2^d finer ones). A model without a mask takes the other's mask and level.
+void unite_hole_masks(codec::DecodedModel& into, const codec::DecodedModel& other) {
+  if (other.hole_mask.empty()) return;
+  if (into.hole_mask.empty()) {
+    into.hole_mask = other.hole_mask;
+    into.hole_mask_level = other.hole_mask_level;
+    return;
+  }
+  if (other.hole_mask.size() != into.hole_mask.size()) return;  // another layout: same_layout() refuses it
+  const int level = std::max(into.hole_mask_level, other.hole_mask_level);
+  const int n = 1 << level;
+  auto at = [&](const codec::DecodedModel& m, std::size_t p, int i, int j) {
+    const int shift = level - m.hole_mask_level, mn = 1 << m.hole_mask_level;
+    const std::size_t q = static_cast<std::size_t>(j >> shift) * static_cast<std::size_t>(mn) +
+                          static_cast<std::size_t>(i >> shift);
+    return q < m.hole_mask[p].size() && m.hole_mask[p][q] != 0;
+  };
+  std::vector<std::vector<std::uint8_t>> united(into.hole_mask.size());
+  for (std::size_t p = 0; p < united.size(); ++p) {
+    united[p].resize(static_cast<std::size_t>(n) * static_cast<std::size_t>(n));
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        united[p][static_cast<std::size_t>(j) * n + i] = at(into, p, i, j) || at(other, p, i, j) ? 1 : 0;
+  }
+  into.hole_mask = std::move(united);
+  into.hole_mask_level = level;
+}
 
 int run_morph(const MorphArgs& args) {
   check_output_directory(args.output);
@@ -61,12 +91,7 @@ int run_morph(const MorphArgs& args) {
 
   // One template for every frame (seams, union of both hole masks): the same connectivity throughout.
   codec::DecodedModel frame = decoded.models[args.from];
-  const auto& other = decoded.models[args.to].hole_mask;
-  if (frame.hole_mask.empty()) frame.hole_mask = other;
-  else if (other.size() == frame.hole_mask.size())
-    for (std::size_t p = 0; p < other.size(); ++p)
-      for (std::size_t q = 0; q < other[p].size() && q < frame.hole_mask[p].size(); ++q)
-        frame.hole_mask[p][q] = frame.hole_mask[p][q] || other[p][q];
+  unite_hole_masks(frame, decoded.models[args.to]);
 
   make_output_directory(args.output);
   const auto schedule = wavelet ? morph::MorphSchedule::kWavelet : morph::MorphSchedule::kLinear;

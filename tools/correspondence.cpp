@@ -4,8 +4,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 
 namespace geomip::tools {
 namespace {
@@ -31,6 +34,41 @@ std::vector<PointSpec> point_list(const std::string& path, const nlohmann::json&
   return out;
 }
 
+// Levenshtein distance of two short keys.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// Keys other than `known` are the user's own (names, notes) and are ignored, unless one looks like a
+// misspelling of a known key (differs in case or by at most two edits): that key would be silently lost, so
+// it is refused, naming the key it resembles.
+void check_keys(const std::string& path, const nlohmann::json& object,
+                std::initializer_list<const char*> known, const std::string& where) {
+  for (const auto& item : object.items()) {
+    const std::string& key = item.key();
+    bool exact = false;
+    for (const char* k : known) exact = exact || key == k;
+    if (exact) continue;
+    std::string lower = key;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (const char* k : known) {
+      if (lower == k || edit_distance(key, k) <= 2)
+        fail(path, where + "\"" + key + "\" is not a key geomip reads; did you mean \"" + k + "\"?");
+    }
+  }
+}
+
 std::vector<PointSpec> points(const std::string& path, const nlohmann::json& model, const char* key, std::size_t m) {
   if (!model.contains(key)) return {};
   return point_list(path, model.at(key), "models[" + std::to_string(m) + "]." + key);
@@ -50,12 +88,14 @@ std::vector<ModelSpec> read_correspondence(const std::string& path) {
   if (!j.is_object() || !j.contains("models") || !j["models"].is_array() || j["models"].empty()) {
     fail(path, "expected {\"models\": [ ... ]} with at least one model");
   }
+  check_keys(path, j, {"models", "layout"}, "");
   const std::filesystem::path base = std::filesystem::path(path).parent_path();
   std::vector<std::array<int, 4>> quads;
   if (j.contains("layout")) {
     const auto& layout = j["layout"];
     if (!layout.is_object() || !layout.contains("quads") || !layout["quads"].is_array() || layout["quads"].empty())
       fail(path, "\"layout\" must be {\"quads\": [[a,b,c,d], ...]} with at least one quad");
+    check_keys(path, layout, {"quads"}, "layout: ");
     for (std::size_t q = 0; q < layout["quads"].size(); ++q) {
       const auto& quad = layout["quads"][q];
       std::array<int, 4> ids{};
@@ -74,6 +114,8 @@ std::vector<ModelSpec> read_correspondence(const std::string& path) {
     if (!model.is_object() || !model.contains("mesh") || !model["mesh"].is_string()) {
       fail(path, "models[" + std::to_string(m) + "] needs a \"mesh\" path");
     }
+    check_keys(path, model, {"mesh", "partition_points", "auxiliary_points", "features", "side_guides"},
+               "models[" + std::to_string(m) + "]: ");
     ModelSpec s;
     const std::filesystem::path mesh = model["mesh"].get<std::string>();
     s.mesh = (mesh.is_absolute() ? mesh : base / mesh).string();

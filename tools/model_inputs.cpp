@@ -78,8 +78,13 @@ TriMesh prepare_mesh(const std::string& path, const TriMesh& input, const std::s
   return repaired.mesh;
 }
 
+// How far an [x,y,z] point of CORR.json may lie from the mesh's nearest vertex, as a fraction of the mesh's
+// bounding-box diagonal.
+constexpr double kMaxSnapDistance = 0.05;
+
 // A point of CORR.json as a position of the input file, then the nearest vertex of the prepared mesh (the
-// same vertex when the mesh was not repaired, its surviving copy when it was).
+// same vertex when the mesh was not repaired, its surviving copy when it was). An [x,y,z] point farther than
+// kMaxSnapDistance from every vertex is refused.
 int resolve_point(const PointSpec& p, const TriMesh& input, const TriMesh& mesh, const std::string& what,
                   const std::string& file) {
   Eigen::Vector3d target = p.position;
@@ -102,6 +107,18 @@ int resolve_point(const PointSpec& p, const TriMesh& input, const TriMesh& mesh,
       best_d = d;
       best = static_cast<int>(v);
     }
+  }
+  // An [x,y,z] point snaps to the nearest vertex, but one far from the surface is a mistake (another unit,
+  // another mesh, a typo), not a choice: refuse it rather than pick a vertex the user did not mean.
+  const double diagonal = referenced_bounding_box(mesh).diagonal();
+  if (p.index < 0 && std::sqrt(best_d) > kMaxSnapDistance * diagonal) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "%s [%g, %g, %g] is %.3g from the nearest vertex of the mesh, %.1f %% of its bounding-box "
+                  "diagonal (at most %.0f %%: points snap to the nearest vertex; wrong units or mesh?)",
+                  what.c_str(), target.x(), target.y(), target.z(), std::sqrt(best_d),
+                  100 * std::sqrt(best_d) / diagonal, 100 * kMaxSnapDistance);
+    throw InvalidInput(file + ": " + text);
   }
   return best;
 }
@@ -203,7 +220,8 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
     specs.push_back(ModelSpec{meshes[0], {}, {}, {}, {}, {}});
   }
 
-  for (const auto& spec : specs) {
+  for (std::size_t m = 0; m < specs.size(); ++m) {
+    const ModelSpec& spec = specs[m];
     const TriMesh input = read_mesh(spec.mesh);
     ParameterizationInput in;
     in.mesh = prepare_mesh(spec.mesh, input, command, quiet);
@@ -212,7 +230,10 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
     const bool repaired =
         in.mesh.positions.size() != input.positions.size() || in.mesh.triangles != input.triangles;
     const TriMesh& source = repaired ? input : in.mesh;
-    const std::string where = points_file.empty() ? spec.mesh : points_file;
+    const std::string where = points_file.empty()
+                                  ? spec.mesh
+                                  : points_file + ": models[" + std::to_string(m) + "] (" +
+                                        std::filesystem::path(spec.mesh).filename().string() + ")";
     const int genus = spec.partition_points.empty() && patches == 2 ? analyze_topology(in.mesh).genus.value_or(0) : 0;
     if (genus >= 2) {
       const QuadLayoutChoice chosen =

@@ -465,6 +465,25 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
              "features");
   expect_two(file("garbage.json", "{not json"), "JSON");
   expect_two(dir_ + "/missing.json", "no such file");
+  // The model is named in messages about its points.
+  expect_two(corr("named.json", model("[0, 1000, 2000, 2900]") + "," + model("[10, 20, 30, 99999]")),
+             "models[1] (spot.obj): partition_points[3] is vertex 99999");
+  // A misspelled key would be lost silently: refused, naming the key it resembles. Keys of the user's own
+  // (names, notes) stay allowed.
+  expect_two(
+      file("typo.json", "{\"models\": [{\"mesh\": \"" + spot_ +
+                            "\", \"partition_points\": [0, 1000, 2000, 2900], \"auxilary_points\": []}]}"),
+      "did you mean \"auxiliary_points\"");
+  expect_two(file("case.json", "{\"Models\": [], \"models\": [" + model("[0, 1000, 2000, 2900]") + "]}"),
+             "did you mean \"models\"");
+  // An [x,y,z] point far from the surface is a mistake (units, mesh), not a vertex to snap to.
+  expect_two(corr("far.json", model("[0, 1000, 2000, [100, 100, 100]]")), "from the nearest vertex");
+  const Outcome note =
+      geomip("param -q --points '" +
+             file("note.json", "{\"note\": \"mine\", \"models\": [" +
+                                   model("[0, 1000, 2000, 2900]").insert(1, "\"name\": \"cow\", ") + "]}") +
+             "' -o '" + dir_ + "/noted'");
+  EXPECT_EQ(note.exit_code, 0) << note.err;
   // Several meshes without a correspondence file.
   const Outcome r = geomip("param '" + spot_ + "' '" + spot_ + "' -o '" + out + "'");
   EXPECT_EQ(r.exit_code, 2);

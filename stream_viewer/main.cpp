@@ -154,6 +154,7 @@ std::string check_options_against_pack(const Options& opt, const geomip::codec::
            "'s finest grid level is " + std::to_string(finest);
   if (opt.morph && models < 2)
     return "--morph needs at least 2 models; the pack has 1";
+  if (opt.animate && models < 2) return "--animate needs at least 2 models; the pack has 1";
   // A morph between models of different layouts cannot be drawn (the renderer would show the source alone):
   // an option that cannot be honoured is an error, as `geomip morph` says for the same pack.
   auto layout_differs = [&](int a, int b) {
@@ -422,26 +423,36 @@ int main(int argc, char** argv) {
                  "grid level to draw, 0 … the model's finest (default: finest; interactive: auto); a level beyond "
                  "the model's finest is an error (exit 2) once the manifest is known")
       ->check(non_negative("a grid level"));
-  app.add_option("--morph", opt.morph,
-                 "morph time t in [0,1] from --model to the next model (outside [0,1], or a one-model pack: exit 2)")
-      ->check(CLI::Validator(
-          [](std::string& v) {
-            float t = 0;
-            if (!CLI::detail::lexical_cast(v, t) || !std::isfinite(t)) return "t = " + v + " is not a number";
-            return t >= 0.0f && t <= 1.0f ? std::string() : "t = " + v + " is outside [0, 1]";
-          },
-          "in [0,1]"));
+  auto* morph_option =
+      app.add_option("--morph", opt.morph,
+                     "morph time t in [0,1] from --model to the next model (the last model's next is model "
+                     "0; outside "
+                     "[0,1], or a one-model pack: exit 2)")
+          ->check(CLI::Validator(
+              [](std::string& v) {
+                float t = 0;
+                if (!CLI::detail::lexical_cast(v, t) || !std::isfinite(t))
+                  return "t = " + v + " is not a number";
+                return t >= 0.0f && t <= 1.0f ? std::string() : "t = " + v + " is outside [0, 1]";
+              },
+              "in [0,1]"));
   app.add_option("--schedule", opt.schedule, "morph schedule")->check(CLI::IsMember({"linear", "wavelet"}));
   app.add_option("--bands", opt.bands, "wavelet bands of the wavelet schedule")->check(CLI::Range(2, 8));
   app.add_option("--model", opt.model,
                  "model index to show (morph source); an index past the pack's models is an error (exit 2) once "
                  "the manifest is known")
       ->check(non_negative("a model index"));
-  app.add_flag("--animate", opt.animate, "cycle the morph through all models");
+  auto* animate =
+      app.add_flag("--animate", opt.animate,
+                   "cycle the morph through all models (a one-model pack: exit 2; not with --morph)");
+  animate->excludes(morph_option);
   app.add_flag("--no-align", opt.no_align,
                "keep each model in its own frame (default: models 1… are aligned to model 0 by the least-squares "
                "similarity over corresponding samples)");
-  app.add_option("--frames", opt.frames, "headless: render N frames after loading, then exit")
+  app.add_option(
+         "--frames", opt.frames,
+         "headless: render N frames after loading, then exit (without it the window stays open until Q, "
+         "also under xvfb-run)")
       ->check(positive("a frame count"));
   app.add_option("--width", opt.width, "framebuffer width")->check(CLI::Range(16, 8192));
   app.add_option("--height", opt.height, "framebuffer height")->check(CLI::Range(16, 8192));

@@ -25,6 +25,7 @@ struct MorphArgs {
   int frames = 10;
   std::string schedule = "linear";
   int bands = 5;
+  bool bands_given = false;
   int from = 0, to = 1;
   int level = -1;
   bool no_align = false;
@@ -73,6 +74,11 @@ int run_morph(const MorphArgs& args) {
   if (args.from >= count || args.to >= count)
     throw InvalidInput(args.pack + " holds " + std::to_string(count) + " models; --from/--to out of range");
   const bool wavelet = args.schedule == "wavelet";
+  if (args.bands_given && !wavelet)
+    throw InvalidInput("--bands sets the wavelet schedule's bands: give --schedule wavelet too");
+  if (args.from == args.to)
+    throw InvalidInput("--from and --to are both model " + std::to_string(args.from) +
+                       ": a morph needs two models");
   morph::DecodeSettings settings;
   settings.bands = wavelet ? args.bands : 1;
   settings.align = !args.no_align;
@@ -116,6 +122,19 @@ int run_morph(const MorphArgs& args) {
       std::printf("morph t=%.3f → %s: %zu vertices, %zu faces\n", t, path.c_str(), mesh.num_vertices(),
                   mesh.num_triangles());
   }
+  // Frames of an earlier, longer run in the same directory would read as part of this sequence
+  // (morph_*.obj): those files, and only files of exactly that name, go.
+  std::size_t stale = 0;
+  for (int k = args.frames; k <= 9999; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "morph_%04d.obj", k);
+    std::error_code ignored;
+    const std::filesystem::path path = std::filesystem::path(args.output) / name;
+    if (!std::filesystem::is_regular_file(path, ignored)) break;
+    if (std::filesystem::remove(path, ignored)) ++stale;
+  }
+  if (stale > 0 && !args.quiet)
+    std::printf("removed %zu frames of an earlier run (morph_%04d.obj on)\n", stale, args.frames);
   return kExitOk;
 }
 
@@ -127,10 +146,18 @@ CommandRunner add_morph_command(CLI::App& app) {
       "morph", "Morph between two models of a consistent .gip pack: N OBJ meshes with the same connectivity.");
   cmd->add_option("pack", args->pack, "The .gip pack (at least two consistent models)")->required();
   cmd->add_option("-o,--output", args->output, "Output directory (morph_0000.obj, ...)")->required();
-  cmd->add_option("--frames", args->frames, "Number of frames, t = 0 … 1")->check(positive_number());
+  cmd->add_option("--frames", args->frames,
+                  "Number of frames, t = 0 … 1 (frames of an earlier, longer run in DIR "
+                  "are removed)")
+      ->check(positive_number())
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
   cmd->add_option("--schedule", args->schedule, "linear, or wavelet (per-band schedule, paper §6.2)")
       ->check(CLI::IsMember({"linear", "wavelet"}));
-  cmd->add_option("--bands", args->bands, "Wavelet bands of the wavelet schedule")->check(CLI::Range(2, 8));
+  cmd->add_option("--bands", args->bands, "Wavelet bands of the wavelet schedule (with --schedule wavelet)")
+      ->check(CLI::Range(2, 8))
+      ->capture_default_str()
+      ->each([args](const std::string&) { args->bands_given = true; });
   cmd->add_option("--from", args->from, "Source model index")->check(non_negative_number());
   cmd->add_option("--to", args->to, "Target model index")->check(non_negative_number());
   cmd->add_option("--level", args->level, "Output grid level (default: the pack's level)")

@@ -181,6 +181,27 @@ TEST_F(MorphCommandTest, FramesLeaveOutTheHolesOfEitherEnd) {
 
 TEST_F(MorphCommandTest, BadModelIndexIsBadInput) {
   EXPECT_EQ(morph("--frames 2 --to 7 -o " + (dir_ / "x").string()), 2);
+  EXPECT_EQ(morph("--frames 2 --from 1 --to 1 -o " + (dir_ / "x").string()), 2) << "one model is no morph";
+  EXPECT_EQ(morph("--frames 2 --bands 4 -o " + (dir_ / "x").string()), 2)
+      << "--bands without the wavelet schedule";
+  EXPECT_FALSE(fs::exists(dir_ / "x" / "morph_0000.obj"));
+}
+
+// A shorter run into the same directory leaves only its own frames (a sequence loaded as morph_*.obj would
+// mix two runs); files of other names stay.
+TEST_F(MorphCommandTest, AShorterRunRemovesTheEarlierRunsExtraFrames) {
+  const fs::path out = dir_ / "seq";
+  ASSERT_EQ(morph("--frames 6 -o " + out.string()), 0);
+  std::ofstream(out / "notes.txt") << "mine";
+  std::ofstream(out / "morph_0004.obj.bak") << "mine";
+  ASSERT_EQ(morph("--frames 3 -o " + out.string()), 0);
+  for (int k = 0; k < 6; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "morph_%04d.obj", k);
+    EXPECT_EQ(fs::exists(out / name), k < 3) << name;
+  }
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));
+  EXPECT_TRUE(fs::exists(out / "morph_0004.obj.bak"));
 }
 
 }  // namespace

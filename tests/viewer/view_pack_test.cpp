@@ -876,6 +876,9 @@ TEST_F(ViewPackTest, OutOfRangeOptionsExitTwoWithOneLine) {
       // models of different layouts: the morph cannot be drawn (it used to show the first model, exit 0)
       {mixed.string() + " --morph 0.5", "--morph"},
       {mixed.string() + " --animate", "--animate"},
+      // one model has nothing to cycle through (it used to exit 0), and --animate ignored --morph
+      {single.string() + " --animate", "--animate"},
+      {golden.string() + " --animate --morph 0.3", "--animate"},
   };
   for (const auto& [args, option] : cases) {
     const ViewRun r = view_measured(args + " " + size_args());

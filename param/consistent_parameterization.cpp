@@ -1,6 +1,7 @@
 #include "param/consistent_parameterization.h"
 
 #include "mesh/errors.h"
+#include "mesh/mesh_topology.h"
 #include "mesh/predicates.h"
 #include "param/coarse_to_fine.h"
 #include "param/feature_warp.h"
@@ -14,6 +15,7 @@
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <system_error>
@@ -516,24 +518,39 @@ ModelWork prepare_model(const std::vector<ParameterizationInput>& models, std::s
   ModelWork w;
   progress("partition", static_cast<double>(i));
   const auto t0 = Clock::now();
-  if (!in.side_guides.empty()) {
-    if (!in.auxiliary_points.empty() || !in.layout_quads.empty()) {
-      throw InvalidInput("parameterize_consistently: model '" + in.name +
-                         "' has guide lists per path and auxiliary points or a layout; give one of them");
+  if (first) {  // a set of different genus fails later with a message about auxiliary points: say why first
+    const std::optional<int> genus = analyze_topology(in.mesh).genus;
+    const std::optional<int> first_genus = analyze_topology(models[0].mesh).genus;
+    if (genus && first_genus && *genus != *first_genus)
+      throw InvalidInput("parameterize_consistently: model '" + in.name + "' has genus " +
+                         std::to_string(*genus) + ", model '" + models[0].name + "' genus " +
+                         std::to_string(*first_genus) + "; the models of a consistent set share one genus");
+  }
+  try {
+    if (!in.side_guides.empty()) {
+      if (!in.auxiliary_points.empty() || !in.layout_quads.empty()) {
+        throw InvalidInput("parameterize_consistently: model '" + in.name +
+                           "' has guide lists per path and auxiliary points or a layout; give one of them");
+      }
+      w.partition = partition_mesh_guided(in.mesh, in.partition_points, in.side_guides);
+    } else if (in.layout_quads.empty()) {
+      w.partition = partition_mesh(in.mesh, in.partition_points, in.auxiliary_points);
+    } else {
+      if (!in.auxiliary_points.empty()) {
+        throw InvalidInput("parameterize_consistently: model '" + in.name +
+                           "' has a quad layout and auxiliary points; a layout's paths take no guides");
+      }
+      if (i > 0 && in.layout_quads != models[0].layout_quads) {
+        throw InvalidInput("parameterize_consistently: model '" + in.name +
+                           "' has other layout quads than '" + models[0].name +
+                           "'; a consistent set shares one layout");
+      }
+      w.partition = partition_mesh_layout(in.mesh, QuadLayout{in.partition_points, in.layout_quads});
     }
-    w.partition = partition_mesh_guided(in.mesh, in.partition_points, in.side_guides);
-  } else if (in.layout_quads.empty()) {
-    w.partition = partition_mesh(in.mesh, in.partition_points, in.auxiliary_points);
-  } else {
-    if (!in.auxiliary_points.empty()) {
-      throw InvalidInput("parameterize_consistently: model '" + in.name +
-                         "' has a quad layout and auxiliary points; a layout's paths take no guides");
-    }
-    if (i > 0 && in.layout_quads != models[0].layout_quads) {
-      throw InvalidInput("parameterize_consistently: model '" + in.name + "' has other layout quads than '" +
-                         models[0].name + "'; a consistent set shares one layout");
-    }
-    w.partition = partition_mesh_layout(in.mesh, QuadLayout{in.partition_points, in.layout_quads});
+  } catch (const InvalidInput& e) {  // the partition's messages do not know which model they are about
+    const std::string what = e.what();
+    if (models.size() < 2 || what.find("model '") != std::string::npos) throw;
+    throw InvalidInput("model '" + in.name + "': " + what);
   }
   o.seconds.partition = seconds_since(t0);
   if (first && w.partition.patches.size() != first->partition.patches.size()) {

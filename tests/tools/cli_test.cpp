@@ -476,6 +476,18 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
       "did you mean \"auxiliary_points\"");
   expect_two(file("case.json", "{\"Models\": [], \"models\": [" + model("[0, 1000, 2000, 2900]") + "]}"),
              "did you mean \"models\"");
+  // Models of different genus: said as such (it was a message about auxiliary points, naming no model).
+  {
+    std::ofstream torus(dir_ + "/torus.obj");
+    write_mesh(test::torus(24, 12), torus, MeshFormat::kObj);
+  }
+  expect_two(file("genus.json", "{\"models\": [" + model("[0, 1000, 2000, 2900]") + ", {\"mesh\": \"" + dir_ +
+                                    "/torus.obj\", \"partition_points\": [0, 50, 100, 150]}]}"),
+             "model 'torus' has genus 1, model 'spot' genus 0");
+  expect_two(file("aux2.json",
+                  "{\"models\": [" + model("[0, 1000, 2000, 2900]") + ", {\"mesh\": \"" + spot_ +
+                      "\", \"partition_points\": [0, 1000, 2000, 2900], \"auxiliary_points\": [5, 6]}]}"),
+             "model 'spot-1': partition_mesh: a genus-0 mesh takes 0 or 4 auxiliary points, got 2");
   // An [x,y,z] point far from the surface is a mistake (units, mesh), not a vertex to snap to.
   expect_two(corr("far.json", model("[0, 1000, 2000, [100, 100, 100]]")), "from the nearest vertex");
   const Outcome note =

@@ -231,34 +231,48 @@ RepairResult repair_mesh(const TriMesh& input, const RepairOptions& options) {
   return result;
 }
 
-std::optional<SelfIntersections> count_self_intersections(const TriMesh& mesh) {
+std::optional<std::vector<std::size_t>> self_intersecting_faces(const TriMesh& mesh,
+                                                                SelfIntersections* counts) {
   std::vector<Point> points;
   points.reserve(mesh.num_vertices());
   for (const auto& p : mesh.positions) points.emplace_back(p.x(), p.y(), p.z());
   std::vector<std::array<std::size_t, 3>> polygons;
+  std::vector<std::size_t> original;  // polygons[k] is mesh.triangles[original[k]]
   polygons.reserve(mesh.num_triangles());
-  for (const auto& t : mesh.triangles) {
-    const std::array<std::size_t, 3> f{std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])};
+  original.reserve(mesh.num_triangles());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    const std::array<std::size_t, 3> f{std::size_t(tri[0]), std::size_t(tri[1]), std::size_t(tri[2])};
     if (f[0] >= points.size() || f[1] >= points.size() || f[2] >= points.size())
       throw InvalidInput("count_self_intersections: a triangle index is out of range");
     if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2] ||
         CGAL::collinear(points[f[0]], points[f[1]], points[f[2]]))
       continue;
     polygons.push_back(f);
+    original.push_back(t);
   }
   if (polygons.empty() || !PMP::is_polygon_soup_a_polygon_mesh(polygons)) return std::nullopt;
   SurfaceMesh sm;
   PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
   std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> pairs;
   PMP::self_intersections(sm, std::back_inserter(pairs));
-  std::vector<SurfaceMesh::Face_index> faces;
+  // polygon_soup_to_polygon_mesh adds the faces in the soup's order.
+  std::vector<std::size_t> faces;
   faces.reserve(2 * pairs.size());
-  for (const auto& [a, b] : pairs) faces.push_back(a), faces.push_back(b);
+  for (const auto& [a, b] : pairs) faces.push_back(original[a.idx()]), faces.push_back(original[b.idx()]);
   std::sort(faces.begin(), faces.end());
-  SelfIntersections result;
-  result.pairs = pairs.size();
-  result.faces = static_cast<std::size_t>(std::unique(faces.begin(), faces.end()) - faces.begin());
-  return result;
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  if (counts) {
+    counts->pairs = pairs.size();
+    counts->faces = faces.size();
+  }
+  return faces;
+}
+
+std::optional<SelfIntersections> count_self_intersections(const TriMesh& mesh) {
+  SelfIntersections counts;
+  if (!self_intersecting_faces(mesh, &counts)) return std::nullopt;
+  return counts;
 }
 
 }  // namespace geomip

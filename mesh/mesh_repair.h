@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <vector>
 
 namespace geomip {
 
@@ -64,5 +65,10 @@ struct SelfIntersections {
 /// those). Empty when the other faces do not form a polygon mesh (non-manifold edges or vertices, or
 /// inconsistent orientation: `geomip repair` first), where "crossing" has no single answer.
 std::optional<SelfIntersections> count_self_intersections(const TriMesh& mesh);
+
+/// The same check, giving the crossing triangles themselves: indices into mesh.triangles, ascending, each
+/// once; `counts`, when given, receives the counts. Empty optional where count_self_intersections() is.
+std::optional<std::vector<std::size_t>> self_intersecting_faces(const TriMesh& mesh,
+                                                                SelfIntersections* counts = nullptr);
 
 }  // namespace geomip

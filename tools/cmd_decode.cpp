@@ -200,11 +200,10 @@ int run_decode(const DecodeArgs& args) {
                         {"detail_level", decoded.models[m].detail_level},
                         {"geometry_passes", decoded.models[m].geometry_passes}});
     if (args.untangle)
-      j_models.back()["untangle"] = {{"folded_before", untangled.folded_before},
-                                     {"folded_after", untangled.folded_after},
-                                     {"moved", untangled.moved},
-                                     {"max_move", untangled.max_move},
-                                     {"sweeps", untangled.sweeps}};
+      j_models.back()["untangle"] = {
+          {"applied", untangled.applied},           {"folded_before", untangled.folded_before},
+          {"folded_after", untangled.folded_after}, {"moved", untangled.moved},
+          {"max_move", untangled.max_move},         {"sweeps", untangled.sweeps}};
     if (!args.quiet && !args.json) {
       std::printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",
                   codec::one_line(decoded.models[m].name).c_str(), codec::one_line(paths[m]).c_str(),
@@ -256,9 +255,9 @@ CommandRunner add_decode_command(CLI::App& app) {
   cmd->add_flag(
       "--untangle,!--no-untangle", args->untangle,
       "Open the decoded grids' folds before writing (default; samples of triangles that face against "
-      "the surface around them slide along the decoded surface: 27-100 % fewer self-intersecting "
-      "faces, PSNR -0.41..+0.23 dB); --no-untangle writes the grids as decoded, as geomip rd measures "
-      "them");
+      "the surface around them slide along the decoded surface; grids of level 6 and finer: 20-93 % "
+      "fewer self-intersecting faces, PSNR -0.52..+0.28 dB); --no-untangle writes the grids as decoded, "
+      "as geomip rd measures them");
   cmd->add_flag("--json", args->json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args->quiet, "No report");
   return [args] { return run_decode(*args); };

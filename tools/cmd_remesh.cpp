@@ -36,6 +36,7 @@ struct RemeshArgs {
   bool measure_samples = false;
   bool ply = false;
   bool glb = false;
+  bool untangle = false;
   int draco = 0;  ///< the GLB's Draco position bits, 0 = no Draco
   bool fit = false;  ///< least-squares fitted samples (gimage/fit.h) for the uniform remesh
   std::string quad_split = "shorter";
@@ -112,8 +113,27 @@ int run_remesh(const RemeshArgs& args) {
   for (const auto& r : remeshes) split_by.push_back(&r.mesh.positions);
   if (split == QuadSplit::kShorter)
     for (auto& r : remeshes) split_along_shorter_diagonals(r, args.level, split_by);
+  std::vector<UntangleStats> untangled(remeshes.size());
+  std::vector<GeometryImages> as_resampled;  // with --untangle: the images as they were choose the split
+  if (args.untangle) {
+    // The split is chosen already (above); the GLB's and the untangling's choice come from the same images.
+    as_resampled = uniform_images;
+    std::vector<const GeometryImages*> choosers;
+    for (const auto& g : as_resampled) choosers.push_back(&g);
+    const int n = (1 << args.level) + 1;
+    for (std::size_t i = 0; i < remeshes.size(); ++i) {
+      untangled[i] = untangle_geometry_images(uniform_images[i], split, choosers);
+      for (std::size_t p = 0; p < uniform_images[i].geometry.size(); ++p)
+        for (int j = 0; j < n; ++j)
+          for (int k = 0; k < n; ++k) {
+            const float* v = uniform_images[i].geometry[p].at(k, j);
+            remeshes[i].mesh.positions[static_cast<std::size_t>(
+                remeshes[i].grid_vertex[p][static_cast<std::size_t>(j) * n + k])] = {v[0], v[1], v[2]};
+          }
+    }
+  }
   std::vector<const GeometryImages*> images_of_set;
-  for (const auto& g : uniform_images) images_of_set.push_back(&g);
+  for (const auto& g : args.untangle ? as_resampled : uniform_images) images_of_set.push_back(&g);
   for (std::size_t i = 0; i < remeshes.size(); ++i) {
     const UniformRemeshResult& remesh = remeshes[i];
     const GeometryImages& images = uniform_images[i];
@@ -143,6 +163,11 @@ int run_remesh(const RemeshArgs& args) {
       if (args.fit) j["fit_seconds"] = fit_seconds;
       if (args.ply) j["ply"] = stem + ".ply";
       if (args.glb) j["glb"] = stem + ".glb";
+      if (args.untangle)
+        j["untangle"] = {{"folded_before", untangled[i].folded_before},
+                         {"folded_after", untangled[i].folded_after},
+                         {"moved", untangled[i].moved},
+                         {"max_move", untangled[i].max_move}};
       summary.push_back(j);
     } else if (!args.common.quiet) {
       std::printf("remesh %s → %s.obj: %zu vertices, %zu faces (resampled and remeshed in %.3f s",
@@ -242,6 +267,11 @@ CommandRunner add_remesh_command(CLI::App& app) {
       ->check(CLI::IsMember({"shorter", "fixed"}))
       ->capture_default_str();
   cmd->add_flag("--ply", args->ply, "Also write DIR/<stem>.M<K>.ply (binary)");
+  cmd->add_flag(
+      "--untangle", args->untangle,
+      "Open the uniform remesh's folds as `geomip decode` does (samples of triangles that face against "
+      "the surface around them slide along it; same faces): fewer self-intersecting triangles where "
+      "the sampling is stretched. Off by default: the remesh stays the paper's");
   cmd->add_flag("--glb", args->glb,
                 "Also write DIR/<stem>.M<K>.glb: glTF with each patch's (u,v) as TEXCOORD_0 and the normal "
                 "maps' normals (seam vertices once per patch)");

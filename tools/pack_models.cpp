@@ -181,10 +181,13 @@ TriMesh decoded_mesh_impl(const codec::DecodedModel& model, int level, bool weld
 }  // namespace
 
 UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplitOptions& split,
-                                     const UntangleOptions& options) {
+                                     const UntangleOptions& options_in) {
   UntangleStats stats;
   if (model.geometry.empty()) return stats;
+  const UntangleOptions& options = options_in;
   const int level = model.geometry.front().level;
+  if (level < options.min_level) return stats;  // applied = false
+  stats.applied = true;
   UniformRemeshResult remesh = grid_mesh(model, level, /*weld=*/true, split);
   std::vector<Eigen::Vector3d>& x = remesh.mesh.positions;
   const std::vector<std::array<int, 3>>& tris = remesh.mesh.triangles;
@@ -214,7 +217,12 @@ UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplit
     const Eigen::Vector3d n = face_normal(t);
     for (int v : tris[t]) ref[static_cast<std::size_t>(v)] += n;
   }
-  for (int ring = 0; ring < options.normal_rings; ++ring) {
+  // Rings scale with the grid: 20 at level 8 (8 % of a patch side), fewer on coarser grids, where 20 rings
+  // would span patches and average the two sides of a leg.
+  const int rings =
+      std::clamp(static_cast<int>(std::lround(options.normal_rings * std::ldexp(1.0, level - 8))),
+                 std::min(2, options.normal_rings), options.normal_rings);
+  for (int ring = 0; ring < rings; ++ring) {
     for (auto& n : ref) n.normalize();               // a zero vector stays zero
     for (std::size_t t = 0; t < tris.size(); ++t) {  // per triangle: the sum of its corners' normals
       const auto& f = tris[t];
@@ -283,6 +291,41 @@ UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplit
               if (dist < best) best = dist, on = q;
             }
         moved = on;
+      }
+      // No sample slides farther than `max_slide` of its mean edge length from where it was decoded: a sample
+      // that slid far would take its triangles' corners along (a leg's tip samples slid towards the body and
+      // the leg shortened; measured on coarse grids).
+      double edge = 0;
+      int edges = 0;
+      for (int k = tri_start[v]; k < tri_start[v + 1]; ++k)
+        for (int w : tris[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])])
+          if (static_cast<std::size_t>(w) != v)
+            edge += (start[static_cast<std::size_t>(w)] - start[v]).norm(), ++edges;
+      if (edges > 0 && (moved - start[v]).norm() > options.max_slide * edge / edges) continue;
+      // The fan around v must stay on the decoded surface too, not only v: each of its triangles' centroids
+      // within `max_fan_gap` mean edge lengths of the surface as it was (two rings around v).
+      if (edges > 0 && options.max_fan_gap > 0) {
+        const Eigen::Vector3d keep = x[v];
+        x[v] = moved;
+        const double limit = options.max_fan_gap * edge / edges;
+        bool far = false;
+        for (int k = tri_start[v]; k < tri_start[v + 1] && !far; ++k) {
+          const auto& f = tris[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])];
+          const Eigen::Vector3d c = (x[f[0]] + x[f[1]] + x[f[2]]) / 3.0;
+          double best2 = std::numeric_limits<double>::infinity();
+          for (int w : f)
+            for (int k2 = tri_start[static_cast<std::size_t>(w)];
+                 k2 < tri_start[static_cast<std::size_t>(w) + 1]; ++k2) {
+              const auto& g = tris[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k2)])];
+              best2 = std::min(
+                  best2, (closest_on_triangle(c, start[g[0]], start[g[1]], start[g[2]]) - c).squaredNorm());
+            }
+          far = best2 > limit * limit;
+        }
+        if (far) {
+          x[v] = keep;
+          continue;
+        }
       }
       x[v] = moved;
     }
@@ -413,6 +456,19 @@ TexturedMesh textured_mesh(const GeometryImages& images, QuadSplit split,
   std::vector<const codec::DecodedModel*> views;
   for (const auto& m : others) views.push_back(&m);
   return decoded_textured_mesh(model_of(images, true), -1, {.split = split, .chosen_by = views});
+}
+
+UntangleStats untangle_geometry_images(GeometryImages& images, QuadSplit split,
+                                       const std::vector<const GeometryImages*>& chosen_by) {
+  std::vector<codec::DecodedModel> others;
+  for (const GeometryImages* g : chosen_by) others.push_back(model_of(*g, false));
+  std::vector<const codec::DecodedModel*> views;
+  for (const auto& m : others) views.push_back(&m);
+  codec::DecodedModel model = model_of(images, false);
+  const UntangleStats stats = untangle_decoded_model(model, {.split = split, .chosen_by = views});
+  for (std::size_t p = 0; p < images.geometry.size(); ++p)
+    images.geometry[p].values = model.geometry[p].values;
+  return stats;
 }
 
 }  // namespace geomip::tools

@@ -41,7 +41,15 @@ struct QuadSplitOptions {
 TriMesh decoded_mesh(const codec::DecodedModel& model, int level = -1, const QuadSplitOptions& split = {});
 
 struct UntangleOptions {
-  int normal_rings = 20;  ///< rings over which the reference normals are averaged
+  int normal_rings = 20;   ///< rings over which the reference normals are averaged at level 8 (scaled by
+                           ///< 2^(N−8), at least 2, on a level-N grid)
+  double max_slide = 1.0;  ///< no sample moves farther than this many of its mean edge lengths
+  /// Grids coarser than this are left as decoded: there a sample's slide moves the surface (a level-4 horse
+  /// lost 3–7 dB, a level-5 bunny 1 dB; level 6 at most 0.52 dB, levels 7–8 at most 0.23 dB).
+  int min_level = 6;
+  double max_fan_gap =
+      0.1;  ///< a move is refused when a centroid of the sample's triangles lands farther than this
+            ///< many mean edge lengths from the decoded surface as it was (0 = no check)
   int max_sweeps = 100;   ///< sweeps over the folded samples at most
   double step = 0.5;      ///< fraction of the way to the neighbours' centroid per sweep
 };
@@ -51,19 +59,21 @@ struct UntangleStats {
   std::size_t moved = 0;                            ///< samples moved (seam samples once)
   double max_move = 0;                              ///< the largest move, model units
   int sweeps = 0;
+  bool applied = false;  ///< false: the grid is coarser than UntangleOptions::min_level, left as decoded
 };
 
-/// Opens the folds of a decoded model's finest grids in place. A triangle of the welded level-N mesh (quads
-/// split as `split` says, as decoded_mesh() splits them) is folded when it faces against the area-weighted
-/// vertex normals averaged over `normal_rings` rings around it (wider than a fold). Each sweep moves every
-/// sample of a folded triangle half-way towards its neighbours' centroid within that normal's tangent plane,
-/// then onto the nearest point of the decoded surface as it was (its triangles two rings around): the fold
-/// opens along the surface, so the distance to the original mesh barely changes. Sweeps stop when no
-/// triangle is folded or after `max_sweeps`; some folds stay (their nearest surface is the fold). Seam
-/// samples move once, into every patch that has them (bit-identical across seams, as decoded).
-/// Measured (docs/measurements.md, "Folds and self-intersections in decoded meshes"): self-intersecting
-/// faces −27…−100 % on spot, bunny, horse and cow at 8.8 KB and whole packs, PSNR −0.41…+0.23 dB. O(rings ·
-/// F).
+/// Opens the folds of a decoded model's finest grids in place (grids of level ≥ `min_level`; coarser ones are
+/// left as they are). A triangle of the welded level-N mesh (quads split as `split` says, as decoded_mesh()
+/// splits them) is folded when it faces against the area-weighted vertex normals averaged over 20·2^(N−8)
+/// rings around it (wider than a fold, narrower than a limb). Each sweep moves every sample of a folded
+/// triangle half-way towards its neighbours' centroid within that normal's tangent plane, then onto the
+/// nearest point of the decoded surface as it was (its triangles two rings around); a move is refused when
+/// the sample would end more than `max_slide` mean edge lengths from where it was decoded or its triangles'
+/// centroids more than `max_fan_gap` of them off that surface. Sweeps stop when no triangle is folded or
+/// after `max_sweeps`; some folds stay. Seam samples move once, into every patch that has them (bit-identical
+/// across seams, as decoded). Measured (docs/measurements.md, "Folds and self-intersections in decoded
+/// meshes"): self-intersecting faces −20…−93 % on spot, bunny, horse and cow (levels 6–8, 8.8 KB and whole
+/// packs), PSNR −0.52…+0.28 dB. O(rings · F).
 UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplitOptions& split = {},
                                      const UntangleOptions& options = {});
 
@@ -95,5 +105,11 @@ TexturedMesh decoded_textured_mesh(const codec::DecodedModel& model, int level =
 /// have them.
 TexturedMesh textured_mesh(const GeometryImages& images, QuadSplit split = QuadSplit::kShorter,
                            const std::vector<const GeometryImages*>& chosen_by = {});
+
+/// untangle_decoded_model() for geometry images that were not coded (`geomip remesh --untangle`): `images` in
+/// place, the quads split as `split` says, chosen by the images of `chosen_by` (give the set's images as they
+/// were before any untangling, so the face list stays) or by `images` alone when it is empty.
+UntangleStats untangle_geometry_images(GeometryImages& images, QuadSplit split = QuadSplit::kShorter,
+                                       const std::vector<const GeometryImages*>& chosen_by = {});
 
 }  // namespace geomip::tools

@@ -85,10 +85,10 @@ std::vector<ModelSpec> read_correspondence(const std::string& path) {
   } catch (const nlohmann::json::exception& e) {
     fail(path, std::string("not valid JSON: ") + e.what());
   }
+  if (j.is_object()) check_keys(path, j, {"models", "layout"}, "");  // "model": said before "no models"
   if (!j.is_object() || !j.contains("models") || !j["models"].is_array() || j["models"].empty()) {
     fail(path, "expected {\"models\": [ ... ]} with at least one model");
   }
-  check_keys(path, j, {"models", "layout"}, "");
   const std::filesystem::path base = std::filesystem::path(path).parent_path();
   std::vector<std::array<int, 4>> quads;
   if (j.contains("layout")) {

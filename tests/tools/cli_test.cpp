@@ -476,6 +476,8 @@ TEST_F(CliParam, BadCorrespondenceFilesExitTwo) {
       "did you mean \"auxiliary_points\"");
   expect_two(file("case.json", "{\"Models\": [], \"models\": [" + model("[0, 1000, 2000, 2900]") + "]}"),
              "did you mean \"models\"");
+  expect_two(file("model.json", "{\"model\": [" + model("[0, 1000, 2000, 2900]") + "]}"),
+             "did you mean \"models\"");
   // Models of different genus: said as such (it was a message about auxiliary points, naming no model).
   {
     std::ofstream torus(dir_ + "/torus.obj");

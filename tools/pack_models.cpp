@@ -260,6 +260,17 @@ UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplit
         active[static_cast<std::size_t>(v)] = 1, set.push_back(static_cast<std::size_t>(v));
   }
   const std::vector<Eigen::Vector3d> start = x;
+  // Each sample's mean edge length as decoded (over its triangles' other corners): the scale of its limits.
+  std::vector<double> mean_edge(nv, 0.0);
+  for (std::size_t v = 0; v < nv; ++v) {
+    double sum = 0;
+    int count = 0;
+    for (int k = tri_start[v]; k < tri_start[v + 1]; ++k)
+      for (int w : tris[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])])
+        if (static_cast<std::size_t>(w) != v)
+          sum += (start[static_cast<std::size_t>(w)] - start[v]).norm(), ++count;
+    if (count > 0) mean_edge[v] = sum / count;
+  }
   for (int sweep = 0; sweep < options.max_sweeps && !set.empty(); ++sweep) {
     for (std::size_t v : set) {
       bool touches_fold = false;  // only the samples of a triangle still folded move
@@ -295,19 +306,14 @@ UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplit
       // No sample slides farther than `max_slide` of its mean edge length from where it was decoded: a sample
       // that slid far would take its triangles' corners along (a leg's tip samples slid towards the body and
       // the leg shortened; measured on coarse grids).
-      double edge = 0;
-      int edges = 0;
-      for (int k = tri_start[v]; k < tri_start[v + 1]; ++k)
-        for (int w : tris[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])])
-          if (static_cast<std::size_t>(w) != v)
-            edge += (start[static_cast<std::size_t>(w)] - start[v]).norm(), ++edges;
-      if (edges > 0 && (moved - start[v]).norm() > options.max_slide * edge / edges) continue;
+      const double edge = mean_edge[v];
+      if (edge > 0 && (moved - start[v]).norm() > options.max_slide * edge) continue;
       // The fan around v must stay on the decoded surface too, not only v: each of its triangles' centroids
       // within `max_fan_gap` mean edge lengths of the surface as it was (two rings around v).
-      if (edges > 0 && options.max_fan_gap > 0) {
+      if (edge > 0 && options.max_fan_gap > 0) {
         const Eigen::Vector3d keep = x[v];
         x[v] = moved;
-        const double limit = options.max_fan_gap * edge / edges;
+        const double limit = options.max_fan_gap * edge;
         bool far = false;
         for (int k = tri_start[v]; k < tri_start[v + 1] && !far; ++k) {
           const auto& f = tris[static_cast<std::size_t>(tri_of[static_cast<std::size_t>(k)])];

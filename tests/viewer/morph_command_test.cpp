@@ -47,13 +47,24 @@ class MorphCommandTest : public ::testing::Test {
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("geomip_morph_test_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
-    const auto bytes = codec::write_pack({testing::pack_input(5, 0), testing::pack_input(5, 1)});
-    std::ofstream(dir_ / "two.gip", std::ios::binary)
-        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    pack_file("two", codec::write_pack({testing::pack_input(5, 0), testing::pack_input(5, 1)}));
   }
   void TearDown() override {
     std::error_code ignored;
     fs::remove_all(dir_, ignored);
+  }
+  // `geomip ARGS` (output to log.txt): its exit code.
+  int geomip(const std::string& args) {
+    const int status = std::system(
+        (std::string(GEOMIP_BINARY) + " " + args + " > " + (dir_ / "log.txt").string() + " 2>&1").c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  // Writes `bytes` as DIR/NAME.gip; its path.
+  std::string pack_file(const std::string& name, const std::vector<std::uint8_t>& bytes) {
+    const fs::path path = dir_ / (name + ".gip");
+    std::ofstream(path, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    return path.string();
   }
   int morph(const std::string& args) {
     const std::string cmd = std::string(GEOMIP_BINARY) + " morph " + (dir_ / "two.gip").string() + " " + args +
@@ -127,20 +138,12 @@ TEST_F(MorphCommandTest, FramesHaveDecodesFaceListInAPackOfThree) {
   stretched.name = "stretched";
   for (auto& patch : stretched.geometry)
     for (std::size_t i = 0; i < patch.values.size(); i += 3) patch.values[i] *= 4.0f;
-  const auto bytes =
-      codec::write_pack({testing::pack_input(5, 0), testing::pack_input(5, 1), std::move(stretched)});
-  std::ofstream(dir_ / "three.gip", std::ios::binary)
-      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  const std::string log = " > " + (dir_ / "log3.txt").string() + " 2>&1";
+  const std::string pack = pack_file(
+      "three",
+      codec::write_pack({testing::pack_input(5, 0), testing::pack_input(5, 1), std::move(stretched)}));
   fs::create_directories(dir_ / "d3");
-  ASSERT_EQ(std::system((std::string(GEOMIP_BINARY) + " morph " + (dir_ / "three.gip").string() +
-                         " --frames 2 --from 0 --to 1 -o " + (dir_ / "m3").string() + log)
-                            .c_str()),
-            0);
-  ASSERT_EQ(std::system((std::string(GEOMIP_BINARY) + " decode " + (dir_ / "three.gip").string() + " -o " +
-                         (dir_ / "d3" / "x.obj").string() + log)
-                            .c_str()),
-            0);
+  ASSERT_EQ(geomip("morph " + pack + " --frames 2 --from 0 --to 1 -o " + (dir_ / "m3").string()), 0);
+  ASSERT_EQ(geomip("decode " + pack + " -o " + (dir_ / "d3" / "x.obj").string()), 0);
   const Obj frame = read_obj(dir_ / "m3" / "morph_0000.obj");
   const Obj decoded = read_obj(dir_ / "d3" / "x.ellipsoid.obj");
   ASSERT_FALSE(frame.faces.empty());
@@ -157,19 +160,11 @@ TEST_F(MorphCommandTest, FramesLeaveOutTheHolesOfEitherEnd) {
   holed.hole_mask.assign(holed.geometry.size(), std::vector<std::uint8_t>(32 * 32, 0));
   for (int j = 10; j < 14; ++j)
     for (int i = 8; i < 16; ++i) holed.hole_mask[0][static_cast<std::size_t>(j) * 32 + i] = 1;  // 32 quads
-  const auto bytes = codec::write_pack({testing::pack_input(5, 1), std::move(holed)});
-  std::ofstream(dir_ / "holed.gip", std::ios::binary)
-      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  const std::string log = " > " + (dir_ / "logh.txt").string() + " 2>&1";
+  const std::string pack =
+      pack_file("holed", codec::write_pack({testing::pack_input(5, 1), std::move(holed)}));
   fs::create_directories(dir_ / "dh");
-  ASSERT_EQ(std::system((std::string(GEOMIP_BINARY) + " morph " + (dir_ / "holed.gip").string() +
-                         " --frames 2 --from 0 --to 1 -o " + (dir_ / "mh").string() + log)
-                            .c_str()),
-            0);
-  ASSERT_EQ(std::system((std::string(GEOMIP_BINARY) + " decode " + (dir_ / "holed.gip").string() + " -o " +
-                         (dir_ / "dh" / "x.obj").string() + log)
-                            .c_str()),
-            0);
+  ASSERT_EQ(geomip("morph " + pack + " --frames 2 --from 0 --to 1 -o " + (dir_ / "mh").string()), 0);
+  ASSERT_EQ(geomip("decode " + pack + " -o " + (dir_ / "dh" / "x.obj").string()), 0);
   const Obj decoded = read_obj(dir_ / "dh" / "x.holed.obj");
   EXPECT_EQ(decoded.faces.size(), 2u * 2 * 32 * 32 - 2 * 32) << "32 quads left out";
   for (const char* name : {"morph_0000.obj", "morph_0001.obj"}) {

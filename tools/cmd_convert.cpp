@@ -176,7 +176,8 @@ int run_convert(const ConvertArgs& args) {
   ConvertResult converted;
   std::optional<SearchResult> searched;
   const int named_level = level;  // the level the search names its candidates against
-  bool relayouted = false;        // moved from two stretched squares to kStretchedShapePatches patches
+  bool relayouted = false;        // moved from two stretched squares to more patches
+  RelayoutChoice relayout_choice;
   if (searching) {
     // --choose-loop: the loops only (with --fit every loop fitted: options.fit).
     SearchOptions search = args.search ? full_search_options() : SearchOptions{};
@@ -192,21 +193,24 @@ int run_convert(const ConvertArgs& args) {
     models = std::move(searched->models);
     level = searched->chosen.level;
   } else {
-    // One mesh on the plain two squares, layout and level left to us: a shape they stretch moves to 16
-    // patches one level coarser (kStretchedTwoSquares), unless the level-dependent options do not fit there.
-    int relayout_level = 0;
-    if (!args.common.patches_given && args.common.points.empty() && args.common.meshes.size() == 1 &&
-        loop_asked == LoopKind::kPlain) {
-      relayout_level = stretched_shape_level(level);
+    // One mesh on the plain two squares, layout and level left to us: a shape they stretch moves to 16 or
+    // 64 patches, whichever codes it better (kStretchedTwoSquares, kStretchedShapeLayouts), each at a level
+    // that keeps about the two squares' samples, unless the level-dependent options do not fit there.
+    const bool may_move = !args.common.patches_given && args.common.points.empty() &&
+                          args.common.meshes.size() == 1 && loop_asked == LoopKind::kPlain;
+    const auto level_for = [&](int patches) {
+      if (!may_move) return 0;
+      const int l = relayout_level(level, patches);
       try {
-        if (relayout_level > 0) check_level_options(args, relayout_level);
+        if (l > 0) check_level_options(args, l);
       } catch (const InvalidInput&) {
-        relayout_level = 0;
+        return 0;
       }
-    }
+      return l;
+    };
     bool announced = false;
     converted = convert_relayout_when_stretched(
-        models, options, relayout_level,
+        models, options, level_for,
         [&](int patches) {
           return prepare_models(args.common.meshes, "", "geomip convert", true, patches, LoopKind::kPlain,
                                 args.common.equal_area_layout);
@@ -217,15 +221,29 @@ int run_convert(const ConvertArgs& args) {
           if (report)
             std::printf(
                 "layout: the two squares stretch this shape (L2 stretch %.2f; 1 is none): converting it "
-                "again on %d patches at level %d, which code such shapes better (--patches 2 keeps the "
-                "two squares)\n",
-                stretch, kStretchedShapePatches, relayout_level);
+                "again on 16 and 64 patches and keeping the one whose prefixes measure closer to the mesh "
+                "(--patches 2 keeps the two squares)\n",
+                stretch);
         },
-        relayouted);
-    // The announced layout failed after its announcement (its parameterization): say what was written.
-    if (announced && !relayouted && report)
-      std::printf("layout: no %d-patch layout fits this mesh; keeping the two squares\n",
-                  kStretchedShapePatches);
+        relayout_choice);
+    relayouted = relayout_choice.chosen_patches > 0;
+    if (announced && report) {
+      bar.finish();
+      for (const RelayoutChoice::Candidate& c : relayout_choice.candidates) {
+        if (!c.not_built.empty())
+          std::printf("layout: %d patches: not built (%s)\n", c.patches, c.not_built.c_str());
+        else
+          std::printf(
+              "layout: %d patches at level %d: %.2f dB mean PSNR of the geometry prefixes (%zu B)%s\n",
+              c.patches, c.level, c.mean_psnr_db, c.geometry_bytes,
+              c.patches == relayout_choice.chosen_patches ? ", kept" : "");
+      }
+      if (relayouted)
+        std::printf("layout: chosen in %.1f s (--patches 16 or --patches 64 skips the choice)\n",
+                    relayout_choice.seconds);
+      // Every layout failed after the announcement (its parameterization): say what was written.
+      if (!relayouted) std::printf("layout: no such layout fits this mesh; keeping the two squares\n");
+    }
     level = options.level;
   }
   // --choose-loop's report: the mean PSNR of each loop (NaN: not built, e.g. a mesh without tips).
@@ -266,6 +284,7 @@ int run_convert(const ConvertArgs& args) {
                                 {"level", level},
                                 {"patches", info.models.front().geometry.num_patches},
                                 {"moved_to_patches", relayouted},
+                                {"layout_choice", relayout_json(relayout_choice)},
                                 {"normals", !args.no_normals},
                                 {"models", j_models},
                                 {"normal_mesh",
@@ -344,7 +363,7 @@ CommandRunner add_convert_command(CLI::App& app) {
       "--level", args->level,
       "Grid level N in [1, 10] (default 8: 257² samples per patch, for two squares; for a K-patch layout "
       "the coarsest level whose K grids hold at least as many samples: K = 3 to 7: 8, 8 to 31: 7, 32 to 121: "
-      "6; a stretched shape moved to 16 patches gets one level below the two squares' N)");
+      "6; a stretched shape moved to 16 or 64 patches gets one or two levels below the two squares' N)");
   cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
   cmd->add_option("--bits", args->quantization_bits,
                   "Position quantization bits over the largest bounding-box extent (default 14)");

@@ -60,7 +60,8 @@ struct RdArgs {
   bool no_geomip = false;   // only the baselines
   int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
   int patches = 2;          // geomip: patches of the automatic layout (--patches)
-  bool patches_given = false;  // --patches on the command line (else a stretched shape moves to 16 patches)
+  bool patches_given =
+      false;  // --patches on the command line (else a stretched shape moves to 16 or 64 patches)
   bool equal_area_layout = false;  // geomip: --equal-area-layout
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
   bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)
@@ -207,12 +208,12 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
 /// pack), then one job per prefix size: decode the first N bytes and build the level-N mesh. `search`: the
 /// pack of search_conversion() (the loops, the K-patch layouts, the fit, ...), its choice in `chosen`.
 /// `relayout`: the layout was left to us (no --patches, the plain loop), so a shape that two squares stretch
-/// moves to 16 patches one level coarser, as `geomip convert` does (convert_relayout_when_stretched());
-/// `moved` then holds the two squares' L2 stretch and the level, else stays empty.
+/// moves to 16 or 64 patches, whichever codes it better, as `geomip convert` does
+/// (convert_relayout_when_stretched()); `moved` then reports the choice (chosen_patches 0: not moved).
 Series geomip_series(const std::string& mesh_path, int level, int patches, bool equal_area_layout,
                      LoopKind loop, int normal_mesh_steps, bool fit, bool search, bool quick, bool relayout,
                      std::vector<std::uint8_t>& pack_out, std::optional<SearchResult>& chosen,
-                     std::optional<std::pair<double, int>>& moved, ProgressBar& progress) {
+                     RelayoutChoice& moved, ProgressBar& progress) {
   ConvertOptions options;
   options.seam_slide_rounds = default_seam_slide_rounds(loop);
   options.level = level;
@@ -227,16 +228,17 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, bool 
   } else {
     PreparedModels models =
         prepare_models({mesh_path}, "", "geomip rd", true, patches, loop, equal_area_layout);
-    const int coarser = stretched_shape_level(level);
-    const bool fits = normal_mesh_steps <= coarser;  // the default framed steps are capped at the level
-    bool switched = false;
     ConvertResult converted = convert_relayout_when_stretched(
-        models, options, relayout && fits ? coarser : 0,
+        models, options,
+        [&](int k) {
+          const int coarser = relayout_level(level, k);
+          // The default framed steps are capped at the level; asked-for normal-mesh steps must fit.
+          return relayout && normal_mesh_steps <= coarser ? coarser : 0;
+        },
         [&](int k) {
           return prepare_models({mesh_path}, "", "geomip rd", true, k, LoopKind::kPlain, equal_area_layout);
         },
-        {}, switched);
-    if (switched) moved.emplace(converted.two_squares_l2_stretch, options.level);
+        {}, moved);
     pack = std::make_shared<const std::vector<std::uint8_t>>(std::move(converted.pack));
   }
   pack_out = *pack;
@@ -330,8 +332,7 @@ int run_rd(const RdArgs& args) {
   std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
   std::optional<SearchResult> searched;
-  std::optional<std::pair<double, int>>
-      moved;  // two squares' stretch and the level, when moved to 16 patches
+  RelayoutChoice moved;  // the layout chosen for a shape two squares stretch
   if (!args.no_geomip)
     plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.equal_area_layout, loop,
                                  args.normal_mesh_steps, args.fit, args.search, args.quick,
@@ -457,10 +458,11 @@ int run_rd(const RdArgs& args) {
     j["geomip_vs_draco_envelope"] = comparison;
     if (!lt_points.empty()) j["geomip_vs_draco_lt_envelope"] = lt_comparison;
     if (searched) j["search"] = search_json(*searched, args.level);
-    if (moved)
-      j["geomip_moved_to_patches"] = {{"patches", kStretchedShapePatches},
-                                      {"level", moved->second},
-                                      {"two_squares_l2_stretch", moved->first}};
+    if (moved.chosen_patches > 0)
+      j["geomip_moved_to_patches"] = {{"patches", moved.chosen_patches},
+                                      {"level", moved.chosen_level},
+                                      {"two_squares_l2_stretch", moved.two_squares_l2_stretch}};
+    if (!moved.candidates.empty()) j["geomip_layout_choice"] = relayout_json(moved);
     j["points"] = nlohmann::json::array();
     for (const RdPoint& p : all) j["points"].push_back(point_to_json(p));
     std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
@@ -486,11 +488,16 @@ int run_rd(const RdArgs& args) {
     std::cout << "geomip pack: " << searched->chosen.name(args.level) << " (--search; mean PSNR of its "
               << searched->sizes.size() << " scored prefixes: " << scores << ")\n";
   }
-  if (moved)
+  if (moved.chosen_patches > 0) {
+    std::string scores;
+    for (const RelayoutChoice::Candidate& c : moved.candidates)
+      if (c.not_built.empty())
+        scores += (scores.empty() ? "" : ", ") + format("%d patches %.2f dB", c.patches, c.mean_psnr_db);
     std::cout << format(
-        "geomip pack: %d patches at level %d (the two squares stretch this shape: L2 stretch %.2f; "
-        "--patches 2 keeps them)\n",
-        kStretchedShapePatches, moved->second, moved->first);
+        "geomip pack: %d patches at level %d (the two squares stretch this shape: L2 stretch %.2f; the "
+        "layout whose prefixes measured closer: %s; --patches 2 keeps the two squares)\n",
+        moved.chosen_patches, moved.chosen_level, moved.two_squares_l2_stretch, scores.c_str());
+  }
   std::cout << "(" << candidates << " decimate-then-Draco points, the envelopes' candidates, are in rd.csv)\n"
             << comparison_text
             << "wrote " << (dir / "rd.csv").string() << " and " << (dir / "rd.svg").string()

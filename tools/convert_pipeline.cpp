@@ -147,43 +147,138 @@ int default_grid_level(std::size_t patches) {
   return level;
 }
 
-int stretched_shape_level(int level) {
-  const int shifted =
-      level + default_grid_level(static_cast<std::size_t>(kStretchedShapePatches)) - default_grid_level(2);
-  return shifted >= 1 ? shifted : 0;
+int relayout_level(int level, int patches) {
+  const int coarser = level + default_grid_level(static_cast<std::size_t>(patches)) - default_grid_level(2);
+  return coarser >= 1 ? coarser : 0;
+}
+
+std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
+                                const TriMesh& reference, const SurfaceDistanceOptions& distance) {
+  std::vector<double> out(sizes.size(), NAN);
+  codec::parallel_for(static_cast<int>(sizes.size()), 0, [&](int i) {
+    codec::PackDecodeOptions decode;
+    decode.max_bytes = sizes[i];
+    decode.normals = false;
+    decode.max_threads = 1;
+    const codec::PackDecodeResult result = codec::decode_pack(pack, decode);
+    if (result.models.empty()) return;
+    SurfaceDistanceOptions one = distance;
+    one.threads = 1;
+    out[i] = measure_surface_distance(reference, decoded_mesh(result.models.front()), one).psnr_db;
+  });
+  return out;
+}
+
+SurfaceDistanceOptions relayout_distance_options() {
+  SurfaceDistanceOptions o;
+  o.face_samples = 100000;
+  o.sample_vertices = false;
+  return o;
 }
 
 ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOptions& options,
-                                              int relayout_level,
+                                              const std::function<int(int patches)>& level_for,
                                               const std::function<PreparedModels(int patches)>& prepare,
                                               const std::function<void(double stretch)>& before_switch,
-                                              bool& switched) {
-  switched = false;
-  if (relayout_level < 1) return convert_models(models, options);
+                                              RelayoutChoice& choice) {
+  choice = {};
+  bool any = false;
+  for (int k : kStretchedShapeLayouts) any = any || level_for(k) >= 1;
+  if (!any || models.inputs.size() != 1) return convert_models(models, options);
   // The two squares' parameterization tells; the rest of their pipeline runs only when they stay.
   ConvertOptions probe = options;
   probe.stop_when_stretched = kStretchedTwoSquares;
   ConvertResult first = convert_models(models, probe);
   if (!first.stopped_stretched) return first;
   const double stretch = first.two_squares_l2_stretch;
-  try {
-    PreparedModels moved = prepare(kStretchedShapePatches);
-    if (before_switch) before_switch(stretch);
-    ConvertOptions at_level = options;
-    at_level.level = relayout_level;
-    ConvertResult result = convert_models(moved, at_level);
-    result.two_squares_l2_stretch = stretch;
-    result.param_seconds += first.param_seconds;  // both parameterizations
-    models = std::move(moved);
-    options = at_level;
-    switched = true;
-    return result;
-  } catch (const InvalidInput&) {  // no 16-patch layout fits this mesh (too few vertices, paths that fail)
-  } catch (const SolverFailure&) {
+  choice.two_squares_l2_stretch = stretch;
+  const auto t_choice = std::chrono::steady_clock::now();
+  const TriMesh& reference =
+      models.originals.front().positions.empty() ? models.inputs.front().mesh : models.originals.front();
+
+  struct Built {
+    PreparedModels models;
+    ConvertOptions options;
+    ConvertResult result;
+    std::vector<std::uint8_t> geometry_pack;  // what `convert --no-normals` writes on this layout
+  };
+  std::vector<Built> built;
+  std::vector<std::size_t> built_candidate;  // index into choice.candidates
+  bool announced = false;
+  for (int k : kStretchedShapeLayouts) {
+    RelayoutChoice::Candidate c;
+    c.patches = k;
+    c.level = level_for(k);
+    if (c.level < 1) {
+      c.not_built = "its level does not fit the options";
+      choice.candidates.push_back(c);
+      continue;
+    }
+    try {
+      Built b{prepare(k), options, {}, {}};
+      if (!announced && before_switch) before_switch(stretch);
+      announced = true;
+      b.options.level = c.level;
+      b.options.keep_inputs = true;  // the geometry-only pack is encoded again from them
+      b.result = convert_models(b.models, b.options);
+      if (options.normals) {
+        ConvertOptions geometry = b.options;
+        geometry.normals = false;
+        b.geometry_pack = codec::write_pack(
+            b.result.inputs, pack_write_options(geometry, b.result.inputs.front().geometry.size()));
+      } else {
+        b.geometry_pack = b.result.pack;
+      }
+      if (!options.keep_inputs) b.result.inputs.clear();
+      b.options.keep_inputs = options.keep_inputs;
+      c.geometry_bytes = b.geometry_pack.size();
+      built.push_back(std::move(b));
+      built_candidate.push_back(choice.candidates.size());
+    } catch (const InvalidInput& e) {  // no such layout fits this mesh (too few vertices, paths that fail)
+      c.not_built = e.what();
+    } catch (const SolverFailure& e) {
+      c.not_built = e.what();
+    }
+    choice.candidates.push_back(c);
   }
-  // Two squares after all: their whole pipeline (the note on the stretch is the caller's).
-  ConvertResult result = convert_models(models, options);
-  result.param_seconds += first.param_seconds;
+  if (built.empty()) {
+    // Two squares after all: their whole pipeline (the note on the stretch is the caller's).
+    ConvertResult result = convert_models(models, options);
+    result.param_seconds += first.param_seconds;
+    return result;
+  }
+
+  // Sizes below the larger pack (a smaller pack is scored whole there), as the search scores them.
+  std::size_t largest = 0;
+  for (const Built& b : built) largest = std::max(largest, b.geometry_pack.size());
+  for (std::size_t s : kStretchedChoiceSizes)
+    if (s < largest) choice.sizes.push_back(s);
+  if (choice.sizes.empty()) choice.sizes.push_back(largest);
+  std::size_t best = built.size();
+  for (std::size_t i = 0; i < built.size(); ++i) {
+    if (options.progress)
+      options.progress("measure layouts", static_cast<double>(i) / static_cast<double>(built.size()));
+    RelayoutChoice::Candidate& c = choice.candidates[built_candidate[i]];
+    c.psnr_db = prefix_psnr(built[i].geometry_pack, choice.sizes, reference, relayout_distance_options());
+    double sum = 0;
+    for (double p : c.psnr_db) sum += p;  // NaN stays NaN: not eligible
+    c.mean_psnr_db = sum / static_cast<double>(c.psnr_db.size());
+    if (std::isfinite(c.mean_psnr_db) &&
+        (best == built.size() || c.mean_psnr_db > choice.candidates[built_candidate[best]].mean_psnr_db))
+      best = i;
+  }
+  if (best == built.size()) best = 0;  // no prefix decodes on any: the first layout, as before the choice
+  choice.seconds = seconds_since(t_choice);
+  Built& winner = built[best];
+  choice.chosen_patches = choice.candidates[built_candidate[best]].patches;
+  choice.chosen_level = winner.options.level;
+  ConvertResult result = std::move(winner.result);
+  result.two_squares_l2_stretch = stretch;
+  result.param_seconds += first.param_seconds;  // the two squares' parameterization too
+  for (std::size_t i = 0; i < built.size(); ++i)
+    if (i != best) result.param_seconds += built[i].result.param_seconds;
+  models = std::move(winner.models);
+  options = winner.options;
   return result;
 }
 

@@ -4,13 +4,17 @@
 
 #include "codec/normal_mesh.h"
 #include "codec/pack.h"
+#include "gimage/surface_distance.h"
 #include "mesh/mesh.h"
 #include "mesh/view_frame.h"
 #include "tools/model_inputs.h"
 
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace geomip::tools {
@@ -90,7 +94,7 @@ struct ConvertOptions {
   /// The front with `up` (upright_rotation()'s `front`): a signed unit axis of the first model's units, or
   /// zero (default) for the shape's rule.
   Eigen::Vector3d front = Eigen::Vector3d::Zero();
-  ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode"
+  ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode" (and "measure layouts")
   /// Keep the pack's inputs (geometry images, normal maps, hole masks before coding) in
   /// ConvertResult::inputs (codec_bench --normals measures the coded normal maps against them).
   bool keep_inputs = false;
@@ -117,22 +121,64 @@ struct ConvertResult {
 };
 
 /// From this L2 stretch of a model's two squares up, `geomip convert` and `geomip rd` move the mesh to
-/// kStretchedShapePatches patches when --patches is not given (convert_relayout_when_stretched()). The two
-/// squares' L2 stretch (as `convert` parameterizes) and which layout coded better (mean PSNR of the
+/// more patches (kStretchedShapeLayouts) when --patches is not given (convert_relayout_when_stretched()). The
+/// two squares' L2 stretch (as `convert` parameterizes) and which layout coded better (mean PSNR of the
 /// 1.5–32 KB geometry prefixes; docs/measurements.md, "A note when two squares stretch the shape" and
 /// "Stretched shapes move to 16 patches"): venus 1.07, max-planck 1.07, pig 1.17, camelhead 1.19, spot 1.23,
 /// bunny 1.31 (two squares better by 0.8–2.6 dB); fandisk 1.22 (16 patches +0.5 dB); cow 1.74 (16 patches
 /// about the same: −1.1…+1.6 dB by size); horse 1.78 (16 patches +1.0 dB), armadillo 1.97 (16 patches
-/// +1.1 dB, 64 patches +2.8 dB).
+/// +1.1 dB, 64 patches +2.8 dB; measured before the curvature metric).
 inline constexpr double kStretchedTwoSquares = 1.5;
 
-/// The layout a stretched shape moves to: 16 patches, an automatic layout (choose_quad_layout()).
-inline constexpr int kStretchedShapePatches = 16;
+/// The layouts a stretched shape may move to: automatic layouts (choose_quad_layout()) of 16 and 64
+/// patches, each at the level that keeps about the two squares' samples (relayout_level()). Which codes a
+/// shape better depends on the shape, not on a stretch figure: on the mean PSNR of the 1.5–32 KB geometry
+/// prefixes the horse and the cow code better on 16 patches (horse +0.87 dB over 64), the armadillo on 64
+/// (+1.98 dB over 16, higher at every size), and the parameterizations' stretch does not tell them apart
+/// (docs/measurements.md, "How many patches for a moved shape" and "16 or 64 patches, measured by convert").
+/// So convert_relayout_when_stretched() converts the shape on each and keeps the one whose prefixes measure
+/// closer to the mesh.
+inline constexpr int kStretchedShapeLayouts[] = {16, 64};
 
-/// The grid level of that layout for two squares at `level`: about their samples, as --search names its
-/// K-patch candidates (level + default_grid_level(16) − default_grid_level(2), i.e. one level coarser);
-/// 0 when that is below 1.
-int stretched_shape_level(int level);
+/// The prefix sizes that choice scores (issue #14's range, as `--search`'s kSearchSizes).
+inline constexpr std::size_t kStretchedChoiceSizes[] = {1500, 2000, 4700, 8800, 16000, 32000};
+
+/// The grid level of a `patches`-patch layout for two squares at `level`: about their samples, as --search
+/// names its K-patch candidates (level + default_grid_level(patches) − default_grid_level(2): 16 patches one
+/// level coarser, 64 two); 0 when that is below 1.
+int relayout_level(int level, int patches);
+
+/// PSNR of the geometry of `pack` decoded from each prefix in `sizes` against `reference` (the symmetric
+/// RMS surface distance of `geomip eval`, measured with `distance`; the decoded grids as decoded, no
+/// untangling, as `geomip rd` measures); NaN where a prefix decodes to no model. One size per thread; the
+/// result does not depend on the thread count.
+std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
+                                const TriMesh& reference, const SurfaceDistanceOptions& distance = {});
+
+/// The choice convert_relayout_when_stretched() made, for reports: each layout tried, with the mean PSNR of
+/// its geometry prefixes at `sizes` (NaN: not built — no such layout fits the mesh, or its level does not
+/// fit the options — or a prefix decoded to nothing).
+struct RelayoutChoice {
+  double two_squares_l2_stretch = 0;  ///< 0: the two squares did not stretch the shape (nothing tried)
+  std::vector<std::size_t> sizes;
+  struct Candidate {
+    int patches = 0;
+    int level = 0;
+    double mean_psnr_db = NAN;
+    std::vector<double> psnr_db;     ///< per size
+    std::size_t geometry_bytes = 0;  ///< its geometry-only pack
+    std::string not_built;           ///< why it was not built, or empty
+  };
+  std::vector<Candidate> candidates;
+  int chosen_patches = 0;  ///< 0: the two squares were kept
+  int chosen_level = 0;
+  double seconds = 0;  ///< building and measuring the layouts (the two squares' parameterization not counted)
+};
+
+/// The distance measure of that choice: 100,000 area-uniform samples per surface, no vertex samples (a
+/// tenth of `geomip eval`'s default on a decoded level-7 grid; the same choice on the meshes measured, where
+/// the layouts' means differ by 0.9–2 dB, and the measure's spread over seeds is about ±0.05 dB).
+SurfaceDistanceOptions relayout_distance_options();
 
 /// The mesh the viewer's frame (ConvertOptions::up, front) is guessed from: the first model as read when it
 /// was repaired (a filled hole — the camel head's neck cut faired into a dome — would hide the cut that tells
@@ -159,18 +205,20 @@ void check_quantization_switches(int bits, int normal_bits, bool normal_bits_giv
 /// images come from resample_geometry()).
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options);
 
-/// convert_models(models, options), except that with `relayout_level` ≥ 1 one mesh whose two squares have
-/// an L2 stretch of at least kStretchedTwoSquares is, right after that parameterization, prepared again by
-/// `prepare(kStretchedShapePatches)`, announced by `before_switch(stretch)` and converted at
-/// `relayout_level`; `models` and `options.level` then describe that conversion, whose result is returned
-/// with the two squares' stretch in two_squares_l2_stretch and both parameterizations' seconds. When no
-/// such layout fits the mesh (InvalidInput, SolverFailure) the two squares are converted after all.
-/// `switched` says which happened. The callers pass 0 (no switch) when the user chose the layout (--patches,
-/// --points, a loop) or the level-dependent options do not fit the coarser level.
+/// convert_models(models, options), except that one mesh whose two squares have an L2 stretch of at least
+/// kStretchedTwoSquares is, right after that parameterization, converted again on each layout of
+/// kStretchedShapeLayouts whose `level_for(patches)` is ≥ 1 (`prepare(patches)` prepares it; `before_switch(
+/// stretch)` is called once before the first), and the one whose geometry-only prefixes at
+/// kStretchedChoiceSizes (those below the larger pack; its whole pack where smaller) have the higher mean
+/// PSNR against the mesh (relayout_distance_options()) is returned; `models` and `options.level` then
+/// describe it. Its pack is byte for byte that of convert_models() on its layout and level (the choice is
+/// deterministic). When no layout can be built (InvalidInput, SolverFailure) the two squares are converted
+/// after all. `choice` reports what was tried (chosen_patches 0: the two squares). The callers pass a
+/// `level_for` that returns 0 when the user chose the layout (--patches, --points, a loop).
 ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOptions& options,
-                                              int relayout_level,
+                                              const std::function<int(int patches)>& level_for,
                                               const std::function<PreparedModels(int patches)>& prepare,
                                               const std::function<void(double stretch)>& before_switch,
-                                              bool& switched);
+                                              RelayoutChoice& choice);
 
 }  // namespace geomip::tools

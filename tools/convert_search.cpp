@@ -27,27 +27,6 @@ const char* loop_name(LoopKind kind) {
   return "plain";
 }
 
-/// PSNR of `pack`'s geometry decoded from each prefix in `sizes` against `reference` (as `geomip eval`
-/// measures it: the default SurfaceDistanceOptions, whose results do not depend on the thread count); NaN
-/// where a prefix decodes to no model. One size per thread: a measurement is mostly serial (its trees and
-/// samples).
-std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
-                                const TriMesh& reference) {
-  std::vector<double> out(sizes.size(), NAN);
-  codec::parallel_for(static_cast<int>(sizes.size()), 0, [&](int i) {
-    codec::PackDecodeOptions decode;
-    decode.max_bytes = sizes[i];
-    decode.normals = false;
-    decode.max_threads = 1;
-    const codec::PackDecodeResult result = codec::decode_pack(pack, decode);
-    if (result.models.empty()) return;
-    SurfaceDistanceOptions distance;
-    distance.threads = 1;
-    out[i] = measure_surface_distance(reference, decoded_mesh(result.models.front()), distance).psnr_db;
-  });
-  return out;
-}
-
 struct Built {
   SearchCandidate candidate;
   PreparedModels models;
@@ -265,6 +244,28 @@ nlohmann::json search_json(const SearchResult& result, int default_level) {
           {"switches", result.chosen.switches(default_level)},
           {"sizes", result.sizes},
           {"candidates", candidates}};
+}
+
+nlohmann::json relayout_json(const RelayoutChoice& choice) {
+  if (choice.candidates.empty()) return nullptr;
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json layouts = nlohmann::json::array();
+  for (const RelayoutChoice::Candidate& c : choice.candidates) {
+    nlohmann::json psnr = nlohmann::json::array();
+    for (double p : c.psnr_db) psnr.push_back(number(p));
+    layouts.push_back(
+        {{"patches", c.patches},
+         {"level", c.level},
+         {"mean_psnr_db", number(c.mean_psnr_db)},
+         {"psnr_db", psnr},
+         {"geometry_bytes", c.geometry_bytes},
+         {"not_built", c.not_built.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.not_built)}});
+  }
+  return {{"two_squares_l2_stretch", choice.two_squares_l2_stretch},
+          {"sizes", choice.sizes},
+          {"chosen_patches", choice.chosen_patches},
+          {"seconds", choice.seconds},
+          {"layouts", layouts}};
 }
 
 }  // namespace geomip::tools

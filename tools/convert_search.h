@@ -136,4 +136,10 @@ SearchResult search_conversion(const std::string& mesh, const ConvertOptions& op
 /// "geometry_bytes" and "seconds". Names and switches are relative to `default_level`.
 nlohmann::json search_json(const SearchResult& result, int default_level);
 
+/// The layout choice of a stretched shape (convert_relayout_when_stretched()) as JSON (`convert --json`
+/// and `rd --json`): null when nothing was tried, else "two_squares_l2_stretch", "sizes", "chosen_patches"
+/// (0: the two squares kept) and per layout "patches", "level", "mean_psnr_db" and "psnr_db" per size (null:
+/// not measured), "geometry_bytes" and "not_built" (null, or why), and "seconds" (building and measuring).
+nlohmann::json relayout_json(const RelayoutChoice& choice);
+
 }  // namespace geomip::tools

@@ -324,7 +324,8 @@ void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_ar
          "(genus 1: a 2x2 periodic grid; genus >= 2: the first K = 2g+2, 4g, 6g, ... quad layout that fits); "
          "K >= 3 pairs the triangles of a coarse mesh into K quads (any genus: K + 2 - 2g >= 4). "
          "convert and rd without --patches move one mesh that two squares stretch (L2 stretch >= 1.5) "
-         "to 16 patches one level coarser; --patches 2 keeps the two squares")
+         "to 16 patches one level coarser or 64 two levels coarser, whichever layout's prefixes measure "
+         "closer to the mesh; --patches 2 keeps the two squares")
       ->each([&given](const std::string&) { given = true; });
   cmd->add_flag(
       "--equal-area-layout", equal_area_layout,

@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -1467,11 +1468,12 @@ TEST_F(CliPack, QuadSplitShorterIsCloserAndSharedByTheSet) {
 }
 
 // A single mesh on two squares gets its patches' L2 stretch in the JSON. From 1.5 up (tools/
-// convert_pipeline.h, kStretchedTwoSquares: the horse and the armadillo coded better on 16 patches, six
-// rounder shapes did not) convert moves it to 16 patches one level coarser when the layout is left to it,
-// and with --patches 2 prints a note pointing at --patches and --search instead. The cow's legs stretch its
-// squares (about 1.74), the spot's round body does not (about 1.23); another layout has no such figure.
-TEST_F(CliPack, ConvertMovesAStretchedShapeTo16PatchesUnlessTold) {
+// convert_pipeline.h, kStretchedTwoSquares: the horse and the armadillo coded better on more patches, six
+// rounder shapes did not) convert moves it, when the layout is left to it, to 16 or 64 patches (one or two
+// levels coarser), whichever layout's geometry prefixes measure closer to the mesh, and with --patches 2
+// prints a note pointing at --patches and --search instead. The cow's legs stretch its squares (about
+// 1.74), the spot's round body does not (about 1.23); another layout has no such figure.
+TEST_F(CliPack, ConvertMovesAStretchedShapeToItsBetterLayoutUnlessTold) {
   GEOMIP_REQUIRE_SHARED_MESH(cow, "cow.obj");
   const std::string note = "note: the two squares stretch this shape";
   const std::string moved = "layout: the two squares stretch this shape";
@@ -1482,17 +1484,64 @@ TEST_F(CliPack, ConvertMovesAStretchedShapeTo16PatchesUnlessTold) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return nlohmann::json::parse(r.out);
   };
-  // The cow (L2 stretch 1.74 on two squares) moves to 16 patches one level coarser: the same pack, byte for
-  // byte, as asking for that layout.
+  // The cow (L2 stretch 1.74 on two squares) is converted on 16 patches at level 3 and 64 at level 2; the
+  // pack is byte for byte that of asking for the layout kept.
   const nlohmann::json cow_auto = convert_json(cow, "", dir_ + "/cow-auto.gip");
   EXPECT_GE(cow_auto["two_squares_l2_stretch"].get<double>(), 1.5);
-  EXPECT_EQ(cow_auto["patches"], 16);
-  EXPECT_EQ(cow_auto["level"], 3);
   EXPECT_TRUE(cow_auto["moved_to_patches"].get<bool>());
-  ASSERT_EQ(geomip("convert -q '" + cow + "' --patches 16 --level 3 --no-normals -o '" + dir_ + "/cow16.gip'")
+  const nlohmann::json& choice = cow_auto["layout_choice"];
+  ASSERT_EQ(choice["layouts"].size(), 2u) << choice;
+  const std::vector<std::size_t> sizes = choice["sizes"].get<std::vector<std::size_t>>();
+  ASSERT_FALSE(sizes.empty());
+  const int chosen = choice["chosen_patches"].get<int>();
+  EXPECT_EQ(cow_auto["patches"], chosen);
+  std::map<int, double> reported_mean, measured_mean;
+  std::map<int, std::string> packs;
+  for (const nlohmann::json& layout : choice["layouts"]) {
+    const int k = layout["patches"].get<int>(), level = layout["level"].get<int>();
+    EXPECT_EQ(level, k == 16 ? 3 : 2) << layout;
+    EXPECT_TRUE(layout["not_built"].is_null()) << layout;
+    reported_mean[k] = layout["mean_psnr_db"].get<double>();
+    if (k == chosen) EXPECT_EQ(cow_auto["level"], level);
+    packs[k] = dir_ + "/cow" + std::to_string(k) + ".gip";
+    ASSERT_EQ(geomip("convert -q '" + cow + "' --patches " + std::to_string(k) + " --level " +
+                     std::to_string(level) + " --no-normals -o '" + packs[k] + "'")
+                  .exit_code,
+              0);
+    EXPECT_EQ(slurp(packs[k]).size(), layout["geometry_bytes"].get<std::size_t>());
+    // Each layout's prefixes measured independently (decode and eval's default measure, ten times the
+    // choice's samples): the layout kept is the better one.
+    double sum = 0;
+    for (std::size_t n : sizes) {
+      const std::string obj = dir_ + "/cow-prefix.obj";
+      ASSERT_EQ(geomip("decode -q --no-untangle '" + packs[k] + "' --bytes " + std::to_string(n) + " -o '" +
+                       obj + "'")
+                    .exit_code,
+                0);
+      const Outcome e = geomip("eval --json '" + cow + "' '" + obj + "'");
+      ASSERT_EQ(e.exit_code, 0) << e.err;
+      sum += nlohmann::json::parse(e.out)["psnr_db"].get<double>();
+    }
+    measured_mean[k] = sum / static_cast<double>(sizes.size());
+    // The choice's measure has no vertex samples: 0.1–0.3 dB above eval's on such coarse grids.
+    EXPECT_NEAR(measured_mean[k], reported_mean[k], 0.5) << k;
+  }
+  const int other = chosen == 16 ? 64 : 16;
+  EXPECT_GT(reported_mean[chosen], reported_mean[other]);
+  EXPECT_GT(measured_mean[chosen], measured_mean[other]);
+  EXPECT_EQ(slurp(dir_ + "/cow-auto.gip"), slurp(packs[chosen]));
+  // With normal maps the layouts are scored on the same geometry-only packs (encoded again from the
+  // conversion's images), so the choice is the same, and the pack is that of asking for the layout.
+  const Outcome with_normals = geomip("convert --json '" + cow + "' --level 4 -o '" + dir_ + "/cow-n.gip'");
+  ASSERT_EQ(with_normals.exit_code, 0) << with_normals.err;
+  const nlohmann::json jn = nlohmann::json::parse(with_normals.out);
+  EXPECT_TRUE(jn["normals"].get<bool>());
+  EXPECT_EQ(jn["layout_choice"]["layouts"], choice["layouts"]);
+  ASSERT_EQ(geomip("convert -q '" + cow + "' --patches " + std::to_string(chosen) + " --level " +
+                   std::to_string(cow_auto["level"].get<int>()) + " -o '" + dir_ + "/cow-n-named.gip'")
                 .exit_code,
             0);
-  EXPECT_EQ(slurp(dir_ + "/cow-auto.gip"), slurp(dir_ + "/cow16.gip"));
+  EXPECT_EQ(slurp(dir_ + "/cow-n.gip"), slurp(dir_ + "/cow-n-named.gip"));
   // --patches 2 keeps the two squares (and the note says more patches may code it better).
   const nlohmann::json cow_two = convert_json(cow, "--patches 2", dir_ + "/cow2.gip");
   EXPECT_EQ(cow_two["patches"], 2);
@@ -1504,11 +1553,15 @@ TEST_F(CliPack, ConvertMovesAStretchedShapeTo16PatchesUnlessTold) {
   EXPECT_LT(spot["two_squares_l2_stretch"].get<double>(), 1.5);
   EXPECT_EQ(spot["patches"], 2);
   EXPECT_FALSE(spot["moved_to_patches"].get<bool>());
+  EXPECT_TRUE(spot["layout_choice"].is_null());
   EXPECT_TRUE(convert_json(spot_, "--patches 6", dir_ + "/spot6.gip")["two_squares_l2_stretch"].is_null());
   // What the report says.
   Outcome r = geomip("convert '" + cow + "' --level 4 --no-normals -o '" + dir_ + "/cow.gip'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find(moved), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("layout: " + std::to_string(chosen) + " patches at level "), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find(", kept"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find(note), std::string::npos) << r.out;
   r = geomip("convert '" + cow + "' --patches 2 --level 4 --no-normals -o '" + dir_ + "/cow.gip'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -1525,8 +1578,8 @@ TEST_F(CliPack, ConvertMovesAStretchedShapeTo16PatchesUnlessTold) {
 
 // A long box (10 × 1 × 1) of `segments` square rings: two squares stretch it, so convert tries 16 patches.
 // With 2 segments (12 vertices) no 16-patch layout fits: the two squares are kept (exit 0, the note), as
-// before the move existed. With 20, convert and rd --level 3 both move it (to level 2) and agree byte for
-// byte.
+// before the move existed. With 20, convert and rd --level 3 both move it (16 patches at level 2 or 64 at
+// level 1) and agree byte for byte.
 TEST_F(CliPack, AStretchedShapeThatCannotMoveKeepsItsTwoSquares) {
   const auto box = [&](int segments) {
     std::ostringstream obj;
@@ -1567,7 +1620,7 @@ TEST_F(CliPack, AStretchedShapeThatCannotMoveKeepsItsTwoSquares) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   j = nlohmann::json::parse(r.out);
   ASSERT_TRUE(j["moved_to_patches"].get<bool>());
-  EXPECT_EQ(j["level"], 2);
+  EXPECT_EQ(j["level"], j["patches"] == 16 ? 2 : 1) << j["layout_choice"];
   r = geomip("rd -q --quick --level 3 '" + long_box + "' -o '" + dir_ + "/rd'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(slurp(dir_ + "/rd/box20.gip"), slurp(dir_ + "/long.gip"));

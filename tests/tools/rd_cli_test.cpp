@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <filesystem>
@@ -140,14 +141,20 @@ TEST_F(RdCli, LoopFlagsMeasureThatLoopsPack) {
   }
 }
 
-// Without --patches, rd measures the pack `convert` would write: the cow, which two squares stretch, on 16
-// patches one level coarser (byte for byte convert's pack), and says so; --patches 2 keeps the two squares.
+// Without --patches, rd measures the pack `convert` would write: the cow, which two squares stretch, on the
+// layout convert chooses (16 or 64 patches; byte for byte convert's pack), and says so; --patches 2 keeps
+// the two squares.
 TEST_F(RdCli, StretchedShapeIsMeasuredOnConvertsLayout) {
   GEOMIP_REQUIRE_SHARED_MESH(cow, "cow.obj");
   std::string err;
+  ASSERT_EQ(geomip("convert --json --no-normals --level 4 '" + cow + "' -o '" + dir_ + "/c.gip'", err), 0)
+      << err;
+  const nlohmann::json c = nlohmann::json::parse(slurp(fs::path(dir_) / "stdout"));
+  ASSERT_TRUE(c["moved_to_patches"].get<bool>());
   ASSERT_EQ(geomip("rd --quick --level 4 '" + cow + "' -o '" + dir_ + "/rd'", err), 0) << err;
-  EXPECT_NE(slurp(fs::path(dir_) / "stdout").find("geomip pack: 16 patches at level 3"), std::string::npos);
-  ASSERT_EQ(geomip("convert -q --no-normals --level 4 '" + cow + "' -o '" + dir_ + "/c.gip'", err), 0) << err;
+  const std::string said = "geomip pack: " + std::to_string(c["patches"].get<int>()) + " patches at level " +
+                           std::to_string(c["level"].get<int>());
+  EXPECT_NE(slurp(fs::path(dir_) / "stdout").find(said), std::string::npos) << said;
   EXPECT_EQ(slurp(fs::path(dir_) / "rd" / "cow.gip"), slurp(fs::path(dir_) / "c.gip"));
   ASSERT_EQ(geomip("rd --quick --json --level 4 --patches 2 '" + cow + "' -o '" + dir_ + "/rd2'", err), 0)
       << err;

@@ -154,6 +154,16 @@ void print_pack(const nlohmann::json& j) {
 }
 
 int run_info(const InfoArgs& args) {
+  // Checked before any output: a pack holds coefficients, not triangles, and which triangles cross depends
+  // on how it is decoded (prefix, level, untangling).
+  if (args.self_intersections) {
+    for (const auto& path : args.meshes) {
+      if (is_pack(path))
+        throw InvalidInput("--self-intersections counts the triangles of a mesh, and " + path +
+                           " is a pack: decode it first (geomip decode PACK -o MESH.obj, then geomip info "
+                           "--self-intersections MESH.obj)");
+    }
+  }
   nlohmann::json all = nlohmann::json::array();
   for (const auto& path : args.meshes) {
     if (is_pack(path)) {
@@ -208,7 +218,7 @@ CommandRunner add_info_command(CLI::App& app) {
       "--self-intersections", args->self_intersections,
       "Also count the triangles that cross other triangles of the mesh (CGAL, exact predicates; "
       "seconds on a million faces); JSON: self_intersections {pairs, faces}, null where the mesh is "
-      "not manifold and oriented");
+      "not manifold and oriented. Meshes only: a pack is refused (decode it first)");
   return [args] { return run_info(*args); };
 }
 

@@ -155,6 +155,16 @@ TEST_F(Cli, InfoCountsSelfIntersections) {
   r = geomip("info --json --self-intersections '" + pinch + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(nlohmann::json::parse(r.out)["self_intersections"].is_null()) << r.out;
+  // A pack has no triangles until decoded: refused with the way to count them, before any output (it used to
+  // print the pack's report as if the flag were not there).
+  const std::string pack = dir_ + "/spot3.gip";
+  ASSERT_EQ(geomip("convert -q '" + mesh + "' --level 3 --no-normals -o '" + pack + "'").exit_code, 0);
+  ASSERT_EQ(geomip("info '" + pack + "'").exit_code, 0);
+  expect_bad_input("info --self-intersections '" + mesh + "' '" + pack + "'", pack);
+  r = geomip("info --json --self-intersections '" + mesh + "' '" + pack + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_NE(r.err.find("geomip decode"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, BadInputsExitTwoWithOneLine) {

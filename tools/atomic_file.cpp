@@ -15,6 +15,20 @@
 
 namespace geomip::tools {
 
+namespace {
+
+/// An existing target that is neither a regular file nor a directory (a device such as /dev/null or
+/// /dev/full, a named pipe): renaming a temporary file over it would replace the device node (as root) or
+/// the pipe, so it is written in place.
+bool writes_in_place(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  return !ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
+}
+
+}  // namespace
+
 void check_output_file(const std::string& path) {
   namespace fs = std::filesystem;
   if (path.empty()) throw InvalidInput("-o: the output path is empty");
@@ -22,6 +36,10 @@ void check_output_file(const std::string& path) {
   if (dir.empty()) dir = ".";
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw InvalidInput(path + ": is a directory, not a file to write");
+  if (writes_in_place(path)) {  // a device or a pipe: written through, its directory is not touched
+    if (::access(path.c_str(), W_OK) != 0) throw InvalidInput(path + ": is not writable");
+    return;
+  }
   if (!fs::is_directory(dir, ec)) {  // the user's path, not a failure of the machine: exit 2
     throw InvalidInput(path + ": output directory '" + dir.string() + "' " +
                        (fs::exists(dir, ec) ? "is not a directory" : "does not exist"));
@@ -68,6 +86,16 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   namespace fs = std::filesystem;
   const fs::path target(path);
   check_output_file(path);
+  if (writes_in_place(path)) {
+    std::ofstream out(path, std::ios::binary);
+    if (!out) throw IoError(path + ": cannot open: " + std::strerror(errno));
+    write(out);
+    out.flush();
+    if (!out) throw IoError(path + ": write failed (" + std::strerror(errno) + ")");
+    out.close();
+    if (out.fail()) throw IoError(path + ": closing failed");
+    return;
+  }
   const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
   std::error_code ec;
   std::string tmp_name = ".";

@@ -11,7 +11,9 @@ namespace geomip::tools {
 
 /// Calls `write` with a stream to a temporary file in the target's directory; on success flushes, closes and
 /// renames it to `path`. If `write` throws or the stream fails, the temporary file is removed and the
-/// exception (or an IoError) propagates; `path` is untouched.
+/// exception (or an IoError) propagates; `path` is untouched. An existing `path` that is neither a regular
+/// file nor a directory (/dev/null, /dev/full, a named pipe) is written in place instead (a rename would
+/// replace the device node or the pipe); a failed write there is an IoError.
 /// \throw IoError when the directory is not writable or the disk is full.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
@@ -21,7 +23,8 @@ void write_file_atomically(const std::string& path, const std::function<void(std
 void check_pack_output_name(const std::string& path);
 
 /// Checks, before any work, that `path` can be written: not empty, not an existing directory, its directory
-/// exists, is a directory and is writable. \throw InvalidInput naming what is in the way.
+/// exists, is a directory and is writable (an existing device or pipe: writable itself). \throw InvalidInput
+/// naming what is in the way.
 void check_output_file(const std::string& path);
 
 /// Checks, before any work, that the output `path` is none of `inputs` (the same file under any name): an

@@ -198,51 +198,58 @@ int run_convert(const ConvertArgs& args) {
     // that keeps about the two squares' samples, unless the level-dependent options do not fit there.
     const bool may_move = !args.common.patches_given && args.common.points.empty() &&
                           args.common.meshes.size() == 1 && loop_asked == LoopKind::kPlain;
-    const auto level_for = [&](int patches) {
-      if (!may_move) return 0;
+    const auto level_for = [&](int patches, std::string& why_not) {
+      if (!may_move) return -1;
       const int l = relayout_level(level, patches);
+      if (l < 1) {
+        why_not = "its level would be below 1 (--level " + std::to_string(level) + ")";
+        return 0;
+      }
       try {
-        if (l > 0) check_level_options(args, l);
-      } catch (const InvalidInput&) {
+        check_level_options(args, l);
+      } catch (const InvalidInput& e) {
+        why_not = std::string("at level ") + std::to_string(l) + ": " + e.what();
         return 0;
       }
       return l;
     };
-    bool announced = false;
     converted = convert_relayout_when_stretched(
         models, options, level_for,
         [&](int patches) {
           return prepare_models(args.common.meshes, "", "geomip convert", true, patches, LoopKind::kPlain,
                                 args.common.equal_area_layout);
         },
-        [&](double stretch) {
+        [&](double stretch, const std::vector<int>& layouts) {
           bar.finish();
-          announced = true;
-          if (report)
-            std::printf(
-                "layout: the two squares stretch this shape (L2 stretch %.2f; 1 is none): converting it "
-                "again on 16 and 64 patches and keeping the one whose prefixes measure closer to the mesh "
-                "(--patches 2 keeps the two squares)\n",
-                stretch);
+          if (!report) return;
+          std::string which;
+          for (std::size_t i = 0; i < layouts.size(); ++i)
+            which += (i == 0 ? "" : i + 1 == layouts.size() ? " and " : ", ") + std::to_string(layouts[i]);
+          std::printf(
+              "layout: the two squares stretch this shape (L2 stretch %.2f; 1 is none): converting it again "
+              "on %s patches%s (--patches 2 keeps the two squares)\n",
+              stretch, which.c_str(),
+              layouts.size() > 1 ? " and keeping the layout whose prefixes measure closer to the mesh" : "");
         },
         relayout_choice);
     relayouted = relayout_choice.chosen_patches > 0;
-    if (announced && report) {
+    if (!relayout_choice.candidates.empty() && report) {
       bar.finish();
       for (const RelayoutChoice::Candidate& c : relayout_choice.candidates) {
         if (!c.not_built.empty())
           std::printf("layout: %d patches: not built (%s)\n", c.patches, c.not_built.c_str());
-        else
+        else if (std::isfinite(c.mean_psnr_db))
           std::printf(
               "layout: %d patches at level %d: %.2f dB mean PSNR of the geometry prefixes (%zu B)%s\n",
               c.patches, c.level, c.mean_psnr_db, c.geometry_bytes,
               c.patches == relayout_choice.chosen_patches ? ", kept" : "");
+        else if (c.patches == relayout_choice.chosen_patches)
+          std::printf("layout: %d patches at level %d, kept (the only layout built)\n", c.patches, c.level);
       }
-      if (relayouted)
+      if (relayouted && !relayout_choice.sizes.empty())
         std::printf("layout: chosen in %.1f s (--patches 16 or --patches 64 skips the choice)\n",
                     relayout_choice.seconds);
-      // Every layout failed after the announcement (its parameterization): say what was written.
-      if (!relayouted) std::printf("layout: no such layout fits this mesh; keeping the two squares\n");
+      if (!relayouted) std::printf("layout: keeping the two squares\n");
     }
     level = options.level;
   }
@@ -318,7 +325,9 @@ int run_convert(const ConvertArgs& args) {
                 info.chunks.size(), level, args.no_normals ? ", geometry only" : ", with normal maps");
     std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
                 converted.resample_seconds, converted.encode_seconds);
-    if (!searching && !relayouted && converted.two_squares_l2_stretch >= kStretchedTwoSquares)
+    // The note points at more patches; not when convert tried them and none fits this mesh.
+    if (!searching && !relayouted && converted.two_squares_l2_stretch >= kStretchedTwoSquares &&
+        relayout_choice.candidates.empty())
       std::printf(
           "note: the two squares stretch this shape (L2 stretch %.2f; 1 is none): a layout of more "
           "patches may code it better (on the mean PSNR of the 1.5-32 KB prefixes, `--patches 16`: horse "

@@ -230,10 +230,15 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, bool 
         prepare_models({mesh_path}, "", "geomip rd", true, patches, loop, equal_area_layout);
     ConvertResult converted = convert_relayout_when_stretched(
         models, options,
-        [&](int k) {
+        [&](int k, std::string& why_not) {
+          if (!relayout) return -1;
           const int coarser = relayout_level(level, k);
           // The default framed steps are capped at the level; asked-for normal-mesh steps must fit.
-          return relayout && normal_mesh_steps <= coarser ? coarser : 0;
+          if (coarser < 1 || normal_mesh_steps > coarser) {
+            why_not = coarser < 1 ? "its level would be below 1" : "--normal-mesh is above its level";
+            return 0;
+          }
+          return coarser;
         },
         [&](int k) {
           return prepare_models({mesh_path}, "", "geomip rd", true, k, LoopKind::kPlain, equal_area_layout);
@@ -488,15 +493,24 @@ int run_rd(const RdArgs& args) {
     std::cout << "geomip pack: " << searched->chosen.name(args.level) << " (--search; mean PSNR of its "
               << searched->sizes.size() << " scored prefixes: " << scores << ")\n";
   }
-  if (moved.chosen_patches > 0) {
-    std::string scores;
-    for (const RelayoutChoice::Candidate& c : moved.candidates)
-      if (c.not_built.empty())
+  if (!moved.candidates.empty()) {
+    std::string scores, not_built;
+    for (const RelayoutChoice::Candidate& c : moved.candidates) {
+      if (!c.not_built.empty())
+        not_built +=
+            (not_built.empty() ? "" : "; ") + format("%d patches not built: ", c.patches) + c.not_built;
+      else if (std::isfinite(c.mean_psnr_db))
         scores += (scores.empty() ? "" : ", ") + format("%d patches %.2f dB", c.patches, c.mean_psnr_db);
-    std::cout << format(
-        "geomip pack: %d patches at level %d (the two squares stretch this shape: L2 stretch %.2f; the "
-        "layout whose prefixes measured closer: %s; --patches 2 keeps the two squares)\n",
-        moved.chosen_patches, moved.chosen_level, moved.two_squares_l2_stretch, scores.c_str());
+    }
+    const std::string why = scores.empty() ? not_built : "mean PSNR of the prefixes: " + scores;
+    if (moved.chosen_patches > 0)
+      std::cout << format(
+          "geomip pack: %d patches at level %d (the two squares stretch this shape: L2 stretch %.2f; %s; "
+          "--patches 2 keeps the two squares)\n",
+          moved.chosen_patches, moved.chosen_level, moved.two_squares_l2_stretch, why.c_str());
+    else
+      std::cout << format("geomip pack: two squares (they stretch this shape, L2 stretch %.2f, but %s)\n",
+                          moved.two_squares_l2_stretch, not_built.c_str());
   }
   std::cout << "(" << candidates << " decimate-then-Draco points, the envelopes' candidates, are in rd.csv)\n"
             << comparison_text

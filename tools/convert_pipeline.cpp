@@ -172,19 +172,27 @@ std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std
 SurfaceDistanceOptions relayout_distance_options() {
   SurfaceDistanceOptions o;
   o.face_samples = 100000;
-  o.sample_vertices = false;
   return o;
 }
 
-ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOptions& options,
-                                              const std::function<int(int patches)>& level_for,
-                                              const std::function<PreparedModels(int patches)>& prepare,
-                                              const std::function<void(double stretch)>& before_switch,
-                                              RelayoutChoice& choice) {
+ConvertResult convert_relayout_when_stretched(
+    PreparedModels& models, ConvertOptions& options, const RelayoutLevel& level_for,
+    const std::function<PreparedModels(int patches)>& prepare,
+    const std::function<void(double stretch, const std::vector<int>& layouts)>& before_switch,
+    RelayoutChoice& choice) {
   choice = {};
-  bool any = false;
-  for (int k : kStretchedShapeLayouts) any = any || level_for(k) >= 1;
-  if (!any || models.inputs.size() != 1) return convert_models(models, options);
+  std::vector<RelayoutChoice::Candidate> candidates;
+  std::vector<int> tried;
+  bool left_to_us = false;
+  for (int k : kStretchedShapeLayouts) {
+    RelayoutChoice::Candidate c;
+    c.patches = k;
+    c.level = level_for(k, c.not_built);
+    left_to_us = left_to_us || c.level >= 0;
+    if (c.level >= 1) tried.push_back(k);
+    candidates.push_back(c);
+  }
+  if (!left_to_us || models.inputs.size() != 1) return convert_models(models, options);
   // The two squares' parameterization tells; the rest of their pipeline runs only when they stay.
   ConvertOptions probe = options;
   probe.stop_when_stretched = kStretchedTwoSquares;
@@ -204,40 +212,32 @@ ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOpt
   };
   std::vector<Built> built;
   std::vector<std::size_t> built_candidate;  // index into choice.candidates
-  bool announced = false;
-  for (int k : kStretchedShapeLayouts) {
-    RelayoutChoice::Candidate c;
-    c.patches = k;
-    c.level = level_for(k);
-    if (c.level < 1) {
-      c.not_built = "its level does not fit the options";
-      choice.candidates.push_back(c);
-      continue;
-    }
-    try {
-      Built b{prepare(k), options, {}, {}};
-      if (!announced && before_switch) before_switch(stretch);
-      announced = true;
-      b.options.level = c.level;
-      b.options.keep_inputs = true;  // the geometry-only pack is encoded again from them
-      b.result = convert_models(b.models, b.options);
-      if (options.normals) {
-        ConvertOptions geometry = b.options;
-        geometry.normals = false;
-        b.geometry_pack = codec::write_pack(
-            b.result.inputs, pack_write_options(geometry, b.result.inputs.front().geometry.size()));
-      } else {
-        b.geometry_pack = b.result.pack;
+  if (!tried.empty() && before_switch) before_switch(stretch, tried);
+  for (RelayoutChoice::Candidate& c : candidates) {
+    if (c.level >= 1) {
+      try {
+        Built b{prepare(c.patches), options, {}, {}};
+        b.options.level = c.level;
+        b.options.keep_inputs = true;  // the geometry-only pack is encoded again from them
+        b.result = convert_models(b.models, b.options);
+        if (options.normals) {
+          ConvertOptions geometry = b.options;
+          geometry.normals = false;
+          b.geometry_pack = codec::write_pack(
+              b.result.inputs, pack_write_options(geometry, b.result.inputs.front().geometry.size()));
+        } else {
+          b.geometry_pack = b.result.pack;
+        }
+        if (!options.keep_inputs) b.result.inputs.clear();
+        b.options.keep_inputs = options.keep_inputs;
+        c.geometry_bytes = b.geometry_pack.size();
+        built.push_back(std::move(b));
+        built_candidate.push_back(choice.candidates.size());
+      } catch (const InvalidInput& e) {  // no such layout fits this mesh (too few vertices, paths that fail)
+        c.not_built = e.what();
+      } catch (const SolverFailure& e) {
+        c.not_built = e.what();
       }
-      if (!options.keep_inputs) b.result.inputs.clear();
-      b.options.keep_inputs = options.keep_inputs;
-      c.geometry_bytes = b.geometry_pack.size();
-      built.push_back(std::move(b));
-      built_candidate.push_back(choice.candidates.size());
-    } catch (const InvalidInput& e) {  // no such layout fits this mesh (too few vertices, paths that fail)
-      c.not_built = e.what();
-    } catch (const SolverFailure& e) {
-      c.not_built = e.what();
     }
     choice.candidates.push_back(c);
   }
@@ -254,8 +254,9 @@ ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOpt
   for (std::size_t s : kStretchedChoiceSizes)
     if (s < largest) choice.sizes.push_back(s);
   if (choice.sizes.empty()) choice.sizes.push_back(largest);
+  if (built.size() == 1) choice.sizes.clear();  // nothing to choose between: not measured
   std::size_t best = built.size();
-  for (std::size_t i = 0; i < built.size(); ++i) {
+  for (std::size_t i = 0; i < built.size() && built.size() > 1; ++i) {
     if (options.progress)
       options.progress("measure layouts", static_cast<double>(i) / static_cast<double>(built.size()));
     RelayoutChoice::Candidate& c = choice.candidates[built_candidate[i]];
@@ -267,7 +268,8 @@ ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOpt
         (best == built.size() || c.mean_psnr_db > choice.candidates[built_candidate[best]].mean_psnr_db))
       best = i;
   }
-  if (best == built.size()) best = 0;  // no prefix decodes on any: the first layout, as before the choice
+  if (options.progress && built.size() > 1) options.progress("measure layouts", 1.0);
+  if (best == built.size()) best = 0;  // one layout, or no prefix decodes on any: the first
   choice.seconds = seconds_since(t_choice);
   Built& winner = built[best];
   choice.chosen_patches = choice.candidates[built_candidate[best]].patches;

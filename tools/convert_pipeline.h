@@ -155,9 +155,10 @@ int relayout_level(int level, int patches);
 std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
                                 const TriMesh& reference, const SurfaceDistanceOptions& distance = {});
 
-/// The choice convert_relayout_when_stretched() made, for reports: each layout tried, with the mean PSNR of
-/// its geometry prefixes at `sizes` (NaN: not built — no such layout fits the mesh, or its level does not
-/// fit the options — or a prefix decoded to nothing).
+/// The choice convert_relayout_when_stretched() made, for reports: each layout considered, with the mean
+/// PSNR of its geometry prefixes at `sizes` (NaN: not built — its level is below 1 or does not fit the
+/// options, or no such layout fits the mesh — or the only one built, which is not measured (`sizes`
+/// empty), or a prefix decoded to nothing).
 struct RelayoutChoice {
   double two_squares_l2_stretch = 0;  ///< 0: the two squares did not stretch the shape (nothing tried)
   std::vector<std::size_t> sizes;
@@ -175,9 +176,11 @@ struct RelayoutChoice {
   double seconds = 0;  ///< building and measuring the layouts (the two squares' parameterization not counted)
 };
 
-/// The distance measure of that choice: 100,000 area-uniform samples per surface, no vertex samples (a
-/// tenth of `geomip eval`'s default on a decoded level-7 grid; the same choice on the meshes measured, where
-/// the layouts' means differ by 0.9–2 dB, and the measure's spread over seeds is about ±0.05 dB).
+/// The distance measure of that choice: 100,000 area-uniform samples per surface and every vertex, as
+/// `geomip eval --samples 100000` measures (eval's default takes 10 per face, up to 1.3 M samples on a
+/// decoded level-7 grid). Its means sit 0.2–0.6 dB off the default's, but the difference between the two
+/// layouts is within 0.1 dB of the default's on the horse, the cow and the armadillo (without vertex samples
+/// up to 0.31 dB off: docs/measurements.md, "16 or 64 patches, measured by convert").
 SurfaceDistanceOptions relayout_distance_options();
 
 /// The mesh the viewer's frame (ConvertOptions::up, front) is guessed from: the first model as read when it
@@ -205,20 +208,26 @@ void check_quantization_switches(int bits, int normal_bits, bool normal_bits_giv
 /// images come from resample_geometry()).
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options);
 
+/// The level a layout of `patches` patches would get; 0 with `why_not` saying why that layout is not tried;
+/// −1 when the user chose the layout (no choice at all).
+using RelayoutLevel = std::function<int(int patches, std::string& why_not)>;
+
 /// convert_models(models, options), except that one mesh whose two squares have an L2 stretch of at least
 /// kStretchedTwoSquares is, right after that parameterization, converted again on each layout of
-/// kStretchedShapeLayouts whose `level_for(patches)` is ≥ 1 (`prepare(patches)` prepares it; `before_switch(
-/// stretch)` is called once before the first), and the one whose geometry-only prefixes at
-/// kStretchedChoiceSizes (those below the larger pack; its whole pack where smaller) have the higher mean
-/// PSNR against the mesh (relayout_distance_options()) is returned; `models` and `options.level` then
-/// describe it. Its pack is byte for byte that of convert_models() on its layout and level (the choice is
-/// deterministic). When no layout can be built (InvalidInput, SolverFailure) the two squares are converted
-/// after all. `choice` reports what was tried (chosen_patches 0: the two squares). The callers pass a
-/// `level_for` that returns 0 when the user chose the layout (--patches, --points, a loop).
-ConvertResult convert_relayout_when_stretched(PreparedModels& models, ConvertOptions& options,
-                                              const std::function<int(int patches)>& level_for,
-                                              const std::function<PreparedModels(int patches)>& prepare,
-                                              const std::function<void(double stretch)>& before_switch,
-                                              RelayoutChoice& choice);
+/// kStretchedShapeLayouts whose `level_for` is ≥ 1 (`prepare(patches)` prepares it; `before_switch(stretch,
+/// layouts)` is called once before the first, with the patch counts to be tried). When more than one layout
+/// is built, the one whose geometry-only prefixes at kStretchedChoiceSizes (those below the larger pack; its
+/// whole pack where smaller) have the higher mean PSNR against the mesh (relayout_distance_options()) is
+/// returned; a single built layout is returned unmeasured. `models` and `options.level` then describe it,
+/// and its pack is byte for byte that of convert_models() on its layout and level (the choice is
+/// deterministic). When no layout can be built (InvalidInput, SolverFailure) or none is tried, the two
+/// squares are converted after all. `choice` reports what was tried (chosen_patches 0: the two squares).
+/// The callers give a `level_for` that returns −1 when the user chose the layout (--patches, --points, a
+/// loop).
+ConvertResult convert_relayout_when_stretched(
+    PreparedModels& models, ConvertOptions& options, const RelayoutLevel& level_for,
+    const std::function<PreparedModels(int patches)>& prepare,
+    const std::function<void(double stretch, const std::vector<int>& layouts)>& before_switch,
+    RelayoutChoice& choice);
 
 }  // namespace geomip::tools

@@ -213,13 +213,25 @@ ConvertResult convert_relayout_when_stretched(
   std::vector<Built> built;
   std::vector<std::size_t> built_candidate;  // index into choice.candidates
   if (!tried.empty() && before_switch) before_switch(stretch, tried);
+  std::size_t attempt = 0;  // layouts started, for the progress bar
   for (RelayoutChoice::Candidate& c : candidates) {
     if (c.level >= 1) {
       try {
         Built b{prepare(c.patches), options, {}, {}};
         b.options.level = c.level;
         b.options.keep_inputs = true;  // the geometry-only pack is encoded again from them
+        if (options.progress) {
+          // One bar over all layouts: layout i of n fills 0.9·[i/n, (i+1)/n), its stages named after it; the
+          // measurements the last tenth.
+          const double n = static_cast<double>(tried.size()), i = static_cast<double>(attempt);
+          const std::string prefix = std::to_string(c.patches) + " patches: ";
+          b.options.progress = [&options, prefix, n, i](const char* stage, double f) {
+            options.progress((prefix + stage).c_str(), 0.9 * (i + f) / n);
+          };
+        }
+        ++attempt;
         b.result = convert_models(b.models, b.options);
+        b.options.progress = options.progress;
         if (options.normals) {
           ConvertOptions geometry = b.options;
           geometry.normals = false;
@@ -258,7 +270,8 @@ ConvertResult convert_relayout_when_stretched(
   std::size_t best = built.size();
   for (std::size_t i = 0; i < built.size() && built.size() > 1; ++i) {
     if (options.progress)
-      options.progress("measure layouts", static_cast<double>(i) / static_cast<double>(built.size()));
+      options.progress("measure layouts",
+                       0.9 + 0.1 * static_cast<double>(i) / static_cast<double>(built.size()));
     RelayoutChoice::Candidate& c = choice.candidates[built_candidate[i]];
     c.psnr_db = prefix_psnr(built[i].geometry_pack, choice.sizes, reference, relayout_distance_options());
     double sum = 0;

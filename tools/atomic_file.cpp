@@ -4,6 +4,7 @@
 #include "mesh/errors.h"
 #include "mesh/mesh_io.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -47,6 +48,17 @@ void check_output_file(const std::string& path) {
   // Found now, not after minutes of work when the temporary file cannot be created.
   if (::access(dir.c_str(), W_OK) != 0)
     throw InvalidInput(path + ": output directory '" + dir.string() + "' is not writable");
+  // Some directories pass that check and still take no files (/proc, a read-only mount seen by root): try.
+  const fs::path probe = dir / (".geomip-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0) {
+    const int error = errno;
+    if (error != EEXIST)
+      throw InvalidInput(path + ": cannot create files in '" + dir.string() + "': " + std::strerror(error));
+    return;  // a probe of this process already there: the directory takes files
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 void check_output_is_not_an_input(const std::string& path, const std::vector<std::string>& inputs) {

@@ -23,7 +23,8 @@ void write_file_atomically(const std::string& path, const std::function<void(std
 void check_pack_output_name(const std::string& path);
 
 /// Checks, before any work, that `path` can be written: not empty, not an existing directory, its directory
-/// exists, is a directory and is writable (an existing device or pipe: writable itself). \throw InvalidInput
+/// exists, is a directory, is writable and takes a file (a probe file is created and removed: /proc passes
+/// the permission check and takes none); an existing device or pipe: writable itself. \throw InvalidInput
 /// naming what is in the way.
 void check_output_file(const std::string& path);
 

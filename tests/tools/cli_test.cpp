@@ -1860,6 +1860,11 @@ TEST_F(CliPack, OutputsOverInputsAndDirectoriesExitTwoBeforeAnyWork) {
   EXPECT_EQ(slurp(exr), exr_bytes);
   fs::create_directories(dir_ + "/adir.gip");
   expect_bad_input("convert -q '" + spot_ + "' --level 3 -o '" + dir_ + "/adir.gip'", dir_ + "/adir.gip");
+  // A directory that takes no files although its permissions say so (/proc for root): found before the
+  // work, not when the temporary file could not be created at the end (exit 1).
+  if (fs::is_directory("/proc"))
+    expect_bad_input("convert -q '" + spot_ + "' --level 3 -o /proc/geomip-test.gip",
+                     "/proc/geomip-test.gip");
   const std::string pack = dir_ + "/spot.gip";
   ASSERT_EQ(geomip("encode -q '" + dir_ + "/gi' -o '" + pack + "'").exit_code, 0);
   expect_bad_input("decode -q '" + pack + "' -o '" + pack + "/x.obj'",

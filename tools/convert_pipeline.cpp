@@ -153,19 +153,25 @@ int relayout_level(int level, int patches) {
 }
 
 std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
-                                const TriMesh& reference, const SurfaceDistanceOptions& distance) {
+                                const TriMesh& reference, const SurfaceDistanceOptions& distance,
+                                bool sizes_in_parallel) {
   std::vector<double> out(sizes.size(), NAN);
-  codec::parallel_for(static_cast<int>(sizes.size()), 0, [&](int i) {
+  const auto measure = [&](int i, unsigned threads) {
     codec::PackDecodeOptions decode;
     decode.max_bytes = sizes[i];
     decode.normals = false;
-    decode.max_threads = 1;
+    decode.max_threads = static_cast<int>(threads);
     const codec::PackDecodeResult result = codec::decode_pack(pack, decode);
     if (result.models.empty()) return;
-    SurfaceDistanceOptions one = distance;
-    one.threads = 1;
-    out[i] = measure_surface_distance(reference, decoded_mesh(result.models.front()), one).psnr_db;
-  });
+    SurfaceDistanceOptions o = distance;
+    o.threads = threads;
+    out[i] = measure_surface_distance(reference, decoded_mesh(result.models.front()), o).psnr_db;
+  };
+  if (sizes_in_parallel) {
+    codec::parallel_for(static_cast<int>(sizes.size()), 0, [&](int i) { measure(i, 1); });
+  } else {
+    for (int i = 0; i < static_cast<int>(sizes.size()); ++i) measure(i, 0);
+  }
   return out;
 }
 
@@ -273,7 +279,9 @@ ConvertResult convert_relayout_when_stretched(
       options.progress("measure layouts",
                        0.9 + 0.1 * static_cast<double>(i) / static_cast<double>(built.size()));
     RelayoutChoice::Candidate& c = choice.candidates[built_candidate[i]];
-    c.psnr_db = prefix_psnr(built[i].geometry_pack, choice.sizes, reference, relayout_distance_options());
+    // One prefix at a time on every thread: one set of search trees in memory instead of one per thread.
+    c.psnr_db =
+        prefix_psnr(built[i].geometry_pack, choice.sizes, reference, relayout_distance_options(), false);
     double sum = 0;
     for (double p : c.psnr_db) sum += p;  // NaN stays NaN: not eligible
     c.mean_psnr_db = sum / static_cast<double>(c.psnr_db.size());

@@ -150,10 +150,12 @@ int relayout_level(int level, int patches);
 
 /// PSNR of the geometry of `pack` decoded from each prefix in `sizes` against `reference` (the symmetric
 /// RMS surface distance of `geomip eval`, measured with `distance`; the decoded grids as decoded, no
-/// untangling, as `geomip rd` measures); NaN where a prefix decodes to no model. One size per thread; the
-/// result does not depend on the thread count.
+/// untangling, as `geomip rd` measures); NaN where a prefix decodes to no model. `sizes_in_parallel`: one
+/// size per thread; else one size at a time on every thread (less memory: one decoded mesh and its search
+/// trees at a time). The result depends on neither.
 std::vector<double> prefix_psnr(const std::vector<std::uint8_t>& pack, const std::vector<std::size_t>& sizes,
-                                const TriMesh& reference, const SurfaceDistanceOptions& distance = {});
+                                const TriMesh& reference, const SurfaceDistanceOptions& distance = {},
+                                bool sizes_in_parallel = true);
 
 /// The choice convert_relayout_when_stretched() made, for reports: each layout considered, with the mean
 /// PSNR of its geometry prefixes at `sizes` (NaN: not built — its level is below 1 or does not fit the

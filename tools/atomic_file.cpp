@@ -98,14 +98,18 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   namespace fs = std::filesystem;
   const fs::path target(path);
   check_output_file(path);
-  if (writes_in_place(path)) {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw IoError(path + ": cannot open: " + std::strerror(errno));
+  // Opens `file`, writes, flushes and closes it; an IoError naming `path` on any failure.
+  const auto write_to = [&](const fs::path& file) {
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError(path + ": cannot create '" + file.string() + "': " + std::strerror(errno));
     write(out);
     out.flush();
     if (!out) throw IoError(path + ": write failed (" + std::strerror(errno) + ")");
     out.close();
-    if (out.fail()) throw IoError(path + ": closing failed");
+    if (out.fail()) throw IoError(path + ": closing the file failed");
+  };
+  if (writes_in_place(path)) {
+    write_to(target);
     return;
   }
   const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
@@ -116,13 +120,7 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   tmp_name += std::to_string(::getpid());
   const fs::path tmp = dir / tmp_name;
   try {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw IoError(path + ": cannot create '" + tmp.string() + "': " + std::strerror(errno));
-    write(out);
-    out.flush();
-    if (!out) throw IoError(path + ": write failed (disk full?)");
-    out.close();
-    if (out.fail()) throw IoError(path + ": closing the file failed");
+    write_to(tmp);
     fs::rename(tmp, target, ec);
     if (ec) throw IoError(path + ": cannot rename the temporary file into place: " + ec.message());
   } catch (...) {

@@ -60,8 +60,7 @@ struct RdArgs {
   bool no_geomip = false;   // only the baselines
   int normal_mesh_steps = -1;  // geomip: normal-mesh resampling steps (-1 = the convert default, 0 = off)
   int patches = 2;          // geomip: patches of the automatic layout (--patches)
-  bool patches_given =
-      false;  // --patches on the command line (else a stretched shape moves to 16 or 64 patches)
+  bool patches_given = false;      // --patches given (else a stretched shape moves to 16 or 64 patches)
   bool equal_area_layout = false;  // geomip: --equal-area-layout
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
   bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)

@@ -123,6 +123,16 @@ class ByteReader {
     pos_ += n;
     return true;
   }
+  /// The bytes not read yet (empty once failed).
+  std::span<const std::uint8_t> rest() const {
+    return failed_ ? bytes_.subspan(bytes_.size()) : bytes_.subspan(pos_);
+  }
+  /// Skips `n` bytes; false (and failed) when fewer are left.
+  bool skip(std::size_t n) {
+    if (failed_ || n > remaining()) return fail();
+    pos_ += n;
+    return true;
+  }
   std::size_t remaining() const { return bytes_.size() - pos_; }
   std::size_t position() const { return pos_; }
   bool failed() const { return failed_; }

@@ -6,12 +6,14 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <tuple>
 
 #include "codec/arithmetic_coder.h"
 #include "codec/byte_io.h"
+#include "codec/layout_code.h"
 
 namespace geomip::codec {
 namespace {
@@ -145,8 +147,10 @@ bool read_normalization(ByteReader& r, std::array<double, 16>& m, std::uint16_t 
 //          stored once per pair, bit-packed LSB first: for each side in order whose partner is not known yet,
 //          the partner's patch minus this patch in bit_width(num_patches − 1 − patch) bits (the partner
 //          comes later, so the difference is ≥ 0), its side in 2 bits and `reversed` in 1; zero bits pad to
-//          a byte.
-enum SeamForm : std::uint8_t { kSeamsListed = 0, kSeamsAsBefore = 1, kSeamsMirrored = 2 };
+//          a byte;
+//   form 3 (kSeamsCode, version 9): a closed oriented genus-0 layout in canonical order, as the code of
+//          layout_code.h (a few bits per quad; its length follows from its steps).
+enum SeamForm : std::uint8_t { kSeamsListed = 0, kSeamsAsBefore = 1, kSeamsMirrored = 2, kSeamsCode = 3 };
 
 bool same_seams(const std::vector<PatchSeam>& a, const std::vector<PatchSeam>& b) {
   return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const PatchSeam& x, const PatchSeam& y) {
@@ -171,10 +175,16 @@ bool mirrored_seams(const std::vector<PatchSeam>& seams, int num_patches) {
   return true;
 }
 
-void write_seams(ByteWriter& w, const std::vector<PatchSeam>& seams, int num_patches,
+void write_seams(ByteWriter& w, const std::vector<PatchSeam>& seams, int num_patches, std::uint16_t version,
                  const std::vector<PatchSeam>* before) {
   if (before != nullptr && same_seams(seams, *before)) {
     w.u8(kSeamsAsBefore);
+    return;
+  }
+  if (const auto order = version >= 9 ? layout_order(seams, num_patches) : std::nullopt;
+      order && order->identity()) {
+    w.u8(kSeamsCode);
+    for (std::uint8_t b : order->code) w.u8(b);
     return;
   }
   if (!mirrored_seams(seams, num_patches)) {
@@ -212,10 +222,14 @@ void write_seams(ByteWriter& w, const std::vector<PatchSeam>& seams, int num_pat
 /// Reads what write_seams() wrote into `seams` (for a header of `num_patches` patches). Bounds: a table
 /// never holds more than 4 seams per patch, and a mirrored one is only allocated when the bytes left can
 /// hold it (3 bits per pair at least).
-bool read_seams(ByteReader& r, std::vector<PatchSeam>& seams, int num_patches,
+bool read_seams(ByteReader& r, std::vector<PatchSeam>& seams, int num_patches, std::uint16_t version,
                 const std::vector<PatchSeam>* before) {
   std::uint8_t form;
   if (!r.u8(form)) return false;
+  if (form == kSeamsCode) {
+    std::size_t used = 0;
+    return version >= 9 && read_layout_code(r.rest(), num_patches, seams, used) && r.skip(used);
+  }
   if (form == kSeamsAsBefore) {
     if (before == nullptr) return false;
     seams = *before;
@@ -280,7 +294,7 @@ void write_codec_header(ByteWriter& w, const GeometryCodecHeader& h, std::uint16
     GeometryCodecHeader without = h;
     without.seams.clear();
     write_codec_header(w, without, 6);
-    write_seams(w, h.seams, h.num_patches, seams_before);
+    write_seams(w, h.seams, h.num_patches, version, seams_before);
     return;
   }
   std::vector<std::uint8_t> bytes = h.serialize();
@@ -306,7 +320,7 @@ bool read_codec_header(ByteReader& r, GeometryCodecHeader& h, std::uint16_t vers
     // The header as version 6 stores it, with no seams, then the seam table; parse() checks the whole header
     // again (seam bounds included).
     if (!read_codec_header(r, h, 6) || !h.seams.empty() ||
-        !read_seams(r, h.seams, h.num_patches, seams_before))
+        !read_seams(r, h.seams, h.num_patches, version, seams_before))
       return false;
     GeometryCodecHeader checked;
     return GeometryCodecHeader::parse(h.serialize(), checked) == Status::kOk;
@@ -712,8 +726,52 @@ Status read_pack_info(std::span<const std::uint8_t> bytes, PackInfo& out) {
   return s;
 }
 
+namespace {
+
+/// The models with their patches in the canonical order of their (shared) layout, or nullopt when they are
+/// in it already, have no such layout, or differ in it (PackWriteOptions::canonical_layout).
+std::optional<std::vector<PackModelInput>> canonical_models(const std::vector<PackModelInput>& models) {
+  if (models.empty()) return std::nullopt;
+  const std::vector<PatchSeam>& seams = models.front().seams;
+  const std::size_t patches = models.front().geometry.size();
+  for (const PackModelInput& m : models) {
+    if (m.geometry.size() != patches || !same_seams(m.seams, seams) ||
+        (!m.normals.empty() && m.normals.size() != patches) ||
+        (!m.hole_mask.empty() && m.hole_mask.size() != patches))
+      return std::nullopt;
+  }
+  if (patches > static_cast<std::size_t>(std::numeric_limits<int>::max() / 4)) return std::nullopt;
+  const auto order = layout_order(seams, static_cast<int>(patches));
+  if (!order || order->identity()) return std::nullopt;
+  std::vector<PatchSeam> canonical;
+  std::size_t used = 0;
+  if (!read_layout_code(order->code, static_cast<int>(patches), canonical, used))
+    throw std::logic_error("write_pack: a layout code that does not read back");
+  std::vector<PackModelInput> out = models;
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    out[m].seams = canonical;
+    for (std::size_t c = 0; c < patches; ++c) {
+      const auto p = static_cast<std::size_t>(order->patch[c]);
+      const int turn = order->rotation[c];
+      out[m].geometry[c] = rotate_grid(models[m].geometry[p], turn);
+      if (!models[m].normals.empty()) out[m].normals[c] = rotate_grid(models[m].normals[p], turn);
+      if (!models[m].hole_mask.empty()) out[m].hole_mask[c] = rotate_quad_mask(models[m].hole_mask[p], turn);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
                                      const PackWriteOptions& options) {
+  if (options.canonical_layout) {
+    if (auto canonical = canonical_models(models)) {
+      PackWriteOptions plain = options;
+      plain.canonical_layout = false;
+      return write_pack(*canonical, plain);
+    }
+  }
   if (models.empty()) throw std::invalid_argument("write_pack: no models");
   if (models.size() > kMaxModels) throw std::invalid_argument("write_pack: more than 64 models");
   if (options.normals_delay < 0 || options.normals_delay > static_cast<int>(kMaxPasses))

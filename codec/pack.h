@@ -47,23 +47,25 @@ namespace geomip::codec {
 /// this many bytes of a pack (or all of a shorter source) can always read the fixed header, and the
 /// manifest always ends at or after it.
 inline constexpr std::size_t kPackHeaderSize = 20;
-/// Format version written. Version 8 (this one): version 7 with codec headers of version 6 too (cell frames:
-/// local frames from the coarse grid's normals and a table of octahedral cells; geometry_codec.cpp,
-/// docs/codec-v3.md "Cell frames"; the same container). Version 7: version 6 with compact seam tables — a
-/// codec header's seams follow it as "the same as the header before", one entry per side pair bit-packed
-/// (every layout's table), or the explicit list (pack.cpp, write_seams; docs/codec-v3.md "Seam tables"): the
-/// four animals with a 64-quad layout at level 8 show their first level of detail after 609 bytes instead of
-/// 3,554 (manifest 511 bytes instead of 3,456). Version 6: version 4's container, codec headers of versions 3
-/// to 5 (the encoder writes 5: the geometry's wavelet filter kCubicLong, docs/codec-v3.md "Longer lifting
-/// filters"). Version 5: the same container, codec headers of versions 3 and 4 (4: the wavelet's lifting
-/// update, docs/codec-v3.md "Lifting update"); each bump lets an older reader say "unsupported version"
-/// instead of failing on the codec header. Version 4: the header diet — CRC32 trailers per chunk group
-/// instead of a CRC per chunk in the up-front table, a varint manifest size, compact doubles and codec
-/// headers (above); codec headers of version 3. Version 3: codec header version 3 (local frames, orientation
-/// weights; docs/codec-v3.md). Version 2: bit-plane segments hold one stream per patch (codec header version
-/// 2), decoded in parallel. Version 1: one joint stream per segment. Versions 1–7 are still read. "Version 4"
-/// in the layout notes means versions 4 and later.
-inline constexpr std::uint16_t kPackVersion = 8;
+/// Format version written. Version 9 (this one): version 8 with a fourth form of seam table, the code of a
+/// closed genus-0 quad layout in canonical order (layout_code.h: about 4 bits per quad; the armadillo's
+/// 64-patch table 139 → 29 bytes; PackWriteOptions::canonical_layout puts a layout in that order). Version 8:
+/// version 7 with codec headers of version 6 too (cell frames: local frames from the coarse grid's normals
+/// and a table of octahedral cells; geometry_codec.cpp, docs/codec-v3.md "Cell frames"; the same container).
+/// Version 7: version 6 with compact seam tables — a codec header's seams follow it as "the same as the
+/// header before", one entry per side pair bit-packed (every layout's table), or the explicit list (pack.cpp,
+/// write_seams; docs/codec-v3.md "Seam tables"): the four animals with a 64-quad layout at level 8 show their
+/// first level of detail after 609 bytes instead of 3,554 (manifest 511 bytes instead of 3,456). Version 6:
+/// version 4's container, codec headers of versions 3 to 5 (the encoder writes 5: the geometry's wavelet
+/// filter kCubicLong, docs/codec-v3.md "Longer lifting filters"). Version 5: the same container, codec
+/// headers of versions 3 and 4 (4: the wavelet's lifting update, docs/codec-v3.md "Lifting update"); each
+/// bump lets an older reader say "unsupported version" instead of failing on the codec header. Version 4: the
+/// header diet — CRC32 trailers per chunk group instead of a CRC per chunk in the up-front table, a varint
+/// manifest size, compact doubles and codec headers (above); codec headers of version 3. Version 3: codec
+/// header version 3 (local frames, orientation weights; docs/codec-v3.md). Version 2: bit-plane segments hold
+/// one stream per patch (codec header version 2), decoded in parallel. Version 1: one joint stream per
+/// segment. Versions 1–8 are still read. "Version 4" in the layout notes means versions 4 and later.
+inline constexpr std::uint16_t kPackVersion = 9;
 inline constexpr std::uint16_t kOldestPackVersion = 1;
 
 enum class ChunkKind : std::uint8_t {
@@ -159,6 +161,12 @@ struct PackWriteOptions {
   /// models reach hole_mask_after_bytes.
   int coarse_hole_mask_levels = 2;
   std::size_t hole_mask_after_bytes = 4096;
+  /// Store the patches of a closed genus-0 quad layout in the canonical order of layout_code.h (patches
+  /// renumbered, grids, normal maps and hole masks turned so that side 0 is the side each patch is reached
+  /// by), whose seam table takes a few bits per quad; a decoder then returns the patches in that order. Every
+  /// model must have the same table (a consistent set); otherwise, or for other layouts, nothing moves.
+  /// `geomip convert` sets it (its layouts are its own); false keeps the caller's patch order and sides.
+  bool canonical_layout = false;
 };
 
 /// Encodes and lays out a pack in memory. Throws std::invalid_argument on bad input (models whose patch

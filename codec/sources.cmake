@@ -3,6 +3,7 @@ set(GEOMIP_CODEC_SOURCES
   arithmetic_coder.cpp
   bitplane_coder.cpp
   geometry_codec.cpp
+  layout_code.cpp
   normal_mesh.cpp
   pack.cpp
   status.cpp

@@ -114,6 +114,7 @@ std::size_t geometry_joint_bytes(std::size_t patches) {
 codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::size_t patches) {
   codec::PackWriteOptions write;
   write.geometry.joint_bytes = geometry_joint_bytes(patches);
+  write.canonical_layout = true;  // convert's layouts are its own: their seam tables take a few bits per quad
   write.normals = options.normals;
   write.geometry.quantization_bits = options.quantization_bits;
   write.normal_codec.quantization_bits = options.normal_bits;

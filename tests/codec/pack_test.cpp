@@ -2,6 +2,8 @@
 // pack.
 #include "codec/pack.h"
 
+#include "codec/layout_code.h"
+
 #include "tests/codec/pillow.h"
 
 #include <gtest/gtest.h>
@@ -188,17 +190,55 @@ TEST(Pack, OtherVersionIsUnsupported) {
 
 // Pack formats 6 and 7 hold codec headers of versions 3 to 5 only: a format-8 pack whose cell frames (codec
 // header 6) are relabelled format 7 is refused, the same pack with version 5's frames is a valid format 7.
+/// The pillow with its second patch turned by a side: the same surface, a table that is not in the canonical
+/// order of a layout code (so format 9 stores it as format 7 did, and relabelling the version stays valid).
+PackModelInput turned_pillow_model(int level, const std::string& name) {
+  PackModelInput m = pillow_model(level, name);
+  m.geometry[1] = rotate_grid(m.geometry[1], 1);  // new side s = old side s + 1
+  for (PatchSeam& s : m.seams) {
+    if (s.patch == 1) s.side = (s.side + 3) % 4;
+    if (s.other_patch == 1) s.other_side = (s.other_side + 3) % 4;
+  }
+  std::sort(m.seams.begin(), m.seams.end(), [](const PatchSeam& a, const PatchSeam& b) {
+    return std::pair(a.patch, a.side) < std::pair(b.patch, b.side);
+  });
+  return m;
+}
+
+TEST(Pack, LayoutCodesNeedFormat9) {
+  // The pillow's table is a layout code in canonical order already: format 9 stores it as one.
+  std::vector<std::uint8_t> pack = write_pack({pillow_model(4, "a")}, geometry_only());
+  ASSERT_EQ(kPackVersion, 9);
+  ASSERT_EQ(decode_pack(pack).status, Status::kOk);
+  std::vector<std::uint8_t> as8 = pack;
+  as8[8] = 8;  // the manifest's CRC does not cover the version
+  EXPECT_EQ(decode_pack(as8).status, Status::kCorrupt);
+  // The turned pillow's table is not: stored as format 7 did, it reads as format 8 too.
+  const PackModelInput turned = turned_pillow_model(4, "a");
+  ASSERT_EQ(test::seam_mismatches(turned.geometry, turned.seams), 0u);
+  std::vector<std::uint8_t> other = write_pack({turned}, geometry_only());
+  const PackDecodeResult as9 = decode_pack(other);
+  ASSERT_EQ(as9.status, Status::kOk);
+  other[8] = 8;
+  const PackDecodeResult relabelled = decode_pack(other);
+  ASSERT_EQ(relabelled.status, Status::kOk);
+  EXPECT_EQ(relabelled.models.at(0).geometry[1].values, as9.models.at(0).geometry[1].values);
+  // With canonical_layout the writer turns it back: the code again, and the pillow's own grids.
+  PackWriteOptions o = geometry_only();
+  o.canonical_layout = true;
+  EXPECT_EQ(write_pack({turned}, o), pack);
+}
+
 TEST(Pack, CellFramesNeedFormat8) {
   for (const bool cells : {true, false}) {
     PackWriteOptions o = geometry_only();
     o.geometry.cell_frames = cells;
-    std::vector<std::uint8_t> pack = write_pack({pillow_model(4, "a")}, o);
+    std::vector<std::uint8_t> pack = write_pack({turned_pillow_model(4, "a")}, o);
     PackInfo info;
     ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
     ASSERT_EQ(info.models.at(0).geometry.version, cells ? 6 : 5);
     const PackDecodeResult as8 = decode_pack(pack);
     ASSERT_EQ(as8.status, Status::kOk);
-    ASSERT_EQ(kPackVersion, 8);
     pack[8] = 7;
     const PackDecodeResult as7 = decode_pack(pack);
     if (cells) {
@@ -655,7 +695,8 @@ TEST(Pack, ManifestByteChangesAreRefusedOrReadAsValid) {
 // by version 2, golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by
 // version 5: codec header version 4, the lifting update; golden-pillow-v6.gip by version 6: codec header
 // version 5, the filter kCubicLong; golden-pillow-v7.gip by version 7: compact seam tables;
-// golden-pillow-v8.gip by version 8: codec header version 6, cell frames) must keep decoding to
+// golden-pillow-v8.gip by version 8: codec header version 6, cell frames; golden-pillow-v9.gip by version 9:
+// the two squares' seam table as a layout code) must keep decoding to
 // the pillow they were made from: decoders of old streams do not silently change.
 class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
 
@@ -704,7 +745,8 @@ INSTANTIATE_TEST_SUITE_P(Versions, GoldenPack,
                                            std::pair<const char*, int>{"golden-pillow-v5.gip", 5},
                                            std::pair<const char*, int>{"golden-pillow-v6.gip", 6},
                                            std::pair<const char*, int>{"golden-pillow-v7.gip", 7},
-                                           std::pair<const char*, int>{"golden-pillow-v8.gip", 8}));
+                                           std::pair<const char*, int>{"golden-pillow-v8.gip", 8},
+                                           std::pair<const char*, int>{"golden-pillow-v9.gip", 9}));
 
 }  // namespace
 }  // namespace geomip::codec

@@ -6,8 +6,10 @@
 #include "codec/geometry_codec.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <numeric>
 #include <random>
 #include <vector>
@@ -40,6 +42,54 @@ inline std::vector<codec::PatchSeam> random_layout_seams(int patches, std::mt199
     seams[static_cast<std::size_t>(b)] = {b / 4, b % 4, a / 4, a % 4, reversed};
   }
   return seams;
+}
+
+using Quad = std::array<int, 4>;  // corner ids, counter-clockwise seen from outside
+
+/// The seam table of a closed quad mesh: side s of quad q runs from corner s to corner s + 1 (the grid's
+/// sides), glued reversed to the quad that has the same edge the other way. Empty if an edge has no partner.
+inline std::vector<codec::PatchSeam> seams_of(const std::vector<Quad>& quads) {
+  std::map<std::pair<int, int>, std::pair<int, int>> edge;  // (from, to) → (quad, side)
+  for (int q = 0; q < static_cast<int>(quads.size()); ++q)
+    for (int s = 0; s < 4; ++s) edge[{quads[q][s], quads[q][(s + 1) % 4]}] = {q, s};
+  std::vector<codec::PatchSeam> seams;
+  for (int q = 0; q < static_cast<int>(quads.size()); ++q) {
+    for (int s = 0; s < 4; ++s) {
+      const auto it = edge.find({quads[q][(s + 1) % 4], quads[q][s]});
+      if (it == edge.end()) return {};
+      seams.push_back({q, s, it->second.first, it->second.second, true});
+    }
+  }
+  return seams;
+}
+
+/// The surface of the cube [0, n]³ cut into 6·n² unit quads, oriented outwards.
+inline std::vector<Quad> cube_quads(int n) {
+  std::map<std::array<int, 3>, int> ids;
+  const auto id = [&](std::array<int, 3> p) {
+    return ids.emplace(p, static_cast<int>(ids.size())).first->second;
+  };
+  std::vector<Quad> quads;
+  for (int a = 0; a < 3; ++a) {
+    for (int sign = 0; sign < 2; ++sign) {
+      // u × v = the outward normal: (a+1, a+2) for +a, swapped for −a.
+      const int u = sign == 1 ? (a + 1) % 3 : (a + 2) % 3, v = sign == 1 ? (a + 2) % 3 : (a + 1) % 3;
+      for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+          Quad q;
+          const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
+          for (int c = 0; c < 4; ++c) {
+            std::array<int, 3> p{};
+            p[a] = sign == 1 ? n : 0;
+            p[u] = i + du[c], p[v] = j + dv[c];
+            q[c] = id(p);
+          }
+          quads.push_back(q);
+        }
+      }
+    }
+  }
+  return quads;
 }
 
 /// A smooth unit vector field for normal-map tests: each sample's normalized position ((0, 0, 1) at the

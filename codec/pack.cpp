@@ -778,6 +778,18 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
     throw std::invalid_argument("write_pack: normals_delay outside [0, 64]");
   if (options.crc_group_bytes < 1 || options.crc_group_bytes > kMaxChunkSize)
     throw std::invalid_argument("write_pack: crc_group_bytes outside [1, 2^31)");
+  {
+    // The readers' bound (read_pack_info: kMaxSamplesPerPack): a pack they would refuse is not written.
+    std::uint64_t samples = 0;
+    for (const PackModelInput& model : models) {
+      for (const Grid3& g : model.geometry) samples += static_cast<std::uint64_t>(g.size()) * g.size();
+      if (options.normals)
+        for (const Grid3& g : model.normals) samples += static_cast<std::uint64_t>(g.size()) * g.size();
+    }
+    if (samples > kMaxSamplesPerPack)
+      throw std::invalid_argument("write_pack: " + std::to_string(samples) +
+                                  " samples (geometry and normal maps), more than a pack holds (2^25)");
+  }
   std::vector<EncodedGeometry> geometry(models.size()), normals(models.size());
   std::vector<int> geometry_passes, normal_passes, mask_level;
   for (std::size_t m = 0; m < models.size(); ++m) {

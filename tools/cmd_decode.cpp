@@ -160,9 +160,14 @@ int run_decode(const DecodeArgs& args) {
   nlohmann::json j_models = nlohmann::json::array();
   // The grids as decoded choose the quad split, also when their folds are opened before writing: the face
   // list stays what it was (the web loader's and `--no-untangle`'s), the same for every model of a layout.
+  // Untangling opens the folds of the grid that is written: an output level below
+  // UntangleOptions::min_level is left as decoded, as grids of those levels always are (and a crafted pack's
+  // claimed level 10 written at --level 0 no longer costs minutes).
+  const bool untangle =
+      args.untangle && (args.level < 0 ? grid_level : args.level) >= UntangleOptions{}.min_level;
   std::vector<codec::DecodedModel> as_decoded;
-  if (args.untangle) as_decoded = decoded.models;
-  const std::vector<codec::DecodedModel>& choosers = args.untangle ? as_decoded : decoded.models;
+  if (untangle) as_decoded = decoded.models;
+  const std::vector<codec::DecodedModel>& choosers = untangle ? as_decoded : decoded.models;
   for (std::size_t m = 0; m < decoded.models.size(); ++m) {
     // The models of the same layout (a consistent pack: all of them) choose the quad split together, so they
     // keep one face list (as far as their hole masks agree).
@@ -174,7 +179,7 @@ int run_decode(const DecodeArgs& args) {
     }
     const QuadSplitOptions split{.split = quad_split, .chosen_by = same_layout};
     UntangleStats untangled;
-    if (args.untangle) untangled = untangle_decoded_model(decoded.models[m], split);
+    if (untangle) untangled = untangle_decoded_model(decoded.models[m], split);
     // glTF carries per-patch texture coordinates and the normal maps' normals (seams not welded); the
     // other formats get the welded mesh.
     const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level, split) : TexturedMesh{};

@@ -64,6 +64,13 @@ void unite_hole_masks(codec::DecodedModel& into, const codec::DecodedModel& othe
 int run_morph(const MorphArgs& args) {
   check_output_directory(args.output);
   const std::vector<std::uint8_t> bytes = read_pack_file(args.pack);
+  // The manifest first: a pack of one model (or a damaged one) is refused before its grids are decoded.
+  codec::PackInfo info;
+  if (const codec::Status s = codec::read_pack_info(bytes, info); s != codec::Status::kOk)
+    throw InvalidInput(args.pack + ": " + std::string(codec::status_message(s)));
+  if (info.models.size() < 2)
+    throw InvalidInput(args.pack +
+                       " holds one model; a morph needs a pack of two or more (geomip convert --points)");
   codec::PackDecodeResult decoded = codec::decode_pack(bytes);
   if (decoded.status != codec::Status::kOk)
     throw InvalidInput(args.pack + ": " + std::string(codec::status_message(decoded.status)));

@@ -186,7 +186,9 @@ UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplit
   if (model.geometry.empty()) return stats;
   const UntangleOptions& options = options_in;
   const int level = model.geometry.front().level;
-  if (level < options.min_level) return stats;  // applied = false
+  std::size_t samples = 0;
+  for (const codec::Grid3& g : model.geometry) samples += g.values.size() / 3;
+  if (level < options.min_level || samples > options.max_samples) return stats;  // applied = false
   stats.applied = true;
   UniformRemeshResult remesh = grid_mesh(model, level, /*weld=*/true, split);
   std::vector<Eigen::Vector3d>& x = remesh.mesh.positions;

@@ -47,6 +47,10 @@ struct UntangleOptions {
   /// Grids coarser than this are left as decoded: there a sample's slide moves the surface (a level-4 horse
   /// lost 3–7 dB, a level-5 bunny 1 dB; level 6 at most 0.52 dB, levels 7–8 at most 0.23 dB).
   int min_level = 6;
+  /// Models with more samples than this are left as decoded too: the sweeps' state takes about 240 bytes a
+  /// sample (a crafted 1 KB pack claiming 32 M samples took 7.6 GB and minutes), and 2^22 is above every
+  /// pack `convert` writes by default (16 patches at level 8: 1.05 M; two squares at level 10: 2.1 M).
+  std::size_t max_samples = std::size_t{1} << 22;
   double max_fan_gap =
       0.1;  ///< a move is refused when a centroid of the sample's triangles lands farther than this
             ///< many mean edge lengths from the decoded surface as it was (0 = no check)
@@ -62,18 +66,18 @@ struct UntangleStats {
   bool applied = false;  ///< false: the grid is coarser than UntangleOptions::min_level, left as decoded
 };
 
-/// Opens the folds of a decoded model's finest grids in place (grids of level ≥ `min_level`; coarser ones are
-/// left as they are). A triangle of the welded level-N mesh (quads split as `split` says, as decoded_mesh()
-/// splits them) is folded when it faces against the area-weighted vertex normals averaged over 20·2^(N−8)
-/// rings around it (wider than a fold, narrower than a limb). Each sweep moves every sample of a folded
-/// triangle half-way towards its neighbours' centroid within that normal's tangent plane, then onto the
-/// nearest point of the decoded surface as it was (its triangles two rings around); a move is refused when
-/// the sample would end more than `max_slide` mean edge lengths from where it was decoded or its triangles'
-/// centroids more than `max_fan_gap` of them off that surface. Sweeps stop when no triangle is folded or
-/// after `max_sweeps`; some folds stay. Seam samples move once, into every patch that has them (bit-identical
-/// across seams, as decoded). Measured (docs/measurements.md, "Folds and self-intersections in decoded
-/// meshes"): self-intersecting faces −20…−93 % on spot, bunny, horse and cow (levels 6–8, 8.8 KB and whole
-/// packs), PSNR −0.52…+0.28 dB. O(rings · F).
+/// Opens the folds of a decoded model's finest grids in place (grids of level ≥ `min_level` with at most
+/// `max_samples` samples in all; others are left as they are). A triangle of the welded level-N mesh (quads
+/// split as `split` says, as decoded_mesh() splits them) is folded when it faces against the area-weighted
+/// vertex normals averaged over 20·2^(N−8) rings around it (wider than a fold, narrower than a limb). Each
+/// sweep moves every sample of a folded triangle half-way towards its neighbours' centroid within that
+/// normal's tangent plane, then onto the nearest point of the decoded surface as it was (its triangles two
+/// rings around); a move is refused when the sample would end more than `max_slide` mean edge lengths from
+/// where it was decoded or its triangles' centroids more than `max_fan_gap` of them off that surface. Sweeps
+/// stop when no triangle is folded or after `max_sweeps`; some folds stay. Seam samples move once, into every
+/// patch that has them (bit-identical across seams, as decoded). Measured (docs/measurements.md, "Folds and
+/// self-intersections in decoded meshes"): self-intersecting faces −20…−93 % on spot, bunny, horse and cow
+/// (levels 6–8, 8.8 KB and whole packs), PSNR −0.52…+0.28 dB. O(rings · F).
 UntangleStats untangle_decoded_model(codec::DecodedModel& model, const QuadSplitOptions& split = {},
                                      const UntangleOptions& options = {});
 

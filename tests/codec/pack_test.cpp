@@ -251,6 +251,20 @@ TEST(Pack, CellFramesNeedFormat8) {
   }
 }
 
+// The writer refuses what every reader would (more than 2^25 samples): 9 patches of level 11 claim
+// 9 · 2049² = 37.8 M. Checked before any grid is read, so the grids here can stay empty.
+TEST(Pack, WriterRefusesMoreSamplesThanAPackHolds) {
+  PackModelInput m;
+  m.name = "big";
+  m.geometry.assign(9, Grid3{11, {}});
+  try {
+    write_pack({m}, geometry_only());
+    FAIL() << "written";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("more than a pack holds"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Pack, TrailingBytesAreTolerated) {
   const std::vector<std::uint8_t> pack = write_pack({pillow_model(4, "a")});
   std::vector<std::uint8_t> longer = pack;

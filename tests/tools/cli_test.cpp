@@ -1376,6 +1376,13 @@ TEST_F(CliPack, DecodeOpensFoldsKeepingFacesAndDistance) {
   EXPECT_EQ(nlohmann::json::parse(c.out)["models"][0]["untangle"]["applied"], false);
   ASSERT_EQ(geomip("decode -q --no-untangle '" + coarse + "' -o '" + dir_ + "/c_raw.obj'").exit_code, 0);
   EXPECT_EQ(read_mesh(dir_ + "/c.obj").positions, read_mesh(dir_ + "/c_raw.obj").positions);
+  // So is an output level below 6 of a finer pack: the folds opened are those of the grid written.
+  const Outcome l5 = geomip("decode --json --level 5 '" + pack + "' -o '" + dir_ + "/l5.obj'");
+  ASSERT_EQ(l5.exit_code, 0) << l5.err;
+  EXPECT_EQ(nlohmann::json::parse(l5.out)["models"][0]["untangle"]["applied"], false);
+  ASSERT_EQ(geomip("decode -q --no-untangle --level 5 '" + pack + "' -o '" + dir_ + "/l5_raw.obj'").exit_code,
+            0);
+  EXPECT_EQ(read_mesh(dir_ + "/l5.obj").positions, read_mesh(dir_ + "/l5_raw.obj").positions);
 }
 
 // A pack with normal maps decodes to OBJ/PLY/OFF with the maps' normals per vertex (OBJ `vn` and `v//vn`,
@@ -1513,7 +1520,9 @@ TEST_F(CliPack, ConvertMovesAStretchedShapeToItsBetterLayoutUnlessTold) {
     EXPECT_EQ(level, k == 16 ? 3 : 2) << layout;
     EXPECT_TRUE(layout["not_built"].is_null()) << layout;
     reported_mean[k] = layout["mean_psnr_db"].get<double>();
-    if (k == chosen) EXPECT_EQ(cow_auto["level"], level);
+    if (k == chosen) {
+      EXPECT_EQ(cow_auto["level"], level);
+    }
     packs[k] = dir_ + "/cow" + std::to_string(k) + ".gip";
     ASSERT_EQ(geomip("convert -q '" + cow + "' --patches " + std::to_string(k) + " --level " +
                      std::to_string(level) + " --no-normals -o '" + packs[k] + "'")
@@ -1982,6 +1991,13 @@ TEST_F(CliPack, DefaultsFitLowLevelsAndFallbacksAreSaid) {
   EXPECT_EQ(tips, slurp(dir_ + "/t.gip") != slurp(dir_ + "/p.gip")) << r.err;
   expect_bad_input("morph '" + dir_ + "/p.gip' -o '" + dir_ + "/m'", "holds one model");
   EXPECT_FALSE(fs::exists(dir_ + "/m"));
+  // Told from the manifest, before any grid is decoded: a damaged chunk of a one-model pack says the same.
+  {
+    std::string bytes = slurp(dir_ + "/p.gip");
+    bytes.back() = static_cast<char>(bytes.back() ^ 0x5A);  // the last CRC trailer
+    std::ofstream(dir_ + "/damaged.gip", std::ios::binary) << bytes;
+    expect_bad_input("morph '" + dir_ + "/damaged.gip' -o '" + dir_ + "/m'", "holds one model");
+  }
   r = geomip("rd -q --quick '" + spot_ + "' -o '" + dir_ + "/rd'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;

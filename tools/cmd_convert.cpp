@@ -385,13 +385,16 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "one above the grid level N is taken as N)")
       ->check(CLI::Range(0, 10));
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack (for rate–distortion comparisons)");
-  cmd->add_option("--normal-mesh", args->normal_mesh_steps,
-                  "Normal-mesh resampling: move the samples of the finest STEPS wavelet steps onto the surface "
-                  "along their predicted normals, so their details are normal offsets (fewer bits); one mesh "
-                  "only (default " + std::to_string(kAutoNormalMeshSteps) + " for one mesh, 0 = off)");
+  cmd->add_option(
+         "--normal-mesh", args->normal_mesh_steps,
+         "Normal-mesh resampling: move the samples of the finest STEPS wavelet steps onto the surface "
+         "along their predicted normals, so their details are normal offsets (fewer bits); one mesh "
+         "only (default " +
+             std::to_string(kAutoNormalMeshSteps) + " for one mesh, 0 = off)")
+      ->check(CLI::Range(0, 10));
   cmd->add_option("--normal-mesh-reach", args->normal_mesh_reach,
                   "Largest move of a normal-mesh sample, in sample spacings of its level")
-      ->check(CLI::Range(0.0, 4.0));
+      ->check(finite_range(0.0, 4.0));
   cmd->add_option("--normal-mesh-guard", args->normal_mesh_guard,
                   "Normal-mesh steps from STEP up (the coarser ones) refuse a move that would fold their grid "
                   "around the sample (default 3; 0 = none, 1 = every step)")

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -66,6 +67,11 @@ std::string format(const char* fmt, T... values) {
 int run_eval(EvalArgs args) {
   args.options.sample_vertices = !args.no_vertices;
   args.options.error_maps = !args.error_map.empty() || !args.error_map_original.empty();
+  if (!args.error_map.empty() && !args.error_map_original.empty() &&
+      std::filesystem::weakly_canonical(args.error_map) ==
+          std::filesystem::weakly_canonical(args.error_map_original))
+    throw InvalidInput("--error-map and --error-map-original are both " + args.error_map +
+                       ": one map would overwrite the other");
   for (const std::string* path : {&args.error_map, &args.error_map_original}) {
     if (!path->empty() && mesh_format_from_path(*path) != MeshFormat::kPly)
       throw InvalidInput(*path + ": an error map is written as PLY (.ply)");

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <sstream>
 
 namespace geomip::tools {
 namespace {
@@ -60,17 +61,34 @@ void check_parameterizable(const std::string& path, const TriMesh& mesh, const T
   }
 }
 
-// The mesh ready for partitioning: repaired when open, non-manifold or degenerate (with a note on stderr).
+// True when no directed edge appears twice: neighbouring faces run through their shared edge in opposite
+// directions (a closed manifold mesh with one face flipped is still "manifold" to analyze_topology, but its
+// signed volume cancels and its partition fails).
+bool consistently_oriented(const TriMesh& mesh) {
+  std::vector<std::pair<int, int>> directed;
+  directed.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) directed.emplace_back(t[k], t[(k + 1) % 3]);
+  std::sort(directed.begin(), directed.end());
+  return std::adjacent_find(directed.begin(), directed.end()) == directed.end();
+}
+
+// The mesh ready for partitioning: repaired when open, non-manifold, degenerate or inconsistently oriented
+// (with a note on stderr).
 TriMesh prepare_mesh(const std::string& path, const TriMesh& input, const std::string& command, bool quiet) {
   const TopologyReport r = analyze_topology(input);
-  if (r.boundary_loops == 0 && r.manifold && r.degenerate_faces == 0) {
+  const bool oriented = consistently_oriented(input);
+  if (r.boundary_loops == 0 && r.manifold && r.degenerate_faces == 0 && oriented) {
     check_parameterizable(path, input, r);
     return input;
   }
   const RepairResult repaired = repair_mesh(input);
   check_parameterizable(path, repaired.mesh, r);
   if (!quiet) {
-    std::cerr << command << ": " << path << ": " << (r.boundary_loops ? "open" : "non-manifold or degenerate")
+    std::cerr << command << ": " << path << ": "
+              << (r.boundary_loops                                    ? "open"
+                  : !r.manifold || r.degenerate_faces > 0 || oriented ? "non-manifold or degenerate"
+                                                                      : "inconsistently oriented")
               << " mesh repaired first (as `geomip repair`): " << repaired.filled_holes << " holes filled, "
               << repaired.split_non_manifold_vertices << " vertices split, "
               << repaired.removed_degenerate_faces << " degenerate faces removed\n";
@@ -281,6 +299,29 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
   return models;
 }
 
+CLI::Validator finite_range(double lo, double hi) {
+  const auto number = [](double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  };
+  const std::string range = "[" + number(lo) + " - " + number(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        double v = 0;
+        std::size_t used = 0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != text.size()) return "Value " + text + " is not a number";
+        if (!std::isfinite(v) || v < lo || v > hi) return "Value " + text + " not in range " + range;
+        return {};
+      },
+      "FLOAT in " + range);
+}
+
 void add_model_options(CLI::App* cmd, ModelArgs& args) {
   cmd->add_option("mesh", args.meshes, "One mesh (partition points chosen automatically)");
   cmd->add_option("--points", args.points,
@@ -288,16 +329,17 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
   cmd->add_option("-o,--output", args.output, "Output directory (created if missing)")->required();
   cmd->add_flag("--json", args.json, "Machine-readable summary on stdout");
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar, no report");
-  cmd->add_option("--sampling-exponent", args.sampling_exponent,
-                  "Curvature sampling exponent g: stretch weights ((eps + |II|^2)/eps)^g give bent regions more "
-                  "samples; 0 = plain geometric stretch (default: 1/3 for param, gimage, remesh; 0 for convert)")
-      ->check(CLI::Range(0.0, 2.0));
+  cmd->add_option(
+         "--sampling-exponent", args.sampling_exponent,
+         "Curvature sampling exponent g: stretch weights ((eps + |II|^2)/eps)^g give bent regions more "
+         "samples; 0 = plain geometric stretch (default: 1/3 for param, gimage, remesh; 0 for convert)")
+      ->check(finite_range(0.0, 2.0));
   cmd->add_option(
          "--curvature-metric", args.curvature_metric,
          "Anisotropic stretch: measure triangles in the metric I + L*D*|S| (S the shape operator, D the "
          "bounding-box diagonal), so directions in which the surface bends get more samples than "
          "straight ones (around a leg, not along it); 0 = Euclidean (default 0.03)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finite_range(0.0, 1.0));
   cmd->add_option("--linf-sweeps", args.linf_sweeps,
                   "Sweeps of the L-infinity pass after the stretch optimization: lowers each patch's worst "
                   "stretch (never raises it), raises the L2 stretch (default 0: off)")

@@ -84,6 +84,10 @@ void apply_sampling(const ModelArgs& args, ParameterizationOptions& options);
 /// Registers ModelArgs' options on `cmd` (same names and help in every command).
 void add_model_options(CLI::App* cmd, ModelArgs& args);
 
+/// CLI::Range for a floating-point option that also refuses NaN and infinities (every comparison with NaN is
+/// false, so CLI::Range lets it through and the option silently acted as its default).
+CLI::Validator finite_range(double lo, double hi);
+
 /// `meshes`: one mesh (automatic partition points) or none when `points_file` names them. `command` prefixes
 /// the repair note ("geomip param"); `quiet` silences it. `patches`: see ModelArgs::patches.
 /// \throw InvalidInput when both or neither are given, several meshes come without CORR.json, a file is

@@ -1385,6 +1385,32 @@ TEST_F(CliPack, DecodeOpensFoldsKeepingFacesAndDistance) {
   EXPECT_EQ(read_mesh(dir_ + "/l5.obj").positions, read_mesh(dir_ + "/l5_raw.obj").positions);
 }
 
+// Options and inputs that used to pass silently: NaN where a number in a range is asked (CLI::Range lets
+// NaN through, and the option acted as its default), --normal-mesh below 0, two error maps on one path, and a
+// closed mesh with a face flipped (analyze_topology calls it manifold; its volume cancels, and convert said
+// "the mesh is flat"): now refused, or repaired first as an open mesh is.
+TEST_F(CliPack, NanOptionsSharedOutputsAndFlippedFacesAreHandled) {
+  expect_bad_input("convert -q '" + spot_ + "' --sampling-exponent nan -o '" + dir_ + "/x.gip'", "nan");
+  expect_bad_input("param -q '" + spot_ + "' --curvature-metric inf -o '" + dir_ + "/x'", "inf");
+  expect_bad_input("convert -q '" + spot_ + "' --normal-mesh-reach nan -o '" + dir_ + "/x.gip'", "nan");
+  expect_bad_input("convert -q '" + spot_ + "' --normal-mesh -1 -o '" + dir_ + "/x.gip'", "-1");
+  EXPECT_FALSE(fs::exists(dir_ + "/x.gip"));
+  expect_bad_input("eval '" + spot_ + "' '" + spot_ + "' --error-map '" + dir_ +
+                       "/m.ply' --error-map-original '" + dir_ + "/./m.ply'",
+                   "overwrite");
+  EXPECT_FALSE(fs::exists(dir_ + "/m.ply"));
+  TriMesh flipped = read_mesh(spot_);
+  std::swap(flipped.triangles[7][1], flipped.triangles[7][2]);
+  const std::string path = dir_ + "/flipped.obj";
+  {
+    std::ofstream out(path);
+    write_mesh(flipped, out, MeshFormat::kObj);
+  }
+  const Outcome r = geomip("convert '" + path + "' --level 3 --no-normals -o '" + dir_ + "/f.gip'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("inconsistently oriented mesh repaired first"), std::string::npos) << r.err;
+}
+
 // A pack with normal maps decodes to OBJ/PLY/OFF with the maps' normals per vertex (OBJ `vn` and `v//vn`,
 // PLY nx/ny/nz, NOFF): unit, one per vertex, facing as the surface does; a geometry-only pack writes none.
 TEST_F(CliPack, DecodeWritesTheNormalMapsNormalsInEveryFormat) {

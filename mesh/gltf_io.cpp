@@ -23,6 +23,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -79,8 +80,45 @@ struct DracoAttribute {
   int bits;
 };
 
+/// A number for a message: "%g".
+std::string short_number(double x) {
+  std::array<char, 32> text{};
+  std::snprintf(text.data(), text.size(), "%g", x);
+  return text.data();
+}
+
+/// Why Draco cannot quantize `count` tuples of `components` floats, or "" when it can: a value that is not
+/// finite, or an extent along an axis (max − min, in float as Draco computes it) that overflows float —
+/// Draco's quantizer divides by that extent and crashes (draco 1.5.5) when it is infinite.
+std::string draco_range_problem(const float* values, std::size_t count, int components) {
+  static constexpr std::array<const char*, 4> kAxis{"x", "y", "z", "w"};
+  std::vector<float> lo(static_cast<std::size_t>(components), std::numeric_limits<float>::max());
+  std::vector<float> hi(static_cast<std::size_t>(components), -std::numeric_limits<float>::max());
+  for (std::size_t i = 0; i < count; ++i) {
+    for (int c = 0; c < components; ++c) {
+      const float v = values[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)];
+      if (!std::isfinite(v)) return "value " + std::to_string(i) + " is not finite";
+      lo[static_cast<std::size_t>(c)] = std::min(lo[static_cast<std::size_t>(c)], v);
+      hi[static_cast<std::size_t>(c)] = std::max(hi[static_cast<std::size_t>(c)], v);
+    }
+  }
+  for (std::size_t c = 0; c < lo.size() && count > 0; ++c) {
+    const auto extent = static_cast<float>(static_cast<double>(hi[c]) - static_cast<double>(lo[c]));
+    if (!std::isfinite(extent)) {
+      return std::string("the extent along ") + (c < kAxis.size() ? kAxis[c] : "an axis") + " (" +
+             short_number(lo[c]) + " to " + short_number(hi[c]) +
+             ") overflows float, so Draco cannot quantize it";
+    }
+  }
+  return {};
+}
+
 void add_draco_primitive(tinygltf::Model& model, tinygltf::Primitive& prim, std::size_t num_vertices,
                          const std::vector<std::uint32_t>& indices, const std::vector<DracoAttribute>& attributes) {
+  for (const DracoAttribute& a : attributes) {
+    const std::string problem = draco_range_problem(a.values, num_vertices, a.components);
+    if (!problem.empty()) throw InvalidInput(std::string("write_gltf: ") + a.gltf_name + ": " + problem);
+  }
   draco::Mesh mesh;
   const auto n = static_cast<draco::PointIndex::ValueType>(num_vertices);
   mesh.set_num_points(n);
@@ -456,6 +494,21 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
   tinygltf::TinyGLTF gltf;
   if (!gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/!options.binary, options.binary) || !out)
     throw IoError("write_gltf: writing the glTF stream failed");
+}
+
+void check_draco_positions(const std::vector<Eigen::Vector3d>& positions, const std::string& who) {
+  std::vector<float> values;
+  values.reserve(3 * positions.size());
+  for (std::size_t v = 0; v < positions.size(); ++v) {
+    for (int c = 0; c < 3; ++c) {
+      const double x = positions[v][c];
+      if (!std::isfinite(x) || std::abs(x) > kFloatMax)
+        throw InvalidInput(who + ": vertex " + std::to_string(v) + " is not finite or beyond float range");
+      values.push_back(static_cast<float>(x));
+    }
+  }
+  const std::string problem = draco_range_problem(values.data(), positions.size(), 3);
+  if (!problem.empty()) throw InvalidInput(who + ": " + problem);
 }
 
 namespace {

@@ -299,6 +299,27 @@ TEST(GltfIo, DamagedDracoBytesAndBadBitsAreRefusedWithAMessage) {
   EXPECT_EQ(refused + read, 64);
 }
 
+// Coordinates each within float range whose extent (max − min) is not: Draco divides by that extent and
+// crashed (draco 1.5.5). Refused with InvalidInput before Draco sees them; the same mesh without Draco, and a
+// mesh whose extent just fits, are written.
+TEST(GltfIo, DracoRefusesAnExtentBeyondFloatRange) {
+  TriMesh huge = test::sphere(2);
+  for (auto& p : huge.positions) p *= 3e38;  // the sphere spans −3e38..3e38: extent 6e38 > FLT_MAX
+  try {
+    to_gltf(huge, {}, true, 14);
+    ADD_FAILURE() << "an extent beyond float range was written with Draco";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("overflows float"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(check_draco_positions(huge.positions, "huge.obj"), InvalidInput);
+  EXPECT_NO_THROW(to_gltf(huge, {}, true, 0));  // plain float accessors hold it
+  TriMesh fits = test::sphere(2);
+  for (auto& p : fits.positions) p *= 1.5e38;  // extent 3e38 < FLT_MAX
+  EXPECT_NO_THROW(check_draco_positions(fits.positions, "fits.obj"));
+  EXPECT_EQ(read_gltf_from_memory(to_gltf(fits, {}, true, 14), "fits", "").triangles.size(),
+            fits.triangles.size());
+}
+
 TEST(GltfIo, IndicesBeyondTheVertexCountAreRefused) {
   TriMesh tet = test::tetrahedron();
   tet.positions.pop_back();  // the last vertex is referenced but gone

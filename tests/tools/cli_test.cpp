@@ -1086,6 +1086,30 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
 // --choose-loop builds the pack with the plain loop, the tip loop and the end loop and keeps the one whose
 // prefixes are closest to the mesh: the pack written is byte for byte the candidate with the highest score,
 // which the same convert with that loop alone writes.
+// Finite coordinates whose bounding box's extent overflows float (a sphere of radius 3e38): Draco crashed
+// (SIGSEGV) and left the hidden temporary file behind. `remesh --draco` refuses before the work (no output
+// directory); `decode --draco` of a pack of it refuses before a byte is written (no file, no temporary file);
+// one line, exit 2. Without Draco the same pack decodes.
+TEST_F(CliPack, DracoRefusesAnExtentBeyondFloatRange) {
+  const std::string mesh = dir_ + "/huge.obj";
+  {
+    TriMesh huge = test::sphere(3);
+    for (auto& p : huge.positions) p *= 3e38;  // −3e38..3e38: extent 6e38 > FLT_MAX
+    std::ofstream out(mesh);
+    write_mesh(huge, out, MeshFormat::kObj);
+  }
+  expect_bad_input("remesh -q '" + mesh + "' --level 3 -o '" + dir_ + "/rm' --glb --draco", "huge.obj");
+  EXPECT_FALSE(fs::exists(dir_ + "/rm"));
+  const std::string pack = dir_ + "/huge.gip";
+  Outcome r = geomip("convert -q --no-normals --level 3 '" + mesh + "' -o '" + pack + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  fs::create_directory(dir_ + "/dec");
+  expect_bad_input("decode -q --draco '" + pack + "' -o '" + dir_ + "/dec/h.glb'", "overflows float");
+  EXPECT_TRUE(fs::is_empty(dir_ + "/dec")) << "no output and no temporary file";
+  r = geomip("decode -q '" + pack + "' -o '" + dir_ + "/dec/h.glb'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 TEST_F(CliPack, ChooseLoopKeepsTheBestOfTheLoops) {
   const std::string mesh = write_spiked_ellipsoid(dir_);
   const std::string common = " --no-normals --level 5 '" + mesh + "' -o '" + dir_;

@@ -64,9 +64,12 @@ void check_draco_positions(const std::vector<Eigen::Vector3d>& positions, const 
 
 /// Parses glTF 2.0 bytes (GLB when they start with the "glTF" magic, JSON otherwise). External buffers of a
 /// JSON file are looked up in `base_dir`; `name` only labels the messages. Work and memory are linear in
-/// the bytes and the buffers they reference.
+/// the bytes and the buffers they reference: the nodes must form disjoint trees (as glTF 2.0 requires: no
+/// node with two parents, no scene root with one), and all instances together may add at most 16 vertices
+/// plus triangles per byte of the file and its buffers (at least 2^24).
 /// \throw InvalidInput naming `name` and the problem: not glTF, no triangle primitive, an accessor outside
-///   its buffer, an index out of range, a non-finite coordinate.
+///   its buffer, an index out of range, a non-finite coordinate, nodes that are not trees, too many
+///   instanced vertices and triangles.
 TriMesh read_gltf_from_memory(std::string_view bytes, const std::string& name, const std::string& base_dir);
 
 }  // namespace geomip

@@ -24,6 +24,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 namespace geomip {
 namespace {
@@ -68,9 +69,9 @@ class Cli : public ::testing::Test {
   std::string dir_ = test::temp_dir("cli");
   void TearDown() override { fs::remove_all(dir_); }
 
-  Outcome geomip(const std::string& args) {
-    const std::string cmd = std::string("timeout 300 '") + GEOMIP_BINARY + "' " + args + " > '" + dir_ +
-                            "/stdout' 2> '" + dir_ + "/stderr' < /dev/null";
+  Outcome geomip(const std::string& args, int timeout_s = 300) {
+    const std::string cmd = "timeout " + std::to_string(timeout_s) + " '" + GEOMIP_BINARY + "' " + args +
+                            " > '" + dir_ + "/stdout' 2> '" + dir_ + "/stderr' < /dev/null";
     const int status = std::system(cmd.c_str());
     Outcome r;
     r.crashed = !WIFEXITED(status) || WEXITSTATUS(status) >= 124;  // signal, or timeout's 124/137
@@ -277,6 +278,33 @@ TEST_F(Cli, NonRegularFilesAreRefusedUnread) {
   const Outcome r = geomip("info /dev/zero");
   EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// A .gltf's external buffer gets the same checks: its URI naming a FIFO blocked `info` forever (nobody
+// writes), naming a directory ended in "std::bad_alloc". One line naming the URI, exit 2, at once.
+TEST_F(Cli, GltfBufferUrisThatAreNoRegularFilesAreRefusedUnread) {
+  ASSERT_EQ(::mkfifo((dir_ + "/pipe.bin").c_str(), 0600), 0);
+  fs::create_directory(dir_ + "/dir.bin");
+  const auto gltf = [&](const std::string& name, const std::string& uri) {
+    return file(name,
+                R"({"asset": {"version": "2.0"}, "buffers": [{"uri": ")" + uri + R"(", "byteLength": 96}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+                    {"bufferView": 1, "componentType": 5125, "count": 12, "type": "SCALAR"}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
+  };
+  for (const auto& [name, uri, problem] :
+       {std::tuple<std::string, std::string, std::string>{"fifo.gltf", "pipe.bin", "FIFO"},
+        {"dir.gltf", "dir.bin", "is a directory"}}) {
+    const std::string path = gltf(name, uri);
+    const Outcome r = geomip("info '" + path + "'", 30);  // a blocked read ends in timeout's 124
+    EXPECT_FALSE(r.crashed) << name;
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(uri), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(problem), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
 }
 
 // Issue #13: an index that does not fit an int used to drop the face silently (exit 0); a coordinate beyond

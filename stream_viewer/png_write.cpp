@@ -52,6 +52,36 @@ bool write_png_stream(FILE* f, int width, int height, const std::vector<std::uin
   return true;
 }
 
+/// An existing `path` that is neither a regular file nor a directory (a device such as /dev/null, a named
+/// pipe): renaming a temporary file over it would replace the node, so it is written in place.
+bool writes_in_place(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) &&
+         !std::filesystem::is_directory(st);
+}
+
+/// Writes the PNG into `file` (created or truncated: `opened`), flushed and closed; false with `problem` set.
+bool write_png_file(const std::string& file, int width, int height, const std::vector<std::uint8_t>& rgb,
+                    std::string& problem, bool& opened) {
+  FILE* f = std::fopen(file.c_str(), "wb");
+  opened = f != nullptr;
+  if (f == nullptr) {
+    problem = "cannot create '" + file + "' (" + std::strerror(errno) + ")";
+    return false;
+  }
+  bool ok = write_png_stream(f, width, height, rgb, problem);
+  if (ok && std::fflush(f) != 0) {
+    ok = false;
+    problem = std::strerror(errno);
+  }
+  if (std::fclose(f) != 0 && ok) {
+    ok = false;
+    problem = std::strerror(errno);
+  }
+  return ok;
+}
+
 std::filesystem::path directory_of(const std::string& path) {
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   return dir.empty() ? std::filesystem::path(".") : dir;
@@ -66,23 +96,19 @@ bool write_png(const std::string& path, int width, int height, const std::vector
     error = "write_png: bad image size";
     return false;
   }
-  const fs::path tmp =
-      directory_of(path) / ("." + fs::path(path).filename().string() + ".tmp-" + std::to_string(::getpid()));
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (f == nullptr) {
-    error = "cannot write " + path + ": cannot create '" + tmp.string() + "' (" + std::strerror(errno) + ")";
+  std::string problem;
+  bool opened = false;
+  if (writes_in_place(path)) {
+    if (write_png_file(path, width, height, rgb, problem, opened)) return true;
+    error = "cannot write " + path + ": " + problem;
     return false;
   }
-  std::string problem;
-  bool ok = write_png_stream(f, width, height, rgb, problem);
-  if (ok && std::fflush(f) != 0) {
-    ok = false;
-    problem = std::strerror(errno);
-  }
-  if (std::fclose(f) != 0 && ok) {
-    ok = false;
-    problem = std::strerror(errno);
-  }
+  std::string tmp_name = ".";  // appended, not "." + ...: GCC 12's -Wrestrict misfires on that
+  tmp_name += fs::path(path).filename().string();
+  tmp_name += ".tmp-";
+  tmp_name += std::to_string(::getpid());
+  const fs::path tmp = directory_of(path) / tmp_name;
+  bool ok = write_png_file(tmp.string(), width, height, rgb, problem, opened);
   std::error_code ec;
   if (ok) {
     fs::rename(tmp, path, ec);
@@ -92,7 +118,7 @@ bool write_png(const std::string& path, int width, int height, const std::vector
     }
   }
   if (!ok) {
-    fs::remove(tmp, ec);
+    if (opened) fs::remove(tmp, ec);  // ours only
     error = "cannot write " + path + ": " + problem;
   }
   return ok;
@@ -107,6 +133,11 @@ bool check_png_output(const std::string& path, std::string& error) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
     error = path + ": is a directory, not a file to write";
+    return false;
+  }
+  if (writes_in_place(path)) {  // a device or a pipe: written through, its directory is not touched
+    if (::access(path.c_str(), W_OK) == 0) return true;
+    error = path + ": is not writable";
     return false;
   }
   const fs::path dir = directory_of(path);

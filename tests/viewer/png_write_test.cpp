@@ -3,11 +3,13 @@
 // existing file as it was and no temporary file, and libpng prints nothing (the viewer says one line).
 #include "stream_viewer/png_write.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -101,6 +103,28 @@ TEST_F(PngWrite, AFailedWriteLeavesTheOldFileAndPrintsNothing) {
   EXPECT_EQ(slurp(err_file), "") << "libpng printed its own message";
   fs::remove(err_file);
   EXPECT_EQ(files(), std::vector<std::string>{"shot.png"}) << "no temporary file left";
+}
+
+// A named pipe (or a device such as /dev/null) is written through: a rename would replace the node.
+TEST_F(PngWrite, APipeIsWrittenThroughNotReplaced) {
+  const fs::path fifo = dir_ / "pipe.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);  // so the writer's open does not block
+  ASSERT_GE(reader, 0);
+  std::string error;
+  EXPECT_TRUE(check_png_output(fifo.string(), error)) << error;
+  const bool ok = write_png(fifo.string(), 8, 8, noise(8, 8), error);  // ~250 bytes: within the pipe's buffer
+  std::string received;
+  std::array<char, 4096> buffer{};
+  for (ssize_t n; (n = ::read(reader, buffer.data(), buffer.size())) > 0;)
+    received.append(buffer.data(), static_cast<std::size_t>(n));
+  ::close(reader);
+  EXPECT_TRUE(ok) << error;
+  EXPECT_EQ(received.substr(0, 4), "\x89PNG") << received.size() << " bytes through the pipe";
+  struct stat st {};
+  ASSERT_EQ(::stat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the pipe was replaced";
+  EXPECT_EQ(files(), std::vector<std::string>{"pipe.png"});
 }
 
 TEST_F(PngWrite, MissingDirectoriesAreSaidBeforeAndNothingIsCreated) {

@@ -1,6 +1,7 @@
 #include "baselines/draco_baseline.h"
 
 #include "mesh/errors.h"
+#include "mesh/gltf_io.h"
 
 #include <draco/attributes/geometry_attribute.h>
 #include <draco/compression/decode.h>
@@ -40,6 +41,7 @@ void check_input(const TriMesh& mesh, const DracoOptions& options) {
       if (i < 0 || i >= nv) throw InvalidInput(std::string(fn) + "triangle index out of range");
   for (const auto& p : mesh.positions)
     if (!p.allFinite()) throw InvalidInput(std::string(fn) + "non-finite vertex coordinate");
+  check_draco_positions(mesh.positions, "draco_encode");  // an extent beyond float range crashes Draco
 }
 
 // Positions as one float32 attribute with identity point mapping (one point per vertex, as draco's own OBJ

@@ -44,7 +44,8 @@ struct DracoResult {
 /// Draco's connectivity coder, so `decoded` may have fewer triangles only when `mesh` has such faces).
 ///
 /// \param mesh #V×3 positions (any units), #F triangles, 0-based indices.
-/// \pre at least one triangle, indices in range, finite coordinates, 1 ≤ quantization_bits ≤ 30,
+/// \pre at least one triangle, indices in range, finite coordinates within float range whose bounding box's
+///      extent along each axis is finite as a float (check_draco_positions()), 1 ≤ quantization_bits ≤ 30,
 ///      0 ≤ compression_level ≤ 10.
 /// \throw InvalidInput naming `draco_encode` for a precondition failure, SolverFailure when Draco fails to
 ///        encode or to decode its own stream.

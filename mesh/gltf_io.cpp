@@ -10,6 +10,10 @@
 #define TINYGLTF_NO_EXTERNAL_IMAGE
 #include <tiny_gltf.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 #include <draco/attributes/geometry_attribute.h>
@@ -23,6 +27,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -79,8 +84,45 @@ struct DracoAttribute {
   int bits;
 };
 
+/// A number for a message: "%g".
+std::string short_number(double x) {
+  std::array<char, 32> text{};
+  std::snprintf(text.data(), text.size(), "%g", x);
+  return text.data();
+}
+
+/// Why Draco cannot quantize `count` tuples of `components` floats, or "" when it can: a value that is not
+/// finite, or an extent along an axis (max − min, in float as Draco computes it) that overflows float —
+/// Draco's quantizer divides by that extent and crashes (draco 1.5.5) when it is infinite.
+std::string draco_range_problem(const float* values, std::size_t count, int components) {
+  static constexpr std::array<const char*, 4> kAxis{"x", "y", "z", "w"};
+  std::vector<float> lo(static_cast<std::size_t>(components), std::numeric_limits<float>::max());
+  std::vector<float> hi(static_cast<std::size_t>(components), -std::numeric_limits<float>::max());
+  for (std::size_t i = 0; i < count; ++i) {
+    for (int c = 0; c < components; ++c) {
+      const float v = values[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)];
+      if (!std::isfinite(v)) return "value " + std::to_string(i) + " is not finite";
+      lo[static_cast<std::size_t>(c)] = std::min(lo[static_cast<std::size_t>(c)], v);
+      hi[static_cast<std::size_t>(c)] = std::max(hi[static_cast<std::size_t>(c)], v);
+    }
+  }
+  for (std::size_t c = 0; c < lo.size() && count > 0; ++c) {
+    const auto extent = static_cast<float>(static_cast<double>(hi[c]) - static_cast<double>(lo[c]));
+    if (!std::isfinite(extent)) {
+      return std::string("the extent along ") + (c < kAxis.size() ? kAxis[c] : "an axis") + " (" +
+             short_number(lo[c]) + " to " + short_number(hi[c]) +
+             ") overflows float, so Draco cannot quantize it";
+    }
+  }
+  return {};
+}
+
 void add_draco_primitive(tinygltf::Model& model, tinygltf::Primitive& prim, std::size_t num_vertices,
                          const std::vector<std::uint32_t>& indices, const std::vector<DracoAttribute>& attributes) {
+  for (const DracoAttribute& a : attributes) {
+    const std::string problem = draco_range_problem(a.values, num_vertices, a.components);
+    if (!problem.empty()) throw InvalidInput(std::string("write_gltf: ") + a.gltf_name + ": " + problem);
+  }
   draco::Mesh mesh;
   const auto n = static_cast<draco::PointIndex::ValueType>(num_vertices);
   mesh.set_num_points(n);
@@ -190,9 +232,45 @@ Matrix4 node_matrix(const tinygltf::Node& node) {
 
 class Reader {
  public:
-  Reader(const tinygltf::Model& model, const std::string& name) : model_(model), name_(name) {}
+  /// `max_elements`: the most vertices plus triangles all instances together may add (see spend()).
+  Reader(const tinygltf::Model& model, const std::string& name, std::size_t max_elements)
+      : model_(model), name_(name), max_elements_(max_elements), elements_left_(max_elements) {}
 
   [[noreturn]] void fail(const std::string& what) const { throw InvalidInput(name_ + ": " + what); }
+
+  /// glTF 2.0 (§3.5.3, node hierarchy): the nodes form disjoint strict trees, so no node has two parents (nor
+  /// the same parent twice), and a scene's root nodes have none. Checked before any instance is made: a node
+  /// listed twice instances its subtree once per path (60 levels of "the next node, twice" are 2^60
+  /// instances).
+  void check_node_trees(const std::vector<int>& roots) const {
+    const std::size_t n = model_.nodes.size();
+    std::vector<int> parent(n, -1);
+    for (std::size_t p = 0; p < n; ++p) {
+      for (int child : model_.nodes[p].children) {
+        if (child < 0 || static_cast<std::size_t>(child) >= n)
+          fail("node " + std::to_string(p) + " has a child " + std::to_string(child) +
+               " that does not exist");
+        const int other = parent[static_cast<std::size_t>(child)];
+        if (other == static_cast<int>(p))
+          fail("node " + std::to_string(p) + " lists node " + std::to_string(child) +
+               " twice as a child (glTF nodes form disjoint trees)");
+        if (other >= 0)
+          fail("node " + std::to_string(child) + " is a child of both node " + std::to_string(other) +
+               " and node " + std::to_string(p) + " (glTF nodes form disjoint trees)");
+        parent[static_cast<std::size_t>(child)] = static_cast<int>(p);
+      }
+    }
+    std::vector<bool> listed(n, false);
+    for (int root : roots) {
+      if (root < 0 || static_cast<std::size_t>(root) >= n) fail("a scene's node reference is out of range");
+      if (parent[static_cast<std::size_t>(root)] >= 0)
+        fail("scene root node " + std::to_string(root) + " is also a child of node " +
+             std::to_string(parent[static_cast<std::size_t>(root)]) + " (glTF nodes form disjoint trees)");
+      if (listed[static_cast<std::size_t>(root)])
+        fail("node " + std::to_string(root) + " is listed twice among the scene's root nodes");
+      listed[static_cast<std::size_t>(root)] = true;
+    }
+  }
 
   // The bytes of element i of accessor `a` (validated once by check_accessor()).
   struct View {
@@ -250,6 +328,15 @@ class Reader {
     }
   }
 
+  /// Counts `elements` (vertices or triangles) an instance is about to add against the budget: trees bound
+  /// the instances by the nodes, but many nodes (or primitives) may still reuse one large accessor.
+  void spend(std::size_t elements) const {
+    if (elements > elements_left_)
+      fail("the scene instances more than " + std::to_string(max_elements_) +
+           " vertices and triangles (its nodes or primitives reuse the same data too often)");
+    elements_left_ -= elements;
+  }
+
   void add_primitive(const tinygltf::Primitive& prim, const Matrix4& xf, TriMesh& out) const {
     if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) return;  // points, lines, strips, fans: skipped
     if (const auto draco = prim.extensions.find(kDracoExtension); draco != prim.extensions.end()) {
@@ -262,6 +349,7 @@ class Reader {
     if (p.component != TINYGLTF_COMPONENT_TYPE_FLOAT) fail("POSITION is not float");
     const std::size_t first = out.positions.size();
     if (p.count > static_cast<std::size_t>(std::numeric_limits<int>::max()) - first) fail("too many vertices");
+    spend(p.count);
     for (std::size_t i = 0; i < p.count; ++i) {
       float f[3];
       std::memcpy(f, p.base + i * p.stride, sizeof f);
@@ -274,6 +362,7 @@ class Reader {
     if (prim.indices >= 0) {
       const View ix = check_accessor(prim.indices, TINYGLTF_TYPE_SCALAR, "index");
       if (ix.count % 3) fail("an index count is not a multiple of 3");
+      spend(ix.count / 3);
       for (std::size_t i = 0; i < ix.count; i += 3) {
         std::array<int, 3> t{};
         for (int k = 0; k < 3; ++k) {
@@ -285,6 +374,7 @@ class Reader {
       }
     } else {
       if (p.count % 3) fail("a non-indexed primitive's vertex count is not a multiple of 3");
+      spend(p.count / 3);
       for (std::size_t i = 0; i < p.count; i += 3)
         out.triangles.push_back({static_cast<int>(first + i), static_cast<int>(first + i + 1), static_cast<int>(first + i + 2)});
     }
@@ -314,6 +404,7 @@ class Reader {
     const std::size_t first = out.positions.size();
     const std::size_t np = mesh->num_points();
     if (np > static_cast<std::size_t>(std::numeric_limits<int>::max()) - first) fail("too many vertices");
+    spend(np + mesh->num_faces());
     std::array<float, 3> f{};
     for (draco::PointIndex::ValueType i = 0; i < mesh->num_points(); ++i) {
       if (!att->ConvertValue<float>(att->mapped_index(draco::PointIndex(i)), 3, f.data()))
@@ -353,7 +444,93 @@ class Reader {
  private:
   const tinygltf::Model& model_;
   const std::string& name_;
+  std::size_t max_elements_;
+  mutable std::size_t elements_left_;
 };
+
+/// TinyGLTF's file access for external buffers (images are never loaded: TINYGLTF_NO_EXTERNAL_IMAGE), held
+/// to the checks a mesh file given on the command line gets: a regular file (a FIFO blocked the read forever,
+/// a directory ended in std::bad_alloc), of at most the largest byteLength an external buffer declares (a
+/// buffer's file must have exactly its byteLength: a 3 GB file behind "byteLength": 96 is refused unread),
+/// and all of them together at most kMaxExternalBytes. Opened once, not blocking, then checked (fstat).
+struct ExternalFiles {
+  static constexpr std::uint64_t kMaxExternalBytes = std::uint64_t{4} << 30;  // as ReadMeshOptions
+  std::uint64_t max_file_bytes = 0;  ///< the largest byteLength of a buffer with an external URI
+  std::uint64_t bytes_read = 0;
+  std::string error;  ///< the first refusal, for the one-line message
+};
+
+bool external_file_exists(const std::string& path, void*) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;  // no open: a FIFO would block
+}
+
+bool read_external_file(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                        void* user) {
+  auto& files = *static_cast<ExternalFiles*>(user);
+  const auto refuse = [&](const std::string& why) {
+    if (files.error.empty()) files.error = "buffer file '" + path + "' " + why;
+    if (err != nullptr) *err = why;
+    return false;
+  };
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return refuse(std::string("cannot be opened (") + std::strerror(errno) + ")");
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return refuse(std::string("cannot be read (") + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) return refuse("is a directory, not a buffer file");
+  if (S_ISFIFO(st.st_mode)) return refuse("is a FIFO (named pipe), not a regular file");
+  if (!S_ISREG(st.st_mode)) return refuse("is a device or socket, not a regular file");
+  const auto size = static_cast<std::uint64_t>(st.st_size);
+  if (size > files.max_file_bytes) {
+    return refuse("has " + std::to_string(size) + " bytes, more than the " +
+                  std::to_string(files.max_file_bytes) + " its buffer declares");
+  }
+  if (size > ExternalFiles::kMaxExternalBytes - files.bytes_read)
+    return refuse("is past the " + std::to_string(ExternalFiles::kMaxExternalBytes) + " bytes geomip reads");
+  // What the size said, plus one byte to notice a file that grows meanwhile: never more.
+  out->assign(static_cast<std::size_t>(size) + 1, 0);
+  std::size_t got = 0;
+  while (got < out->size()) {
+    const ssize_t n = ::read(fd, out->data() + got, out->size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return refuse(std::string("cannot be read (") + std::strerror(errno) + ")");
+    if (n == 0) break;
+    got += static_cast<std::size_t>(n);
+  }
+  if (got > size) return refuse("grew while it was read");
+  out->resize(got);
+  files.bytes_read += got;
+  return true;
+}
+
+/// The largest byteLength of a buffer whose URI names a file (not a data: URI), from the JSON of `bytes`
+/// (GLB or not); 0 when there is none or the JSON does not parse (TinyGLTF then says what is wrong).
+std::uint64_t largest_external_buffer(std::string_view bytes) {
+  std::string_view json_text = bytes;
+  if (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) {
+    if (bytes.size() < 20) return 0;
+    std::uint32_t json_bytes = 0;
+    std::memcpy(&json_bytes, bytes.data() + 12, 4);
+    if (json_bytes > bytes.size() - 20) return 0;
+    json_text = bytes.substr(20, json_bytes);
+  }
+  if (json_text.find("\"uri\"") == std::string_view::npos) return 0;
+  const nlohmann::json j = nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("buffers") || !j["buffers"].is_array()) return 0;
+  std::uint64_t largest = 0;
+  for (const nlohmann::json& buffer : j["buffers"]) {
+    if (!buffer.is_object() || !buffer.contains("uri") || !buffer["uri"].is_string() ||
+        !buffer.contains("byteLength") || !buffer["byteLength"].is_number_unsigned())
+      continue;
+    if (buffer["uri"].get<std::string>().rfind("data:", 0) == 0) continue;
+    largest = std::max(largest, buffer["byteLength"].get<std::uint64_t>());
+  }
+  return largest;
+}
 
 bool skip_images(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
   return true;
@@ -456,6 +633,21 @@ void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostr
   tinygltf::TinyGLTF gltf;
   if (!gltf.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/!options.binary, options.binary) || !out)
     throw IoError("write_gltf: writing the glTF stream failed");
+}
+
+void check_draco_positions(const std::vector<Eigen::Vector3d>& positions, const std::string& who) {
+  std::vector<float> values;
+  values.reserve(3 * positions.size());
+  for (std::size_t v = 0; v < positions.size(); ++v) {
+    for (int c = 0; c < 3; ++c) {
+      const double x = positions[v][c];
+      if (!std::isfinite(x) || std::abs(x) > kFloatMax)
+        throw InvalidInput(who + ": vertex " + std::to_string(v) + " is not finite or beyond float range");
+      values.push_back(static_cast<float>(x));
+    }
+  }
+  const std::string problem = draco_range_problem(values.data(), positions.size(), 3);
+  if (!problem.empty()) throw InvalidInput(who + ": " + problem);
 }
 
 namespace {
@@ -562,6 +754,10 @@ TriMesh read_gltf_from_memory(std::string_view original, const std::string& name
   const std::string_view bytes = patched.empty() ? original : std::string_view(patched);
   tinygltf::TinyGLTF gltf;
   gltf.SetImageLoader(&skip_images, nullptr);
+  ExternalFiles files;
+  files.max_file_bytes = largest_external_buffer(bytes);
+  gltf.SetFsCallbacks({&external_file_exists, &tinygltf::ExpandFilePath, &read_external_file,
+                       &tinygltf::WriteWholeFile, &files});
   tinygltf::Model model;
   std::string err, warn;
   const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
@@ -574,16 +770,24 @@ TriMesh read_gltf_from_memory(std::string_view original, const std::string& name
   } catch (const std::exception& e) {
     throw InvalidInput(name + ": not a readable glTF file (" + shortened(e.what()) + ")");
   }
+  if (!ok && !files.error.empty()) throw InvalidInput(name + ": " + files.error);
   if (!ok) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     const std::size_t nl = err.find('\n');
     throw InvalidInput(name + ": not a readable glTF file" +
                        (err.empty() ? std::string() : " (" + shortened(err.substr(0, nl)) + ")"));
   }
-  const Reader reader(model, name);
+  // Instances may add at most 16 vertices plus triangles per byte of the file and its buffers (at least
+  // 2^24): read once, a primitive adds at most a third of one per byte (3 one-byte indices make a triangle),
+  // Draco's decode about 2 per byte; this leaves real files room for instances and bounds a crafted one's
+  // memory by its size (a 2 KB file: 2^24 elements, a few hundred MB).
+  std::size_t data_bytes = bytes.size();
+  for (const auto& buffer : model.buffers) data_bytes += buffer.data.size();
+  const Reader reader(model, name, std::max<std::size_t>(std::size_t{1} << 24, 16 * data_bytes));
   TriMesh out;
   if (!model.scenes.empty()) {
     const int s = model.defaultScene >= 0 && static_cast<std::size_t>(model.defaultScene) < model.scenes.size() ? model.defaultScene : 0;
+    reader.check_node_trees(model.scenes[s].nodes);
     for (int node : model.scenes[s].nodes) reader.add_node(node, Matrix4::Identity(), out, 0);
   } else {
     for (const auto& mesh : model.meshes) {

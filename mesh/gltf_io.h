@@ -49,16 +49,27 @@ struct GltfWriteOptions {
 /// With Draco the accessors' counts and POSITION min/max are those of Draco's own decode of the bytes written
 /// (checked in-process before a byte is written: same triangle count, every attribute present).
 /// \throw InvalidInput for an empty mesh, attributes of the wrong size, an index out of range, a coordinate
-///   outside float range or draco_position_bits outside 0..30; SolverFailure when Draco fails to encode or
+///   outside float range, draco_position_bits outside 0..30 or, with Draco, values whose extent along an
+///   axis overflows float (check_draco_positions()); SolverFailure when Draco fails to encode or
 ///   its decode disagrees; IoError when the stream fails.
 void write_gltf(const TriMesh& mesh, const MeshAttributes& attributes, std::ostream& out,
                 const GltfWriteOptions& options = {});
 
+/// Checks, before any work, that Draco can quantize `positions`: every coordinate finite and within float
+/// range, and the bounding box's extent along each axis (max − min of the float coordinates, rounded to
+/// float as Draco computes it) finite. Draco (1.5.5) crashes on an extent that overflows float, e.g. a mesh
+/// spanning −3e38..3e38. `who` starts the message ("write_gltf", "draco_encode", a file name).
+/// \throw InvalidInput naming `who` and the axis.
+void check_draco_positions(const std::vector<Eigen::Vector3d>& positions, const std::string& who);
+
 /// Parses glTF 2.0 bytes (GLB when they start with the "glTF" magic, JSON otherwise). External buffers of a
 /// JSON file are looked up in `base_dir`; `name` only labels the messages. Work and memory are linear in
-/// the bytes and the buffers they reference.
+/// the bytes and the buffers they reference: the nodes must form disjoint trees (as glTF 2.0 requires: no
+/// node with two parents, no scene root with one), and all instances together may add at most 16 vertices
+/// plus triangles per byte of the file and its buffers (at least 2^24).
 /// \throw InvalidInput naming `name` and the problem: not glTF, no triangle primitive, an accessor outside
-///   its buffer, an index out of range, a non-finite coordinate.
+///   its buffer, an index out of range, a non-finite coordinate, nodes that are not trees, too many
+///   instanced vertices and triangles.
 TriMesh read_gltf_from_memory(std::string_view bytes, const std::string& name, const std::string& base_dir);
 
 }  // namespace geomip

@@ -368,6 +368,48 @@ struct PlyProperty {
   bool list = false;
 };
 
+// The name OpenMesh's reader takes for a value type (it knows every PLY name for values, "char" as well as
+// "int8"), one per type.
+const char* ply_type_name(PlyType t) {
+  switch (t) {
+    case PlyType::kChar:
+      return "char";
+    case PlyType::kUchar:
+      return "uchar";
+    case PlyType::kShort:
+      return "short";
+    case PlyType::kUshort:
+      return "ushort";
+    case PlyType::kInt:
+      return "int";
+    case PlyType::kUint:
+      return "uint";
+    case PlyType::kFloat:
+      return "float";
+    case PlyType::kDouble:
+      return "double";
+  }
+  return "uchar";
+}
+
+int ply_size(PlyType t);
+
+// The name OpenMesh's reader takes for a list's length of type `t`. Its header parser knows only "uint8",
+// "uint16", "uchar" and "int" there (it refuses the whole file for "char", "short", "ushort", "uint", ...);
+// validate_ply() has checked every length to be from 0 to the vertex count, so reading a signed length as
+// unsigned of the same size, or a 4-byte unsigned one as int, reads the same numbers. (Its binary reader has
+// no 2-byte length: parse_ply_header() refuses those.)
+const char* ply_count_type_name(PlyType t) {
+  switch (ply_size(t)) {
+    case 1:
+      return "uchar";
+    case 2:
+      return "uint16";
+    default:
+      return "int";
+  }
+}
+
 struct PlyElement {
   std::string name;
   std::uint64_t count = 0;
@@ -389,7 +431,16 @@ struct PlyHeader {
     out += " 1.0\n";
     for (const auto& e : elements) {
       out += "element " + e.name + " " + std::to_string(e.count) + "\n";
-      for (const auto& p : e.properties) out += "property " + p.declaration + "\n";
+      for (const auto& p : e.properties) {
+        out += "property ";
+        if (p.list) {
+          out += "list ";
+          out += ply_count_type_name(p.count_type);
+          out += ' ';
+        }
+        out += ply_type_name(p.type);
+        out += ' ' + p.name + "\n";
+      }
     }
     return out + "end_header\n";
   }
@@ -528,6 +579,27 @@ bool parse_ply_header(std::istream& in, PlyHeader& h, std::string& problem) {
       if (h.binary && !integer_coordinates.empty()) {
         return bad("binary vertex property '" + integer_coordinates.substr(0, 32) +
                    "' has an integer type (float or double expected)");
+      }
+      // OpenMesh's binary reader reads lengths and face indices of 1 or 4 bytes only: a 2-byte one reads as
+      // nothing ("unsupported conversion") and the faces come out wrong. Said, not misread.
+      for (const auto& e : h.elements) {
+        for (const auto& p : e.properties) {
+          if (!h.binary || !p.list) continue;
+          std::istringstream declared(p.declaration);
+          std::string list_word, count_name, item_name;
+          declared >> list_word >> count_name >> item_name;
+          if (ply_size(p.count_type) == 2) {
+            problem = "unsupported binary PLY: list '" + p.name.substr(0, 32) +
+                      "' has the 2-byte length type '" + count_name +
+                      "' (geomip reads 1- or 4-byte lengths in binary PLY: uchar, int, uint)";
+            return false;
+          }
+          if (e.name == "face" && is_face_indices(p.name) && ply_size(p.type) == 2) {
+            problem = "unsupported binary PLY: face indices of the 2-byte type '" + item_name +
+                      "' (geomip reads 1- or 4-byte indices in binary PLY: uchar, int, uint)";
+            return false;
+          }
+        }
       }
       if (h.elements.empty() || h.elements[0].name != "vertex")
         return bad("the first element is not 'vertex'");
@@ -732,6 +804,17 @@ bool parse_number(std::string_view token, double& value) {
   char* end = nullptr;
   value = std::strtod(text.c_str(), &end);
   return end == text.c_str() + text.size();
+}
+
+// OFF as Geomview writes it may hold comments: from '#' to the end of the line. OpenMesh's OFF reader does
+// not know them (it reads "#" as a count or a coordinate), so they become spaces before validate_off() and
+// the reader see the text: lines and columns stay where they were, for the messages.
+std::string blank_off_comments(std::string_view bytes) {
+  std::string text(bytes);
+  for (std::size_t i = text.find('#'); i != std::string::npos; i = text.find('#', i)) {
+    while (i < text.size() && text[i] != '\n' && text[i] != '\r') text[i++] = ' ';
+  }
+  return text;
 }
 
 // OpenMesh's ascii OFF reader takes the first line as the keyword line (the rest of it is ignored), then
@@ -1132,13 +1215,18 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
   }
   bool binary_stl = false;
   std::string ply_header;  // PLY: the validated header, rewritten (PlyHeader::canonical())
+  std::string off_text;    // OFF with '#' comments: the text with them blanked (blank_off_comments())
   std::string_view data = bytes;
   switch (format) {
     case MeshFormat::kObj:
       validate_obj(path, bytes);
       break;
     case MeshFormat::kOff:
-      validate_off(path, bytes);
+      if (bytes.find('#') != std::string_view::npos) {
+        off_text = blank_off_comments(bytes);
+        data = off_text;
+      }
+      validate_off(path, data);
       break;
     case MeshFormat::kPly: {
       const PlyHeader h = validate_ply(path, bytes);

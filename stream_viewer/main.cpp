@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "codec/status.h"
 #include "stream_viewer/pack_source.h"
@@ -301,9 +302,12 @@ int run(const Options& opt) {
 
       if (have_models && !first_written && !opt.first_screenshot.empty()) {
         std::string e;
-        if (!write_png(opt.first_screenshot, opt.width, opt.height, target.read_rgb(), e))
-          std::cerr << "geomip-view: " << e << "\n";
-        std::cout << "geomip-view: first screenshot from " << shown_bytes << " of " << total << " bytes\n";
+        if (write_png(opt.first_screenshot, opt.width, opt.height, target.read_rgb(), e)) {
+          std::cout << "geomip-view: first screenshot from " << shown_bytes << " of " << total << " bytes\n";
+        } else {
+          std::cerr << "geomip-view: --first-screenshot: " << geomip::codec::one_line(e) << "\n";
+          exit_code = kExitFailure;  // said once; the viewing goes on
+        }
         first_written = true;
       }
       if (!headless && t1 - last_title > std::chrono::milliseconds(250)) {
@@ -349,7 +353,7 @@ int run(const Options& opt) {
       if (!opt.screenshot.empty() && !last_pixels.empty()) {
         std::string e;
         if (!write_png(opt.screenshot, opt.width, opt.height, last_pixels, e)) {
-          std::cerr << "geomip-view: " << e << "\n";
+          std::cerr << "geomip-view: --screenshot: " << geomip::codec::one_line(e) << "\n";
           exit_code = kExitFailure;
         }
       }
@@ -489,6 +493,17 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {  // one line, as every other error
     std::cerr << "geomip-view: " << geomip::codec::one_line(e.what()) << " (see --help)\n";
     return kExitBadInput;
+  }
+  // The outputs before any work: a directory that does not exist is said now (exit 2), not after the
+  // rendering.
+  for (const auto& [flag, path] :
+       {std::pair<const char*, const std::string*>{"--screenshot", &opt.screenshot},
+        {"--first-screenshot", &opt.first_screenshot}}) {
+    std::string e;
+    if (app.count(flag) > 0 && !check_png_output(*path, e)) {
+      std::cerr << "geomip-view: " << flag << ": " << geomip::codec::one_line(e) << "\n";
+      return kExitBadInput;
+    }
   }
   try {
     return run(opt);

@@ -15,6 +15,7 @@
 #include "codec/parallel.h"
 #include "gimage/surface_distance.h"
 #include "mesh/errors.h"
+#include "mesh/gltf_io.h"
 #include "mesh/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
@@ -328,6 +329,7 @@ int run_rd(const RdArgs& args) {
                        "--end-loop or --fit");
   const auto start = std::chrono::steady_clock::now();
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
+  check_draco_positions(original->positions, args.mesh);  // every series codes with Draco: refused now
   const unsigned threads =
       args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
   const Sweep sweep = make_sweep(args.quick);

@@ -68,6 +68,11 @@ int run_remesh(const RemeshArgs& args) {
                                                args.common.quiet || args.common.json, args.common.patches,
                                                loop_kind(args.common), args.common.equal_area_layout);
   check_output_directory(args.common.output);
+  // The remesh spans the input's bounding box: what Draco cannot quantize (--draco) is refused now.
+  if (args.draco != 0) {
+    for (std::size_t i = 0; i < models.inputs.size(); ++i)
+      check_draco_positions(models.inputs[i].mesh.positions, models.paths[i]);
+  }
 
   ParameterizationOptions options;
   apply_sampling(args.common, options);

@@ -83,6 +83,10 @@ TEST(DracoBaseline, RejectsBadInputAndBadBytes) {
   bad.triangles[0][0] = 99;
   EXPECT_THROW(draco_encode(bad, {}), InvalidInput);
 
+  TriMesh huge = test::sphere(2);  // finite coordinates, extent 6e38 beyond float range: Draco crashed
+  for (auto& p : huge.positions) p *= 3e38;
+  EXPECT_THROW(draco_encode(huge, {}), InvalidInput);
+
   const DracoResult r = draco_encode(test::sphere(2), {});
   TriMesh out;
   EXPECT_FALSE(draco_decode(nullptr, 0, out));

@@ -15,6 +15,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
 namespace geomip {
@@ -201,8 +203,112 @@ TEST(GltfIo, CraftedFilesAreRefusedWithAMessage) {
   j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = ix;  // indices as positions: wrong type
   expect_refused(j.dump(), "wrong type");
   j = good;
-  j["nodes"][0]["children"] = {0};  // a cycle
-  expect_refused(j.dump(), "deeper than 64");
+  j["nodes"][0]["children"] = {0};  // a cycle: the scene's root is its own child
+  expect_refused(j.dump(), "disjoint trees");
+}
+
+// glTF's nodes form disjoint trees (§3.5.3). A node that lists the next one twice, level after level, made
+// 2^levels instances (60 levels in 2 KB: unbounded memory); a node with two parents, a scene root that is
+// also a child or is listed twice instanced its subtree twice. All refused before any instance is made; a
+// mesh that two sibling nodes reference (a tree) is read twice, as glTF means.
+TEST(GltfIo, NodesThatAreNotDisjointTreesAreRefused) {
+  const TriMesh tet = test::tetrahedron();
+  const auto good = nlohmann::json::parse(to_gltf(tet, {}, false));
+  auto j = good;
+  j["nodes"] = nlohmann::json::array();
+  for (int i = 0; i < 20; ++i) j["nodes"].push_back({{"children", {i + 1, i + 1}}});
+  j["nodes"].push_back({{"mesh", 0}});
+  j["scenes"][0]["nodes"] = {0};
+  expect_refused(j.dump(), "twice as a child");
+  j["nodes"] = {{{"children", {2}}}, {{"children", {2}}}, {{"mesh", 0}}};
+  j["scenes"][0]["nodes"] = {0, 1};
+  expect_refused(j.dump(), "child of both node 0 and node 1");
+  j["nodes"] = {{{"children", {1}}}, {{"mesh", 0}}};
+  expect_refused(j.dump(), "scene root node 1 is also a child of node 0");
+  j["nodes"] = {{{"mesh", 0}}};
+  j["scenes"][0]["nodes"] = {0, 0};
+  expect_refused(j.dump(), "listed twice among the scene's root nodes");
+  j["nodes"] = {{{"children", {1, 2}}}, {{"mesh", 0}, {"translation", {10.0, 0.0, 0.0}}}, {{"mesh", 0}}};
+  j["scenes"][0]["nodes"] = {0};
+  const TriMesh two = read_gltf_from_memory(j.dump(), "two", "");
+  EXPECT_EQ(two.triangles.size(), 2 * tet.triangles.size());
+  EXPECT_EQ(two.positions.size(), 2 * tet.positions.size());
+}
+
+// Trees bound the instances by the nodes, yet many sibling nodes may each instance one large accessor:
+// 200 nodes × 100,000 triangles from one 300 KB index buffer. All instances together are bounded (16
+// vertices plus triangles per byte of data, at least 2^24): refused, with a message, before that memory.
+TEST(GltfIo, InstancesBeyondTheBudgetAreRefused) {
+  const TriMesh tet = test::tetrahedron();
+  auto j = nlohmann::json::parse(to_gltf(tet, {}, false));
+  const std::size_t index_bytes = 300000;  // 100,000 triangles of one-byte indices, all vertex 0
+  j["buffers"].push_back(
+      {{"byteLength", index_bytes},
+       {"uri", "data:application/octet-stream;base64," + std::string(index_bytes / 3 * 4, 'A')}});
+  j["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", 0}, {"byteLength", index_bytes}});
+  j["accessors"].push_back({{"bufferView", j["bufferViews"].size() - 1},
+                            {"componentType", 5121},
+                            {"count", index_bytes},
+                            {"type", "SCALAR"}});
+  nlohmann::json prim = j["meshes"][0]["primitives"][0];
+  prim["indices"] = j["accessors"].size() - 1;
+  j["meshes"].push_back({{"primitives", {prim}}});
+  j["nodes"] = {{{"children", nlohmann::json::array()}}};
+  for (int i = 1; i <= 200; ++i) {
+    j["nodes"][0]["children"].push_back(i);
+    j["nodes"].push_back({{"mesh", 1}});
+  }
+  j["scenes"][0]["nodes"] = {0};
+  expect_refused(j.dump(), "vertices and triangles");
+  j["nodes"] = {{{"children", {1, 2, 3}}}, {{"mesh", 1}}, {{"mesh", 1}}, {{"mesh", 1}}};  // 300,000 triangles
+  EXPECT_EQ(read_gltf_from_memory(j.dump(), "three", "").triangles.size(), 3 * index_bytes / 3);
+}
+
+// A JSON glTF of `mesh` whose buffer is the file `uri` (beside it in `dir`, as `bytes` when not empty),
+// written as DIR/NAME; its path. The buffer's bytes are those of the same mesh's GLB.
+std::string gltf_with_external_buffer(const TriMesh& mesh, const std::string& dir, const std::string& name,
+                                      const std::string& uri, bool write_buffer) {
+  auto j = nlohmann::json::parse(to_gltf(mesh, {}, false));
+  const std::size_t length = j["buffers"][0]["byteLength"];
+  const std::string glb = to_gltf(mesh, {}, true);
+  std::uint32_t json_size = 0;
+  std::memcpy(&json_size, glb.data() + 12, 4);
+  if (write_buffer)
+    std::ofstream(dir + "/" + uri, std::ios::binary) << glb.substr(20 + json_size + 8, length);
+  j["buffers"][0]["uri"] = uri;
+  std::ofstream(dir + "/" + name) << j.dump();
+  return dir + "/" + name;
+}
+
+// External buffers get the checks a mesh file gets: a regular file (a directory ended in std::bad_alloc, a
+// FIFO blocked forever: tests/tools/cli_test.cpp), no larger than the byteLength declared (a 64 MB sparse
+// file behind "byteLength": 136 was read whole before the size mismatch was noticed). One message naming
+// the URI; a buffer file that is right reads.
+TEST(GltfIo, ExternalBuffersMustBeRegularFilesOfTheirDeclaredSize) {
+  namespace fs = std::filesystem;
+  const std::string dir = test::temp_dir("gltf_ext");
+  const TriMesh tet = float_rounded(test::tetrahedron());
+  const std::string good = gltf_with_external_buffer(tet, dir, "good.gltf", "good.bin", true);
+  EXPECT_EQ(read_mesh(good).triangles, tet.triangles);
+  fs::create_directory(dir + "/sub.bin");
+  const auto expect_refused_naming = [](const std::string& path, const std::string& uri,
+                                        const std::string& problem) {
+    try {
+      read_mesh(path);
+      ADD_FAILURE() << path << " was read";
+    } catch (const InvalidInput& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(uri), std::string::npos) << what;
+      EXPECT_NE(what.find(problem), std::string::npos) << "'" << what << "' lacks '" << problem << "'";
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  };
+  expect_refused_naming(gltf_with_external_buffer(tet, dir, "dir.gltf", "sub.bin", false), "sub.bin",
+                        "is a directory");
+  const std::string sparse = gltf_with_external_buffer(tet, dir, "sparse.gltf", "sparse.bin", true);
+  fs::resize_file(dir + "/sparse.bin", std::uint64_t{64} << 20);  // a hole: no disk space, 64 MB to read
+  expect_refused_naming(sparse, "sparse.bin", "more than the");
+  fs::remove_all(dir);
 }
 
 // Largest distance from a vertex of `a` to its corresponding vertex in `b`, matching triangles by their
@@ -297,6 +403,27 @@ TEST(GltfIo, DamagedDracoBytesAndBadBitsAreRefusedWithAMessage) {
   }
   EXPECT_GT(refused, 0);
   EXPECT_EQ(refused + read, 64);
+}
+
+// Coordinates each within float range whose extent (max − min) is not: Draco divides by that extent and
+// crashed (draco 1.5.5). Refused with InvalidInput before Draco sees them; the same mesh without Draco, and a
+// mesh whose extent just fits, are written.
+TEST(GltfIo, DracoRefusesAnExtentBeyondFloatRange) {
+  TriMesh huge = test::sphere(2);
+  for (auto& p : huge.positions) p *= 3e38;  // the sphere spans −3e38..3e38: extent 6e38 > FLT_MAX
+  try {
+    to_gltf(huge, {}, true, 14);
+    ADD_FAILURE() << "an extent beyond float range was written with Draco";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("overflows float"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(check_draco_positions(huge.positions, "huge.obj"), InvalidInput);
+  EXPECT_NO_THROW(to_gltf(huge, {}, true, 0));  // plain float accessors hold it
+  TriMesh fits = test::sphere(2);
+  for (auto& p : fits.positions) p *= 1.5e38;  // extent 3e38 < FLT_MAX
+  EXPECT_NO_THROW(check_draco_positions(fits.positions, "fits.obj"));
+  EXPECT_EQ(read_gltf_from_memory(to_gltf(fits, {}, true, 14), "fits", "").triangles.size(),
+            fits.triangles.size());
 }
 
 TEST(GltfIo, IndicesBeyondTheVertexCountAreRefused) {

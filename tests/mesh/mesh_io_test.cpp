@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <random>
 #include <sstream>
 
@@ -249,6 +251,104 @@ TEST_F(MeshIo, RejectsTruncatedBinaryPly) {
     nan_bytes.replace(header, sizeof nan, reinterpret_cast<const char*>(&nan), sizeof nan);
   }
   expect_rejected(write_text(dir_, "nan_bin.ply", nan_bytes), "NaN");
+}
+
+// A PLY of a tetrahedron whose face list is declared `list COUNT INDEX vertex_indices`: ascii, or binary
+// little endian with float coordinates and the list's length and indices in those types.
+std::string tetrahedron_ply(const TriMesh& tet, const std::string& count, const std::string& index,
+                            bool binary) {
+  std::ostringstream out;
+  out << std::setprecision(9);  // float round trip
+  out << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\nelement vertex "
+      << tet.positions.size() << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
+      << tet.triangles.size() << "\nproperty list " << count << " " << index
+      << " vertex_indices\nend_header\n";
+  const auto size_of = [](const std::string& type) -> std::size_t {
+    for (const char* one : {"char", "uchar", "int8", "uint8"})
+      if (type == one) return 1;
+    for (const char* two : {"short", "ushort", "int16", "uint16"})
+      if (type == two) return 2;
+    return 4;
+  };
+  const auto put = [&](std::uint32_t value, std::size_t bytes) {  // little endian
+    for (std::size_t k = 0; k < bytes; ++k) out.put(static_cast<char>(value >> (8 * k) & 0xff));
+  };
+  for (const auto& p : tet.positions) {
+    for (int c = 0; c < 3; ++c) {
+      const auto f = static_cast<float>(p[c]);
+      if (binary) {
+        std::uint32_t bits = 0;
+        std::memcpy(&bits, &f, 4);
+        put(bits, 4);
+      } else {
+        out << f << (c < 2 ? " " : "\n");
+      }
+    }
+  }
+  for (const auto& t : tet.triangles) {
+    if (binary) {
+      put(3, size_of(count));
+      for (int v : t) put(static_cast<std::uint32_t>(v), size_of(index));
+    } else {
+      out << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+    }
+  }
+  return out.str();
+}
+
+// Every PLY type name may type a list's length; OpenMesh's header parser took only uchar, uint8, uint16 and
+// int there and refused the rest ("cannot parse as a .ply mesh"). Now each reads the same faces in ascii;
+// in binary, where OpenMesh's reader has no 2-byte lengths or indices, those are refused naming the type.
+TEST_F(MeshIo, PlyListsReadWithEveryLengthTypeName) {
+  const TriMesh tet = test::float32(test::tetrahedron());
+  for (const char* count : {"char", "uchar", "short", "ushort", "int", "uint", "int8", "uint8", "int16",
+                            "uint16", "int32", "uint32"}) {
+    for (bool binary : {false, true}) {
+      const std::string name = std::string(count) + (binary ? "_bin.ply" : ".ply");
+      const std::string path = write_text(dir_, name, tetrahedron_ply(tet, count, "int", binary));
+      const bool two_bytes = std::string(count).find("short") != std::string::npos ||
+                             std::string(count).find("16") != std::string::npos;
+      if (binary && two_bytes) {
+        expect_rejected(path, std::string("2-byte length type '") + count + "'");
+        continue;
+      }
+      try {
+        const TriMesh back = read_mesh(path);
+        EXPECT_EQ(back.triangles, tet.triangles) << name;
+        EXPECT_EQ(back.positions, tet.positions) << name;
+      } catch (const InvalidInput& e) {
+        ADD_FAILURE() << name << ": " << e.what();
+      }
+    }
+  }
+  // Index types: 1- and 4-byte ones in binary; 2-byte ones in ascii only.
+  for (const char* index : {"uchar", "char", "uint", "int32", "ushort", "short"}) {
+    for (bool binary : {false, true}) {
+      const std::string name = std::string("index_") + index + (binary ? "_bin.ply" : ".ply");
+      const std::string path = write_text(dir_, name, tetrahedron_ply(tet, "uchar", index, binary));
+      if (binary && std::string(index).find("short") != std::string::npos) {
+        expect_rejected(path, std::string("2-byte type '") + index + "'");
+        continue;
+      }
+      EXPECT_EQ(read_mesh(path).triangles, tet.triangles) << name;
+    }
+  }
+}
+
+// Geomview's OFF allows comments from '#' to the end of a line; they were refused ("the vertex count '#' is
+// not a count"). Comment lines anywhere after the magic and trailing comments read as if absent; a problem
+// after a comment still names its line.
+TEST_F(MeshIo, OffCommentsAreSkipped) {
+  const std::string plain = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  const TriMesh expected = read_mesh(write_text(dir_, "plain.off", plain));
+  const std::string commented =
+      "OFF # a tetrahedron\n# made by hand\n\n4 4 0 # vertices faces edges\n#\n0 0 0\n1 0 0 # x\n"
+      "  # indented\n0 1 0\n0 0 1\n# faces\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3 # last\n# end";
+  const TriMesh back = read_mesh(write_text(dir_, "commented.off", commented));
+  EXPECT_EQ(back.triangles, expected.triangles);
+  EXPECT_EQ(back.positions, expected.positions);
+  expect_rejected(write_text(dir_, "bad.off", "OFF\n# one\n# two\n4 4 0\n0 0 0\n1 0 zero\n"),
+                  "line 6: malformed vertex 1");
 }
 
 TEST_F(MeshIo, GarbageAndMutatedFilesNeverCrashOrHang) {

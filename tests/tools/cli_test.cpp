@@ -24,6 +24,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 namespace geomip {
 namespace {
@@ -68,9 +69,9 @@ class Cli : public ::testing::Test {
   std::string dir_ = test::temp_dir("cli");
   void TearDown() override { fs::remove_all(dir_); }
 
-  Outcome geomip(const std::string& args) {
-    const std::string cmd = std::string("timeout 300 '") + GEOMIP_BINARY + "' " + args + " > '" + dir_ +
-                            "/stdout' 2> '" + dir_ + "/stderr' < /dev/null";
+  Outcome geomip(const std::string& args, int timeout_s = 300) {
+    const std::string cmd = "timeout " + std::to_string(timeout_s) + " '" + GEOMIP_BINARY + "' " + args +
+                            " > '" + dir_ + "/stdout' 2> '" + dir_ + "/stderr' < /dev/null";
     const int status = std::system(cmd.c_str());
     Outcome r;
     r.crashed = !WIFEXITED(status) || WEXITSTATUS(status) >= 124;  // signal, or timeout's 124/137
@@ -277,6 +278,33 @@ TEST_F(Cli, NonRegularFilesAreRefusedUnread) {
   const Outcome r = geomip("info /dev/zero");
   EXPECT_NE(r.err.find("not a regular file"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// A .gltf's external buffer gets the same checks: its URI naming a FIFO blocked `info` forever (nobody
+// writes), naming a directory ended in "std::bad_alloc". One line naming the URI, exit 2, at once.
+TEST_F(Cli, GltfBufferUrisThatAreNoRegularFilesAreRefusedUnread) {
+  ASSERT_EQ(::mkfifo((dir_ + "/pipe.bin").c_str(), 0600), 0);
+  fs::create_directory(dir_ + "/dir.bin");
+  const auto gltf = [&](const std::string& name, const std::string& uri) {
+    return file(name,
+                R"({"asset": {"version": "2.0"}, "buffers": [{"uri": ")" + uri + R"(", "byteLength": 96}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+                    {"bufferView": 1, "componentType": 5125, "count": 12, "type": "SCALAR"}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
+  };
+  for (const auto& [name, uri, problem] :
+       {std::tuple<std::string, std::string, std::string>{"fifo.gltf", "pipe.bin", "FIFO"},
+        {"dir.gltf", "dir.bin", "is a directory"}}) {
+    const std::string path = gltf(name, uri);
+    const Outcome r = geomip("info '" + path + "'", 30);  // a blocked read ends in timeout's 124
+    EXPECT_FALSE(r.crashed) << name;
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(uri), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(problem), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
 }
 
 // Issue #13: an index that does not fit an int used to drop the face silently (exit 0); a coordinate beyond
@@ -1086,6 +1114,30 @@ TEST_F(CliPack, ConvertThenDecodeWholeAndPrefix) {
 // --choose-loop builds the pack with the plain loop, the tip loop and the end loop and keeps the one whose
 // prefixes are closest to the mesh: the pack written is byte for byte the candidate with the highest score,
 // which the same convert with that loop alone writes.
+// Finite coordinates whose bounding box's extent overflows float (a sphere of radius 3e38): Draco crashed
+// (SIGSEGV) and left the hidden temporary file behind. `remesh --draco` refuses before the work (no output
+// directory); `decode --draco` of a pack of it refuses before a byte is written (no file, no temporary file);
+// one line, exit 2. Without Draco the same pack decodes.
+TEST_F(CliPack, DracoRefusesAnExtentBeyondFloatRange) {
+  const std::string mesh = dir_ + "/huge.obj";
+  {
+    TriMesh huge = test::sphere(3);
+    for (auto& p : huge.positions) p *= 3e38;  // −3e38..3e38: extent 6e38 > FLT_MAX
+    std::ofstream out(mesh);
+    write_mesh(huge, out, MeshFormat::kObj);
+  }
+  expect_bad_input("remesh -q '" + mesh + "' --level 3 -o '" + dir_ + "/rm' --glb --draco", "huge.obj");
+  EXPECT_FALSE(fs::exists(dir_ + "/rm"));
+  const std::string pack = dir_ + "/huge.gip";
+  Outcome r = geomip("convert -q --no-normals --level 3 '" + mesh + "' -o '" + pack + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  fs::create_directory(dir_ + "/dec");
+  expect_bad_input("decode -q --draco '" + pack + "' -o '" + dir_ + "/dec/h.glb'", "overflows float");
+  EXPECT_TRUE(fs::is_empty(dir_ + "/dec")) << "no output and no temporary file";
+  r = geomip("decode -q '" + pack + "' -o '" + dir_ + "/dec/h.glb'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 TEST_F(CliPack, ChooseLoopKeepsTheBestOfTheLoops) {
   const std::string mesh = write_spiked_ellipsoid(dir_);
   const std::string common = " --no-normals --level 5 '" + mesh + "' -o '" + dir_;

@@ -165,6 +165,25 @@ TEST_F(RdCli, StretchedShapeIsMeasuredOnConvertsLayout) {
   EXPECT_EQ(slurp(fs::path(dir_) / "rd2" / "cow.gip"), slurp(fs::path(dir_) / "c2.gip"));
 }
 
+// Finite coordinates whose extent overflows float (a sphere of radius 3e38): Draco crashed (SIGSEGV) in
+// every series. Now refused before the work: exit 2, one line naming the mesh, no output directory.
+TEST_F(RdCli, ExtentBeyondFloatRangeIsRefusedBeforeDraco) {
+  const std::string mesh = dir_ + "/huge.obj";
+  {
+    TriMesh huge = test::sphere(2);
+    for (auto& p : huge.positions) p *= 3e38;  // the unit sphere spans −3e38..3e38: extent 6e38
+    std::ofstream out(mesh);
+    write_mesh(huge, out, MeshFormat::kObj);
+  }
+  const std::string out_dir = dir_ + "/rd";
+  std::string err;
+  EXPECT_EQ(geomip("rd -q --quick --no-geomip '" + mesh + "' -o '" + out_dir + "'", err), 2) << err;
+  EXPECT_NE(err.find("huge.obj"), std::string::npos) << err;
+  EXPECT_NE(err.find("overflows float"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_FALSE(fs::exists(out_dir));
+}
+
 TEST_F(RdCli, MissingMeshFailsCleanly) {
   const std::string out_dir = dir_ + "/rd";
   std::string err;

@@ -12,7 +12,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -897,6 +899,49 @@ TEST_F(ViewPackTest, OutOfRangeOptionsExitTwoWithOneLine) {
   EXPECT_EQ(ok.code, 0) << ok.err;
 }
 
+// The screenshot outputs are checked before any work: a directory that does not exist is exit 2 with one
+// line (--screenshot's was found after the rendering, exit 1; --first-screenshot's failure was printed and
+// the run went on to exit 0 saying "first screenshot from N of N bytes"). A first screenshot that cannot be
+// written (a full disk, simulated by a file-size limit of 0 with SIGXFSZ ignored) exits non-zero with one
+// line, does not claim it was written, and leaves the file that was there intact.
+TEST_F(ViewPackTest, ScreenshotOutputsAreCheckedFirstAndFailedWritesExitNonZero) {
+  const fs::path pack = pack_file(4);
+  for (const char* option : {"--screenshot", "--first-screenshot"}) {
+    const fs::path png = work_dir() / "no-such-dir" / "x.png";
+    const ViewRun r = view_measured(pack.string() + " " + size_args() + " " + option + " " + png.string());
+    EXPECT_EQ(r.code, 2) << option << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << option << ": " << r.err;
+    EXPECT_NE(r.err.find(option), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("first screenshot from"), std::string::npos) << r.out;
+  }
+  const fs::path first = work_dir() / "first_on_full_disk.png";
+  std::ofstream(first) << "old";
+  // Output through a pipe (a file-size limit does not apply to pipes): stdout and stderr together.
+  const std::string cmd = "trap '' XFSZ; ulimit -f 0; exec " + std::string(GEOMIP_VIEW_BINARY) + " " +
+                          pack.string() + " " + size_args() + " --first-screenshot " + first.string() +
+                          " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string said;
+  std::array<char, 4096> buffer{};
+  for (std::size_t n; (n = std::fread(buffer.data(), 1, buffer.size(), p)) > 0;)
+    said.append(buffer.data(), n);
+  const int status = ::pclose(p);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal: " << said;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << said;
+  // Its one line (stdout's status line comes through the same pipe).
+  const std::size_t at = said.find("geomip-view: --first-screenshot: cannot write");
+  EXPECT_NE(at, std::string::npos) << said;
+  EXPECT_EQ(said.find("--first-screenshot", said.find('\n', at)), std::string::npos) << said;
+  EXPECT_EQ(said.find("libpng error"), std::string::npos) << "libpng's own message: " << said;
+  EXPECT_EQ(said.find("first screenshot from"), std::string::npos) << said;
+  std::ifstream in(first, std::ios::binary);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "old");
+  for (const auto& entry : fs::directory_iterator(work_dir()))
+    EXPECT_EQ(entry.path().filename().string().find(".first_on_full_disk.png.tmp"), std::string::npos)
+        << "temporary file left: " << entry.path();
+}
 
 // Cancelling (the destructor: Q in the window, the headless timeout) takes effect within ~50 ms, also during a
 // --limit-rate pause on a file, a rate-limited transfer and a stalled server. Bound: "ended, not hung" (1 s).

@@ -15,6 +15,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
 
 namespace geomip::tools {
 namespace {
@@ -116,19 +120,50 @@ int run_morph(const MorphArgs& args) {
     if (model.geometry.size() == frame.geometry.size() &&
         model.geometry.front().level == frame.geometry.front().level)
       same_layout.push_back(&model);
+  namespace fs = std::filesystem;
+  const auto frame_name = [](int k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "morph_%04d.obj", k);
+    return std::string(name);
+  };
+  // Every frame's place must take a file (a directory of that name would stop the run half-way, leaving
+  // this run's first frames beside an earlier run's last ones).
+  for (int k = 0; k < args.frames; ++k) {
+    std::error_code ec;
+    const fs::path target = fs::path(args.output) / frame_name(k);
+    if (fs::exists(target, ec) && !fs::is_regular_file(target, ec))
+      throw InvalidInput((fs::path(args.output) / frame_name(k)).string() +
+                         " is not a regular file: the frame cannot be written there");
+  }
+  // The frames go to a staging directory beside them first and are moved into place only when all are
+  // written: a run that fails (a full disk) leaves an earlier run's frames as they were, not a mix of both.
+  const fs::path staging = fs::path(args.output) / (".morph-partial-" + std::to_string(::getpid()));
+  fs::create_directory(staging);
+  struct RemoveStaging {
+    fs::path path;
+    ~RemoveStaging() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  } remove_staging{staging};
+  std::vector<std::string> report;
   for (int k = 0; k < args.frames; ++k) {
     const float t = args.frames == 1 ? 0.0f : static_cast<float>(k) / static_cast<float>(args.frames - 1);
     const auto positions = morph::evaluate_morph(a, b, t, schedule);
     for (std::size_t p = 0; p < positions.size(); ++p) frame.geometry[p].values = positions[p];
     const TriMesh mesh = decoded_mesh(frame, args.level, {.chosen_by = same_layout});
-    char name[32];
-    std::snprintf(name, sizeof name, "morph_%04d.obj", k);
-    const std::string path = (std::filesystem::path(args.output) / name).string();
-    write_file_atomically(path, [&](std::ostream& o) { write_mesh(mesh, o, MeshFormat::kObj); });
-    if (!args.quiet)
-      std::printf("morph t=%.3f → %s: %zu vertices, %zu faces\n", t, path.c_str(), mesh.num_vertices(),
-                  mesh.num_triangles());
+    const std::string path = (fs::path(args.output) / frame_name(k)).string();
+    write_file_atomically((staging / frame_name(k)).string(),
+                          [&](std::ostream& o) { write_mesh(mesh, o, MeshFormat::kObj); });
+    char line[512];
+    std::snprintf(line, sizeof line, "morph t=%.3f → %s: %zu vertices, %zu faces\n", t, path.c_str(),
+                  mesh.num_vertices(), mesh.num_triangles());
+    report.push_back(line);
   }
+  for (int k = 0; k < args.frames; ++k)
+    fs::rename(staging / frame_name(k), fs::path(args.output) / frame_name(k));
+  if (!args.quiet)
+    for (const std::string& line : report) std::fputs(line.c_str(), stdout);
   // Frames of an earlier, longer run in the same directory would read as part of this sequence
   // (morph_*.obj): those files, and only files of exactly that name, go.
   std::size_t stale = 0;

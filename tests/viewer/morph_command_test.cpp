@@ -1,8 +1,12 @@
 // `geomip morph` end to end: N OBJ frames with identical connectivity, the first and last frames are the two
 // models (in the normalized frame), the linear midpoint is the vertex-wise average, the wavelet one is not.
 #include <gtest/gtest.h>
+
+#include <vector>
+
 #include <sys/wait.h>
 #include <unistd.h>
+#include <iterator>
 
 #include <array>
 #include <filesystem>
@@ -197,6 +201,43 @@ TEST_F(MorphCommandTest, AShorterRunRemovesTheEarlierRunsExtraFrames) {
   }
   EXPECT_TRUE(fs::exists(out / "notes.txt"));
   EXPECT_TRUE(fs::exists(out / "morph_0004.obj.bak"));
+}
+
+// A run that cannot finish leaves an earlier run's frames as they were: a frame's place taken by a directory
+// is refused before anything is written (it used to stop the run at that frame, after replacing the ones
+// before it), and a write that fails (a file-size limit standing in for a full disk) leaves no staging
+// directory and no frame of its own.
+TEST_F(MorphCommandTest, AFailedRunLeavesTheEarlierRunsFrames) {
+  const fs::path out = dir_ / "keep";
+  ASSERT_EQ(morph("--frames 4 --level 2 -o " + out.string()), 0);
+  const auto slurp = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  std::vector<std::string> before;
+  for (const char* name : {"morph_0000.obj", "morph_0001.obj", "morph_0003.obj"})
+    before.push_back(slurp(out / name));
+  fs::remove(out / "morph_0002.obj");
+  fs::create_directory(out / "morph_0002.obj");
+  EXPECT_EQ(morph("--frames 4 -o " + out.string()), 2);
+  std::vector<std::string> after;
+  for (const char* name : {"morph_0000.obj", "morph_0001.obj", "morph_0003.obj"})
+    after.push_back(slurp(out / name));
+  EXPECT_EQ(after, before);
+  fs::remove(out / "morph_0002.obj");
+  ASSERT_EQ(morph("--frames 4 --level 2 -o " + out.string()), 0);
+  const std::string cmd = "trap '' XFSZ; ulimit -f 4; " + std::string(GEOMIP_BINARY) + " morph " +
+                          (dir_ / "two.gip").string() + " --frames 4 -o " + out.string() + " > " +
+                          (dir_ / "log.txt").string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  after.clear();
+  for (const char* name : {"morph_0000.obj", "morph_0001.obj", "morph_0003.obj"})
+    after.push_back(slurp(out / name));
+  EXPECT_EQ(after, before);
+  for (const auto& entry : fs::directory_iterator(out))
+    EXPECT_EQ(entry.path().filename().string().rfind(".morph-partial", 0), std::string::npos) << entry.path();
 }
 
 }  // namespace

@@ -396,9 +396,22 @@ static CLI::Validator non_negative(const std::string& what) {
   return CLI::Validator(
       [what](std::string& v) {
         double x = 0;
-        return CLI::detail::lexical_cast(v, x) && x >= 0 ? std::string() : v + " is negative (" + what + ")";
+        if (!CLI::detail::lexical_cast(v, x) || !std::isfinite(x))
+          return v + " is not a number (" + what + ")";
+        return x >= 0 ? std::string() : v + " is negative (" + what + ")";
       },
       ">= 0");  // ASCII: CLI11 pads its help columns by bytes
+}
+
+/// A number that is not NaN or infinite (a NaN camera drew a blank frame and exited 0).
+static CLI::Validator finite(const std::string& what) {
+  return CLI::Validator(
+      [what](std::string& v) {
+        double x = 0;
+        return CLI::detail::lexical_cast(v, x) && std::isfinite(x) ? std::string()
+                                                                   : v + " is not a number (" + what + ")";
+      },
+      "finite");
 }
 
 /// The same for options that must be > 0.
@@ -406,8 +419,9 @@ static CLI::Validator positive(const std::string& what) {
   return CLI::Validator(
       [what](std::string& v) {
         double x = 0;
-        return CLI::detail::lexical_cast(v, x) && x > 0 ? std::string()
-                                                        : v + " is not above 0 (" + what + ")";
+        return CLI::detail::lexical_cast(v, x) && std::isfinite(x) && x > 0
+                   ? std::string()
+                   : v + " is not a number above 0 (" + what + ")";
       },
       "> 0");
 }
@@ -479,10 +493,12 @@ int main(int argc, char** argv) {
          "the models' up axis in their own units, shown upright whatever the pack's frame says (z for "
          "z-up data such as the horse); default: the frame `geomip convert --up` stored in the pack")
       ->check(CLI::IsMember({"x", "y", "z"}));
-  app.add_option("--yaw", opt.yaw, "camera yaw (radians)");
-  app.add_option("--pitch", opt.pitch, "camera pitch (radians)");
-  app.add_option("--distance", opt.distance,
-                 "camera distance (normalized units); default: the models fill about 70 % of the frame height");
+  app.add_option("--yaw", opt.yaw, "camera yaw (radians)")->check(finite("radians"));
+  app.add_option("--pitch", opt.pitch, "camera pitch (radians)")->check(finite("radians"));
+  app.add_option(
+         "--distance", opt.distance,
+         "camera distance (normalized units); default: the models fill about 70 % of the frame height")
+      ->check(positive("normalized units"));
   try {
     app.parse(argc, argv);
     opt.distance_given = app.count("--distance") > 0;

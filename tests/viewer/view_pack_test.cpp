@@ -656,6 +656,19 @@ TEST_F(ViewPackTest, MissingOrNonPackSourcesGiveAClearMessage) {
   EXPECT_NE(r.err.find("cannot open"), std::string::npos) << r.err;
 }
 
+// NaN and infinities are not numbers for the camera and the timeout (a NaN camera drew a blank frame and
+// exited 0; --timeout nan said "nan is negative"): exit 2, one line, before any window.
+TEST_F(ViewPackTest, NanCameraAndTimeoutAreRefused) {
+  const fs::path pack = pack_file(4);
+  for (const std::string option :
+       {"--yaw nan", "--pitch inf", "--distance nan", "--distance inf", "--timeout nan"}) {
+    const ViewRun r = view(pack.string() + " " + size_args() + " " + option);
+    EXPECT_EQ(r.code, 2) << option << ": " << r.err;
+    EXPECT_NE(r.err.find("not a number"), std::string::npos) << option << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+  }
+}
+
 TEST_F(ViewPackTest, BenchTwoModelLevel8MorphAt1280x720) {
   const fs::path pack = pack_file(8);
   for (std::string schedule : {"linear", "wavelet"}) {

@@ -102,7 +102,17 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   const auto write_to = [&](const fs::path& file) {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);
     if (!out) throw IoError(path + ": cannot create '" + file.string() + "': " + std::strerror(errno));
-    write(out);
+    try {
+      write(out);
+    } catch (const std::exception&) {
+      // A serializer that checks its stream (write_mesh: "writing the obj stream failed") throws before the
+      // checks below: the same message, with the path and the reason, when the stream is what failed.
+      if (out.fail()) {
+        const int error = errno;
+        throw IoError(path + ": write failed (" + std::strerror(error) + ")");
+      }
+      throw;
+    }
     out.flush();
     if (!out) throw IoError(path + ": write failed (" + std::strerror(errno) + ")");
     out.close();

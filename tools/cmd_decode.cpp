@@ -2,6 +2,7 @@
 // N bytes, as if only they had arrived) and writes each model as a mesh (glTF optionally Draco-compressed).
 #include "codec/pack.h"
 #include "codec/status.h"
+#include "gimage/resample.h"
 #include "mesh/errors.h"
 #include "mesh/gltf_io.h"
 #include "mesh/mesh_io.h"
@@ -83,6 +84,15 @@ int run_decode(const DecodeArgs& args) {
                                     std::to_string(bytes.size() >= 10 ? bytes[8] | bytes[9] << 8 : 0) +
                                     " with the layout of another version, or damaged sizes)"
                               : ": not a geomip pack (no GEOMIPK header)"));
+  }
+  // The format holds grids up to level 11, meshes are made up to level 10: a pack of a finer level is
+  // refused from its manifest, before its grids are decoded (it took 400 MB to find out).
+  if (codec::PackInfo info; codec::read_pack_info(bytes, info) == codec::Status::kOk) {
+    for (const codec::PackModelInfo& model : info.models)
+      if (model.geometry.level > kMaxGeometryImageLevel)
+        throw InvalidInput(args.pack + ": model '" + model.name + "' has grids of level " +
+                           std::to_string(model.geometry.level) + "; meshes are decoded up to level " +
+                           std::to_string(kMaxGeometryImageLevel));
   }
   codec::PackDecodeOptions options;
   if (args.bytes >= 0) options.max_bytes = static_cast<std::size_t>(args.bytes);

@@ -1,9 +1,11 @@
 // geomip repair IN -o OUT: make a scanned mesh closed, manifold and clean, ready for parameterization.
+#include "mesh/errors.h"
 #include "mesh/mesh_io.h"
 #include "mesh/mesh_repair.h"
 #include "mesh/mesh_topology.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
+#include "tools/model_inputs.h"
 #include "tools/progress.h"
 #include "tools/report.h"
 
@@ -60,8 +62,10 @@ int run_repair(const RepairArgs& args) {
   options.largest_component_only = args.largest_component;
   ProgressBar bar("repair", !args.quiet && !args.json);
   options.progress = bar.callback();
-  const RepairResult result = repair_mesh(input, options);
+  const RepairResult result = repair_named(args.input, input, options);
   bar.finish();
+  if (result.mesh.triangles.empty())
+    throw InvalidInput(args.input + ": no face is left after repair (each one degenerate or removed)");
   const TopologyReport after = analyze_topology(result.mesh);
 
   WriteMeshOptions write_options;

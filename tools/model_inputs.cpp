@@ -18,6 +18,18 @@
 #include <sstream>
 
 namespace geomip::tools {
+
+// repair_mesh() with its refusals said of `path` ("repair_mesh: every face is degenerate" named no file).
+RepairResult repair_named(const std::string& path, const TriMesh& input, const RepairOptions& options) {
+  try {
+    return repair_mesh(input, options);
+  } catch (const InvalidInput& e) {
+    std::string what = e.what();
+    if (what.rfind("repair_mesh: ", 0) == 0) what.erase(0, 13);
+    throw InvalidInput(path + ": " + what);
+  }
+}
+
 namespace {
 
 // The partition needs 4 partition points and 4 auxiliary points, distinct vertices (genus 0).
@@ -82,7 +94,7 @@ TriMesh prepare_mesh(const std::string& path, const TriMesh& input, const std::s
     check_parameterizable(path, input, r);
     return input;
   }
-  const RepairResult repaired = repair_mesh(input);
+  const RepairResult repaired = repair_named(path, input);
   check_parameterizable(path, repaired.mesh, r);
   if (!quiet) {
     std::cerr << command << ": " << path << ": "

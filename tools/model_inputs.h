@@ -3,6 +3,7 @@
 // ready for parameterize_consistently(). One function so the three commands parameterize identically.
 #pragma once
 
+#include "mesh/mesh_repair.h"
 #include "param/consistent_parameterization.h"
 #include "param/partition_points.h"
 
@@ -83,6 +84,9 @@ void apply_sampling(const ModelArgs& args, ParameterizationOptions& options);
 
 /// Registers ModelArgs' options on `cmd` (same names and help in every command).
 void add_model_options(CLI::App* cmd, ModelArgs& args);
+
+/// repair_mesh(), its refusals (every face degenerate, no triangles, ...) said of `path`.
+RepairResult repair_named(const std::string& path, const TriMesh& input, const RepairOptions& options = {});
 
 /// CLI::Range for a floating-point option that also refuses NaN and infinities (every comparison with NaN is
 /// false, so CLI::Range lets it through and the option silently acted as its default).

@@ -1451,6 +1451,18 @@ TEST_F(CliPack, NanOptionsSharedOutputsAndFlippedFacesAreHandled) {
                        "/m.ply' --error-map-original '" + dir_ + "/./m.ply'",
                    "overwrite");
   EXPECT_FALSE(fs::exists(dir_ + "/m.ply"));
+  // repair_mesh's refusals name the file (they said "repair_mesh: every face is degenerate").
+  const std::string collapsed =
+      file("collapsed.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n");
+  expect_bad_input("repair '" + collapsed + "' -o '" + dir_ + "/r.obj'",
+                   "collapsed.obj: every face is degenerate");
+  expect_bad_input("convert -q '" + collapsed + "' -o '" + dir_ + "/r.gip'",
+                   "collapsed.obj: every face is degenerate");
+  // A mesh whose faces all go in repair: said of the file, nothing written (it was "write_mesh: the mesh has
+  // no triangles").
+  const std::string line = file("line.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\n");
+  expect_bad_input("repair '" + line + "' -o '" + dir_ + "/r.obj'", "line.obj: no face is left after repair");
+  EXPECT_FALSE(fs::exists(dir_ + "/r.obj"));
   TriMesh flipped = read_mesh(spot_);
   std::swap(flipped.triangles[7][1], flipped.triangles[7][2]);
   const std::string path = dir_ + "/flipped.obj";
@@ -1937,6 +1949,37 @@ TEST_F(CliPack, ModelNamesBecomeSafeDistinctFileNames) {
   EXPECT_EQ(nlohmann::json::parse(r.out)["models"][0]["name"], "a/../../../escaped_xx");
 }
 
+// A pack whose grids are finer than any mesh decode makes (level 11: the format's bound is one above
+// meshes') is refused from its manifest with one line (it decoded 400 MB of grids to fail in the remesher).
+TEST_F(CliPack, DecodeRefusesALevelAboveMeshesFromTheManifest) {
+  const std::string pack = dir_ + "/s.gip";
+  ASSERT_EQ(
+      geomip("convert -q '" + spot_ + "' --level 3 --no-normals --patches 2 -o '" + pack + "'").exit_code, 0);
+  std::string bytes = slurp(pack);
+  // Manifest: name (varint length, bytes), normalization form (identity: 1 byte), the codec header as format
+  // 4 on stores it (varint offset, varint size, then serialize(): version byte, level varint, ...).
+  const std::size_t name = bytes.find("spot");
+  ASSERT_NE(name, std::string::npos);
+  const std::size_t level_at = name + 4 + 1 + 1 + 1 + 1;
+  ASSERT_EQ(static_cast<int>(bytes[level_at]), 3) << "the manifest layout changed";
+  bytes[level_at] = 11;
+  std::size_t at = 10, manifest_size = 0;  // magic (8), version u16, varint size, CRC32 u32, manifest
+  for (int shift = 0;; shift += 7) {
+    const auto b = static_cast<unsigned char>(bytes[at++]);
+    manifest_size |= static_cast<std::size_t>(b & 0x7f) << shift;
+    if (!(b & 0x80)) break;
+  }
+  const std::uint32_t crc =
+      codec::crc32({reinterpret_cast<const std::uint8_t*>(bytes.data()) + at + 4, manifest_size});
+  for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>((crc >> (8 * k)) & 0xff);
+  const std::string crafted = file("l11.gip", bytes);
+  const Outcome info = geomip("info --json '" + crafted + "'");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  ASSERT_EQ(nlohmann::json::parse(info.out)["models"][0]["level"], 11) << info.out;
+  expect_bad_input("decode '" + crafted + "' --level 0 -o '" + dir_ + "/l11.obj'", "up to level 10");
+  EXPECT_FALSE(fs::exists(dir_ + "/l11.obj"));
+}
+
 // Outputs that would destroy an input, or that cannot be written at all, are refused before any work (exit
 // 2).
 TEST_F(CliPack, OutputsOverInputsAndDirectoriesExitTwoBeforeAnyWork) {
@@ -1981,6 +2024,14 @@ TEST_F(CliPack, OutputsThatAreDevicesOrPipesAreWrittenThroughNotReplaced) {
   EXPECT_NE(r.err.find("/dev/full"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_TRUE(fs::is_character_file("/dev/full"));
+  // A mesh writer that checks its own stream names the file and the reason too (it said "write_mesh: writing
+  // the obj stream failed").
+  fs::create_symlink("/dev/full", dir_ + "/full.obj");
+  r = geomip("repair -q '" + spot_ + "' -o '" + dir_ + "/full.obj'");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("full.obj: write failed (No space left on device)"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir_ + "/full.obj"));
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   r = geomip("convert -q '" + spot_ + "' --level 3 --no-normals -o /dev/null");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::is_character_file("/dev/null"));

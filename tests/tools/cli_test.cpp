@@ -38,6 +38,21 @@ struct Outcome {
 };
 
 /// A spiked ellipsoid (protrusion tips for the tip and end loops) written as DIR/spiked.obj; its path.
+/// `bytes` (a pack of format 4 or later) with its manifest's CRC32 computed anew: crafted manifests that the
+/// readers take as intact.
+std::string with_manifest_crc(std::string bytes) {
+  std::size_t at = 10, manifest_size = 0;  // magic (8), version u16, varint size, CRC32 u32, manifest
+  for (int shift = 0;; shift += 7) {
+    const auto b = static_cast<unsigned char>(bytes[at++]);
+    manifest_size |= static_cast<std::size_t>(b & 0x7f) << shift;
+    if (!(b & 0x80)) break;
+  }
+  const std::uint32_t crc =
+      codec::crc32({reinterpret_cast<const std::uint8_t*>(bytes.data()) + at + 4, manifest_size});
+  for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>((crc >> (8 * k)) & 0xff);
+  return bytes;
+}
+
 std::string write_spiked_ellipsoid(const std::string& dir) {
   const std::string mesh = dir + "/spiked.obj";
   std::ofstream out(mesh);
@@ -1921,15 +1936,7 @@ TEST_F(CliPack, ModelNamesBecomeSafeDistinctFileNames) {
   ASSERT_NE(second, std::string::npos);
   bytes.replace(first, 21, "a/../../../escaped_xx");
   bytes.replace(second, 21, "\x1b[31mred\x07____________");  // ESC [31m red BEL, 12 underscores
-  std::size_t at = 10, manifest_size = 0;  // magic (8), version u16, varint size, CRC32 u32, manifest
-  for (int shift = 0;; shift += 7) {
-    const auto b = static_cast<unsigned char>(bytes[at++]);
-    manifest_size |= static_cast<std::size_t>(b & 0x7f) << shift;
-    if (!(b & 0x80)) break;
-  }
-  const std::uint32_t crc =
-      codec::crc32({reinterpret_cast<const std::uint8_t*>(bytes.data()) + at + 4, manifest_size});
-  for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>((crc >> (8 * k)) & 0xff);
+  bytes = with_manifest_crc(bytes);
   const std::string crafted = file("crafted.gip", bytes);
   fs::remove_all(dir_ + "/o");
   fs::create_directories(dir_ + "/o/s/x.a");
@@ -1963,15 +1970,7 @@ TEST_F(CliPack, DecodeRefusesALevelAboveMeshesFromTheManifest) {
   const std::size_t level_at = name + 4 + 1 + 1 + 1 + 1;
   ASSERT_EQ(static_cast<int>(bytes[level_at]), 3) << "the manifest layout changed";
   bytes[level_at] = 11;
-  std::size_t at = 10, manifest_size = 0;  // magic (8), version u16, varint size, CRC32 u32, manifest
-  for (int shift = 0;; shift += 7) {
-    const auto b = static_cast<unsigned char>(bytes[at++]);
-    manifest_size |= static_cast<std::size_t>(b & 0x7f) << shift;
-    if (!(b & 0x80)) break;
-  }
-  const std::uint32_t crc =
-      codec::crc32({reinterpret_cast<const std::uint8_t*>(bytes.data()) + at + 4, manifest_size});
-  for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>((crc >> (8 * k)) & 0xff);
+  bytes = with_manifest_crc(bytes);
   const std::string crafted = file("l11.gip", bytes);
   const Outcome info = geomip("info --json '" + crafted + "'");
   ASSERT_EQ(info.exit_code, 0) << info.err;

@@ -1,6 +1,7 @@
 #include "codec/layout_code.h"
 
 #include <bit>
+#include <tuple>
 #include <utility>
 
 namespace geomip::codec {
@@ -290,34 +291,39 @@ bool read_layout_code(std::span<const std::uint8_t> bytes, int num_patches, std:
   return true;
 }
 
-Grid3 rotate_grid(const Grid3& grid, int rotation) {
-  // One turn maps input (i, j) to (N − j, i), which carries side s to side s + 1; side s + rotation must
-  // become side s, so the grid takes (4 − rotation) mod 4 turns.
-  Grid3 out = grid;
-  const int n = grid.size(), last = n - 1;
-  for (int turn = 0; turn < (4 - rotation % 4) % 4; ++turn) {
-    Grid3 in = out;
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (int c = 0; c < 3; ++c)
-          out.values[static_cast<std::size_t>(3 * ((i)*n + (last - j)) + c)] =
-              in.values[static_cast<std::size_t>(3 * (j * n + i) + c)];
+namespace {
+
+/// An n × n row-major array of `channels`-value cells turned as rotate_grid() says, in one pass: a turn maps
+/// cell (i, j) to (n − 1 − j, i), which carries side s of a grid to side s + 1; side s + rotation must become
+/// side s, so a cell takes (4 − rotation) mod 4 turns.
+template <typename T>
+void turn_cells(const std::vector<T>& in, std::vector<T>& out, int n, int channels, int rotation) {
+  const int turns = (4 - rotation % 4) % 4;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      int ti = i, tj = j;
+      for (int t = 0; t < turns; ++t) std::tie(ti, tj) = std::pair(n - 1 - tj, ti);
+      const auto from = static_cast<std::size_t>(channels) * (static_cast<std::size_t>(j) * n + i);
+      const auto to = static_cast<std::size_t>(channels) * (static_cast<std::size_t>(tj) * n + ti);
+      for (int c = 0; c < channels; ++c) out[to + c] = in[from + c];
+    }
   }
+}
+
+}  // namespace
+
+Grid3 rotate_grid(const Grid3& grid, int rotation) {
+  Grid3 out = grid;
+  turn_cells(grid.values, out.values, grid.size(), 3, rotation);
   return out;
 }
 
 std::vector<std::uint8_t> rotate_quad_mask(const std::vector<std::uint8_t>& mask, int rotation) {
-  // Quads: input (qi, qj) → (M − 1 − qj, qi) per turn, as rotate_grid's samples.
   std::vector<std::uint8_t> out = mask;
   int m = 0;
   while (static_cast<std::size_t>(m) * static_cast<std::size_t>(m) < mask.size()) ++m;
-  if (static_cast<std::size_t>(m) * static_cast<std::size_t>(m) != mask.size()) return out;
-  for (int turn = 0; turn < (4 - rotation % 4) % 4; ++turn) {
-    const std::vector<std::uint8_t> in = out;
-    for (int qj = 0; qj < m; ++qj)
-      for (int qi = 0; qi < m; ++qi)
-        out[static_cast<std::size_t>(qi * m + (m - 1 - qj))] = in[static_cast<std::size_t>(qj * m + qi)];
-  }
+  if (static_cast<std::size_t>(m) * static_cast<std::size_t>(m) == mask.size())
+    turn_cells(mask, out, m, 1, rotation);
   return out;
 }
 

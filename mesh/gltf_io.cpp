@@ -32,6 +32,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <unordered_map>
@@ -338,9 +339,12 @@ class Reader {
   }
 
   void add_primitive(const tinygltf::Primitive& prim, const Matrix4& xf, TriMesh& out) const {
-    if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) return;  // points, lines, strips, fans: skipped
+    const int mode = prim.mode == -1 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN)
+      return;  // points and lines: no surface
     if (const auto draco = prim.extensions.find(kDracoExtension); draco != prim.extensions.end()) {
-      add_draco_primitive(draco->second, xf, out);
+      add_draco_primitive(draco->second, xf, out);  // Draco decodes to triangles whatever the mode
       return;
     }
     const auto pos = prim.attributes.find("POSITION");
@@ -359,24 +363,39 @@ class Reader {
         fail("vertex " + std::to_string(i) + " has a coordinate that is not finite or beyond float range");
       out.positions.push_back(q);
     }
-    if (prim.indices >= 0) {
-      const View ix = check_accessor(prim.indices, TINYGLTF_TYPE_SCALAR, "index");
-      if (ix.count % 3) fail("an index count is not a multiple of 3");
-      spend(ix.count / 3);
-      for (std::size_t i = 0; i < ix.count; i += 3) {
-        std::array<int, 3> t{};
-        for (int k = 0; k < 3; ++k) {
-          const std::uint32_t v = index_at(ix, i + k);
-          if (v >= p.count) fail("index " + std::to_string(v) + " is beyond the " + std::to_string(p.count) + " vertices");
-          t[k] = static_cast<int>(first + v);
-        }
-        out.triangles.push_back(t);
-      }
-    } else {
-      if (p.count % 3) fail("a non-indexed primitive's vertex count is not a multiple of 3");
-      spend(p.count / 3);
-      for (std::size_t i = 0; i < p.count; i += 3)
-        out.triangles.push_back({static_cast<int>(first + i), static_cast<int>(first + i + 1), static_cast<int>(first + i + 2)});
+    // The primitive's vertex sequence: its indices, or 0, 1, ... without them.
+    std::optional<View> ix;
+    if (prim.indices >= 0) ix = check_accessor(prim.indices, TINYGLTF_TYPE_SCALAR, "index");
+    const std::size_t n = ix ? ix->count : p.count;
+    const auto vertex = [&](std::size_t i) {
+      const std::uint32_t v = ix ? index_at(*ix, i) : static_cast<std::uint32_t>(i);
+      if (v >= p.count)
+        fail("index " + std::to_string(v) + " is beyond the " + std::to_string(p.count) + " vertices");
+      return static_cast<int>(first + v);
+    };
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (n % 3)
+        fail(ix ? "an index count is not a multiple of 3"
+                : "a non-indexed primitive's vertex count is not a multiple of 3");
+      spend(n / 3);
+      for (std::size_t i = 0; i < n; i += 3)
+        out.triangles.push_back({vertex(i), vertex(i + 1), vertex(i + 2)});
+      return;
+    }
+    // Strips and fans (glTF 2.0 §3.7.2.1): triangle i of a strip is (v_i, v_{i+1}, v_{i+2}), its odd ones
+    // turned (v_{i+1}, v_i, v_{i+2}) so every triangle keeps the first one's winding; of a fan (v_0, v_{i+1},
+    // v_{i+2}). Triangles with a repeated vertex (how strips are joined) are left out.
+    if (n < 3) return;
+    spend(n - 2);
+    const int v0 = vertex(0);
+    int a = v0, b = vertex(1);
+    for (std::size_t i = 2; i < n; ++i) {
+      const int c = vertex(i);
+      std::array<int, 3> t{a, b, c};
+      if (mode == TINYGLTF_MODE_TRIANGLE_STRIP && i % 2 == 1) t = {b, a, c};
+      if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) out.triangles.push_back(t);
+      if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) a = b;
+      b = c;
     }
   }
 

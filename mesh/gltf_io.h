@@ -6,11 +6,13 @@
 // GltfWriteOptions::draco_position_bits, the same primitive compressed by Draco (KHR_draco_mesh_compression,
 // listed in extensionsRequired: accessors without buffer views, one buffer view of Draco bytes), which
 // three.js (DRACOLoader), Blender, Babylon.js and gltf-transform decode.
-// Input: every triangle primitive (mode TRIANGLES, indexed or not) of every mesh reachable from the default
+// Input: every triangle primitive (modes TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN, indexed or not; strips
+// and fans split into triangles of the first one's winding, those with a repeated vertex left out; points and
+// lines skipped) of every mesh reachable from the default
 // scene (all nodes when the file has no scene), node transforms applied, merged into one TriMesh, vertices at
 // bit-identical positions merged into one (glTF splits a vertex wherever an attribute changes — texture
 // seams, hard edges — and geomip reads positions only). Accessors
-// are checked against their buffers before a byte is read; sparse accessors, strips and fans are refused.
+// are checked against their buffers before a byte is read; sparse accessors are refused.
 #pragma once
 
 #include "mesh/mesh.h"

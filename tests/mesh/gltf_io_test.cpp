@@ -440,6 +440,105 @@ TEST(GltfIo, IndicesBeyondTheVertexCountAreRefused) {
   expect_refused(bytes, "beyond the");
 }
 
+// A glTF of one primitive in `mode` (4 triangles, 5 strip, 6 fan, 0 points) over float `positions`, indexed
+// by uint16 `indices` (none when empty), its buffer a base64 data URI.
+std::string primitive_gltf(const std::vector<Eigen::Vector3f>& positions,
+                           const std::vector<std::uint16_t>& indices, int mode) {
+  std::string bytes(positions.size() * 12 + indices.size() * 2, '\0');
+  std::memcpy(bytes.data(), positions.data(), positions.size() * 12);
+  if (!indices.empty()) std::memcpy(bytes.data() + positions.size() * 12, indices.data(), indices.size() * 2);
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string b64;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    std::uint32_t v = 0;
+    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
+    for (std::size_t k = 0; k < 3; ++k) v = v << 8 | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
+    for (std::size_t k = 0; k < 4; ++k) b64 += k <= n ? kAlphabet[v >> (18 - 6 * k) & 63] : '=';
+  }
+  Eigen::Vector3f lo = positions[0], hi = positions[0];
+  for (const auto& p : positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  nlohmann::json j;
+  j["asset"]["version"] = "2.0";
+  j["buffers"] = {{{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + b64}}};
+  j["bufferViews"] = {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", positions.size() * 12}}};
+  j["accessors"] = {{{"bufferView", 0},
+                     {"componentType", 5126},
+                     {"count", positions.size()},
+                     {"type", "VEC3"},
+                     {"min", {lo.x(), lo.y(), lo.z()}},
+                     {"max", {hi.x(), hi.y(), hi.z()}}}};
+  nlohmann::json prim = {{"attributes", {{"POSITION", 0}}}, {"mode", mode}};
+  if (!indices.empty()) {
+    j["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", positions.size() * 12}, {"byteLength", indices.size() * 2}});
+    j["accessors"].push_back(
+        {{"bufferView", 1}, {"componentType", 5123}, {"count", indices.size()}, {"type", "SCALAR"}});
+    prim["indices"] = 1;
+  }
+  j["meshes"] = {{{"primitives", {prim}}}};
+  j["nodes"] = {{{"mesh", 0}}};
+  j["scenes"] = {{{"nodes", {0}}}};
+  j["scene"] = 0;
+  return j.dump();
+}
+
+// Every triangle's normal along +z (the winding of a strip's or fan's first triangle), none degenerate.
+void expect_all_facing_up(const TriMesh& m) {
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3d n =
+        (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]);
+    EXPECT_GT(n.z(), 1e-9) << t[0] << ' ' << t[1] << ' ' << t[2];
+  }
+}
+
+// Strips and fans (glTF 2.0 §3.7.2.1), which exporters of older engines still write: split into triangles of
+// one winding (a strip's odd triangles turned), the degenerate ones that join strips left out. They were
+// skipped before, so a file of strips read as "no triangles".
+TEST(GltfIo, StripsAndFansAreSplitIntoTrianglesOfOneWinding) {
+  // A strip along −x: v_{2k} = (−k, 0, 0), v_{2k+1} = (−k, 1, 0), so its first triangle 0 1 2 is
+  // counter-clockwise seen from +z.
+  std::vector<Eigen::Vector3f> grid;
+  for (int k = 0; k < 4; ++k) grid.emplace_back(-k, 0, 0), grid.emplace_back(-k, 1, 0);
+  const std::vector<std::uint16_t> strip{0, 1, 2, 3, 4, 5, 6, 7};
+  for (const bool indexed : {true, false}) {
+    const TriMesh m = read_gltf_from_memory(
+        primitive_gltf(grid, indexed ? strip : std::vector<std::uint16_t>{}, 5), "strip.gltf", "");
+    EXPECT_EQ(m.triangles.size(), 6u) << indexed;
+    expect_all_facing_up(m);
+    double area = 0;
+    for (const auto& t : m.triangles)
+      area +=
+          0.5 * (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]).norm();
+    EXPECT_NEAR(area, 3.0, 1e-12) << "the strip covers its 3 × 1 rectangle once";
+  }
+  // Two strips joined by repeated vertices (3 3 4 4): the four degenerate triangles are left out, and the
+  // second strip's parity is its own again.
+  std::vector<Eigen::Vector3f> two = {grid[0], grid[1], grid[2], grid[3]};
+  for (int k = 0; k < 2; ++k) two.emplace_back(-5 - k, 0, 0), two.emplace_back(-5 - k, 1, 0);
+  const TriMesh joined =
+      read_gltf_from_memory(primitive_gltf(two, {0, 1, 2, 3, 3, 4, 4, 5, 6, 7}, 5), "joined.gltf", "");
+  EXPECT_EQ(joined.triangles.size(), 4u);
+  expect_all_facing_up(joined);
+  // A fan around the origin, counter-clockwise, closed by repeating its first rim vertex.
+  std::vector<Eigen::Vector3f> disc{{0, 0, 0}};
+  for (int k = 0; k < 6; ++k)
+    disc.emplace_back(static_cast<float>(std::cos(k * M_PI / 3)), static_cast<float>(std::sin(k * M_PI / 3)),
+                      0.f);
+  const TriMesh fan =
+      read_gltf_from_memory(primitive_gltf(disc, {0, 1, 2, 3, 4, 5, 6, 1}, 6), "fan.gltf", "");
+  EXPECT_EQ(fan.triangles.size(), 6u);
+  expect_all_facing_up(fan);
+  // Points (mode 0) are no surface: a file of only points has no triangles.
+  expect_refused(primitive_gltf(disc, {}, 0), "no triangles");
+  // A strip's indices are still checked against the vertices.
+  try {
+    read_gltf_from_memory(primitive_gltf(grid, {0, 1, 2, 9}, 5), "crafted.gltf", "");
+    ADD_FAILURE() << "an index past the vertices was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond the"), std::string::npos) << e.what();
+  }
+}
+
 TEST(VertexNormals, AreUnitAndOutwardOnASphereAndDefinedForLooseVertices) {
   TriMesh sphere = test::sphere(2);
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();

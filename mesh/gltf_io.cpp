@@ -780,6 +780,15 @@ TriMesh read_gltf_from_memory(std::string_view original, const std::string& name
   tinygltf::Model model;
   std::string err, warn;
   const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  if (!binary) {
+    // A .gltf is a JSON object (after an optional UTF-8 byte-order mark and white space); anything else is
+    // named as such instead of by the JSON parser's complaint about its first byte.
+    std::string_view text = bytes.substr(bytes.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0);
+    const std::size_t start = text.find_first_not_of(" \t\r\n");
+    if (start == std::string_view::npos || text[start] != '{')
+      throw InvalidInput(
+          name + ": not a glTF file (neither a binary glTF, which starts with 'glTF', nor a JSON object)");
+  }
   bool ok = false;
   try {
     ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),

@@ -183,8 +183,11 @@ void expect_refused(const std::string& bytes, const std::string& problem) {
 TEST(GltfIo, CraftedFilesAreRefusedWithAMessage) {
   const TriMesh tet = test::tetrahedron();
   const auto good = nlohmann::json::parse(to_gltf(tet, {}, false));
-  expect_refused("", "not a readable glTF");
+  expect_refused("", "not a glTF file (neither a binary glTF");
+  expect_refused("\x8f\x02garbage bytes", "not a glTF file (neither a binary glTF");
+  expect_refused("  [1, 2]", "not a glTF file (neither a binary glTF");
   expect_refused("glTF\x02\0\0\0garbage", "not a readable glTF");
+  expect_refused("\xEF\xBB\xBF {\"asset\": {\"version\": \"2.0\"}}", "no triangles");  // a BOM is fine
   expect_refused("{\"asset\": {\"version\": \"2.0\"}}", "no triangles");
   auto j = good;
   j["accessors"][0]["count"] = 1000000;  // POSITION past its buffer view

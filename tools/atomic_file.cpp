@@ -13,6 +13,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 
 namespace geomip::tools {
 
@@ -26,6 +28,47 @@ bool writes_in_place(const std::string& path) {
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
   return !ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st);
+}
+
+/// Opens `file`, calls `write` with it, flushes and closes it; an IoError naming `path` (the target) on any
+/// failure of the stream.
+void write_stream(const std::filesystem::path& file, const std::string& path,
+                  const std::function<void(std::ostream&)>& write) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) throw IoError(path + ": cannot create '" + file.string() + "': " + std::strerror(errno));
+  try {
+    write(out);
+  } catch (const std::exception&) {
+    // A serializer that checks its stream (write_mesh: "writing the obj stream failed") throws before the
+    // checks below: the same message, with the path and the reason, when the stream is what failed.
+    if (out.fail()) {
+      const int error = errno;
+      throw IoError(path + ": write failed (" + std::strerror(error) + ")");
+    }
+    throw;
+  }
+  out.flush();
+  if (!out) throw IoError(path + ": write failed (" + std::strerror(errno) + ")");
+  out.close();
+  if (out.fail()) throw IoError(path + ": closing the file failed");
+}
+
+/// The temporary file of target `path`: ".<name>.tmp-<pid>" in its directory (a rename within one file
+/// system).
+std::filesystem::path temporary_beside(const std::string& path) {
+  const std::filesystem::path target(path);
+  const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
+  std::string name = ".";
+  name += target.filename().string();
+  name += ".tmp-";
+  name += std::to_string(::getpid());
+  return dir / name;
+}
+
+void rename_into_place(const std::filesystem::path& tmp, const std::string& path) {
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw IoError(path + ": cannot rename the temporary file into place: " + ec.message());
 }
 
 }  // namespace
@@ -95,48 +138,144 @@ std::vector<std::string> model_file_names(const std::vector<std::string>& names)
 }
 
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
   check_output_file(path);
-  // Opens `file`, writes, flushes and closes it; an IoError naming `path` on any failure.
-  const auto write_to = [&](const fs::path& file) {
-    std::ofstream out(file, std::ios::binary | std::ios::trunc);
-    if (!out) throw IoError(path + ": cannot create '" + file.string() + "': " + std::strerror(errno));
-    try {
-      write(out);
-    } catch (const std::exception&) {
-      // A serializer that checks its stream (write_mesh: "writing the obj stream failed") throws before the
-      // checks below: the same message, with the path and the reason, when the stream is what failed.
-      if (out.fail()) {
-        const int error = errno;
-        throw IoError(path + ": write failed (" + std::strerror(error) + ")");
-      }
-      throw;
-    }
-    out.flush();
-    if (!out) throw IoError(path + ": write failed (" + std::strerror(errno) + ")");
-    out.close();
-    if (out.fail()) throw IoError(path + ": closing the file failed");
-  };
   if (writes_in_place(path)) {
-    write_to(target);
+    write_stream(path, path, write);
     return;
   }
-  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  std::error_code ec;
-  std::string tmp_name = ".";
-  tmp_name += target.filename().string();
-  tmp_name += ".tmp-";
-  tmp_name += std::to_string(::getpid());
-  const fs::path tmp = dir / tmp_name;
+  const std::filesystem::path tmp = temporary_beside(path);
   try {
-    write_to(tmp);
-    fs::rename(tmp, target, ec);
-    if (ec) throw IoError(path + ": cannot rename the temporary file into place: " + ec.message());
+    write_stream(tmp, path, write);
+    rename_into_place(tmp, path);
   } catch (...) {
-    fs::remove(tmp, ec);
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
     throw;
   }
+}
+
+AtomicFileSet::~AtomicFileSet() {
+  for (const Entry& e : entries_) {
+    std::error_code ignored;
+    if (!e.done && !e.temporary.empty()) std::filesystem::remove(e.temporary, ignored);
+  }
+}
+
+AtomicFileSet::Entry AtomicFileSet::entry_for(const std::string& path) const {
+  namespace fs = std::filesystem;
+  check_output_file(path);
+  Entry e;
+  e.path = path;
+  if (writes_in_place(path)) return e;  // a device written twice is no conflict (both maps to /dev/null)
+  // Two names of one file (x.obj, ./x.obj, a link to the directory) would share one temporary file.
+  const fs::path dir = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  std::error_code ec;
+  const fs::path canonical_dir = fs::canonical(dir, ec);
+  e.identity = (ec ? fs::absolute(dir).lexically_normal() : canonical_dir) / fs::path(path).filename();
+  for (const Entry& other : entries_) {
+    if (other.identity == e.identity)
+      throw InvalidInput(path + ": named twice among the outputs (as " + other.path + " before)");
+  }
+  e.temporary = temporary_beside(path);
+  return e;
+}
+
+std::uintmax_t AtomicFileSet::add(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  Entry e = entry_for(path);
+  if (e.temporary.empty()) {
+    std::ostringstream bytes;
+    write(bytes);
+    e.bytes = std::move(bytes).str();
+    entries_.push_back(std::move(e));
+    return entries_.back().bytes.size();
+  }
+  try {
+    write_stream(e.temporary, path, write);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(e.temporary, ignored);
+    throw;
+  }
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(e.temporary, ec);
+  entries_.push_back(std::move(e));
+  return ec ? 0 : size;
+}
+
+std::uintmax_t AtomicFileSet::add_file(const std::string& path,
+                                       const std::function<void(const std::string& file)>& write) {
+  namespace fs = std::filesystem;
+  Entry e = entry_for(path);
+  // A device or pipe: the writer writes a file in the temporary directory, which is read back and removed.
+  const bool in_place = e.temporary.empty();
+  const fs::path file = in_place ? fs::temp_directory_path() / (".geomip-" + std::to_string(::getpid()) +
+                                                                "-" + std::to_string(entries_.size()))
+                                 : e.temporary;
+  try {
+    try {
+      write(file.string());
+    } catch (const IoError& error) {  // a message that names the temporary file only: the target too
+      if (std::string(error.what()).find(path) == std::string::npos)
+        throw IoError(path + ": " + error.what());
+      throw;
+    }
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec))
+      throw IoError(path + ": the writer created no file '" + file.string() + "'");
+    const std::uintmax_t size = fs::file_size(file);
+    if (in_place) {
+      std::ifstream in(file, std::ios::binary);
+      e.bytes.assign(std::istreambuf_iterator<char>(in), {});
+      if (!in.good() && !in.eof()) throw IoError(path + ": cannot read back '" + file.string() + "'");
+      fs::remove(file, ec);
+    }
+    entries_.push_back(std::move(e));
+    return size;
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(file, ignored);
+    throw;
+  }
+}
+
+void AtomicFileSet::commit() {
+  namespace fs = std::filesystem;
+  if (committed_) return;
+  // What most often stops a rename, found before any target is replaced.
+  for (const Entry& e : entries_) {
+    std::error_code ec;
+    if (!e.temporary.empty() && fs::is_directory(e.path, ec))
+      throw InvalidInput(e.path + ": is a directory, not a file to write");
+  }
+  // Devices and pipes first: a full one fails while every file target is still as it was.
+  std::vector<Entry*> order;
+  for (Entry& e : entries_)
+    if (e.temporary.empty()) order.push_back(&e);
+  for (Entry& e : entries_)
+    if (!e.temporary.empty()) order.push_back(&e);
+  for (Entry* e : order) {
+    try {
+      if (e->temporary.empty()) {
+        write_stream(e->path, e->path, [&](std::ostream& out) {
+          out.write(e->bytes.data(), static_cast<std::streamsize>(e->bytes.size()));
+        });
+      } else {
+        rename_into_place(e->temporary, e->path);
+      }
+    } catch (const std::exception& error) {
+      std::string replaced, kept;
+      for (const Entry* other : order) {
+        if (other == e) continue;
+        std::string& list = other->done ? replaced : kept;
+        list += (list.empty() ? "" : ", ") + other->path;
+      }
+      if (replaced.empty()) throw;  // nothing replaced: the message says all
+      throw IoError(std::string(error.what()) + "; written already: " + replaced +
+                    (kept.empty() ? std::string() : "; left as they were: " + kept));
+    }
+    e->done = true;
+  }
+  committed_ = true;
 }
 
 void check_output_directory(const std::string& dir) {

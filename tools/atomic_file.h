@@ -1,7 +1,10 @@
 // Atomic output files: written to a temporary file beside the target, then renamed over it. A failed or
-// interrupted run leaves no partial file under the target name (and removes its temporary file).
+// interrupted run leaves no partial file under the target name (and removes its temporary file). A command
+// that writes several files writes them as one AtomicFileSet: all of them or none.
 #pragma once
 
+#include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <iosfwd>
 #include <string>
@@ -16,6 +19,65 @@ namespace geomip::tools {
 /// replace the device node or the pipe); a failed write there is an IoError.
 /// \throw IoError when the directory is not writable or the disk is full.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+/// The output files of one run, all or nothing: a decoded pack's meshes (one per model), a remesh's
+/// .obj/.ply/.glb, a parameterization's .param.obj and .param.json.
+///
+/// add() writes each file as it comes to a temporary file beside its target (".<name>.tmp-<pid>"), so the
+/// files of a set are never all in memory; the targets are not touched. commit() moves them into place
+/// only when every add() has succeeded. A set destroyed without commit() (an add() threw, the command failed
+/// in between) removes its temporary files: every target stays as it was, new or old.
+///
+/// Targets that are devices or pipes (/dev/null, /dev/full, a named pipe: written in place, as by
+/// write_file_atomically()) are kept in memory by add() and written by commit() before any file is renamed:
+/// a full device fails the set while no target has been replaced.
+///
+/// Not jointly atomic: the renames are one per file. commit() renames in the order of add() and stops at
+/// the first that fails; the targets renamed before it stay replaced (the exception's message names them
+/// and the ones left as they were). What usually makes a rename fail (a directory created at a target's
+/// place since add()) is checked for every target before the first rename. A process killed by a signal
+/// leaves its temporary files (hidden names, the pid in them), as write_file_atomically() does.
+class AtomicFileSet {
+ public:
+  AtomicFileSet() = default;
+  AtomicFileSet(const AtomicFileSet&) = delete;
+  AtomicFileSet& operator=(const AtomicFileSet&) = delete;
+  /// Without a successful commit(): removes the temporary files; the targets are untouched.
+  ~AtomicFileSet();
+
+  /// Checks `path` (check_output_file()) and calls `write` with a stream to its temporary file, which is
+  /// flushed and closed. Returns the bytes written. If `write` throws or the stream fails, that temporary
+  /// file is removed and the exception (or an IoError naming `path`) propagates; the files added before
+  /// stay added, to be committed or dropped.
+  /// 	hrow InvalidInput when `path` cannot be written (check_output_file()) or is a file already in the
+  /// set (under any name); IoError when the disk is full or the temporary file cannot be created.
+  std::uintmax_t add(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+  /// add() for a writer that takes a file name, not a stream (write_geometry_image_exr()): `write` is given
+  /// the temporary file's name and must create that file. Returns its size.
+  /// 	hrow as add(); IoError when `write` returns without having created the file.
+  std::uintmax_t add_file(const std::string& path, const std::function<void(const std::string& file)>& write);
+
+  /// Writes the devices and pipes, then renames every temporary file over its target in the order added.
+  /// Calling it again does nothing.
+  /// 	hrow InvalidInput when a target has become a directory since add() (nothing replaced); IoError when
+  /// a device write or a rename fails: its message names the failed target and, when some targets were
+  /// replaced before it, lists those replaced and those left as they were.
+  void commit();
+
+ private:
+  struct Entry {
+    std::string path;                 ///< the target as given
+    std::filesystem::path identity;   ///< its canonical directory and name; empty for a device or pipe
+    std::filesystem::path temporary;  ///< beside it; empty for a device or pipe
+    std::string bytes;                ///< a device's or pipe's contents, written by commit()
+    bool done = false;                ///< renamed or written by commit()
+  };
+  /// A new entry for `path`, checked: writable, not in the set yet.
+  Entry entry_for(const std::string& path) const;
+  std::vector<Entry> entries_;
+  bool committed_ = false;
+};
 
 /// Checks, before any work, that a pack output is not named like a mesh (x.obj, x.glb, ...) or an EXR image:
 /// a .gip pack under such an extension would be opened as one by other tools. \throw InvalidInput naming

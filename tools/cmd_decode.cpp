@@ -11,6 +11,7 @@
 #include "tools/commands.h"
 #include "tools/pack_file.h"
 #include "tools/pack_models.h"
+#include "tools/report.h"
 
 #include <nlohmann/json.hpp>
 
@@ -165,6 +166,7 @@ int run_decode(const DecodeArgs& args) {
             ? args.output
             : (out.parent_path() / (out.stem().string() + "." + file_names[m] + out.extension().string()))
                   .string());
+    check_output_is_not_an_input(paths.back(), {args.pack});
   }
   const QuadSplit quad_split = args.quad_split == "fixed" ? QuadSplit::kFixed : QuadSplit::kShorter;
   nlohmann::json j_models = nlohmann::json::array();
@@ -178,6 +180,9 @@ int run_decode(const DecodeArgs& args) {
   std::vector<codec::DecodedModel> as_decoded;
   if (untangle) as_decoded = decoded.models;
   const std::vector<codec::DecodedModel>& choosers = untangle ? as_decoded : decoded.models;
+  // Every model's mesh or none: a model that cannot be written leaves the earlier ones unwritten too.
+  AtomicFileSet files;
+  std::string report;  // printed once the files are in place
   for (std::size_t m = 0; m < decoded.models.size(); ++m) {
     // The models of the same layout (a consistent pack: all of them) choose the quad split together, so they
     // keep one face list (as far as their hole masks agree).
@@ -199,7 +204,7 @@ int run_decode(const DecodeArgs& args) {
                               : decoded_mesh_with_map_normals(decoded.models[m], args.level, split,
                                                               write_options.vertex_normals);
     const TriMesh& written = gltf ? textured.mesh : mesh;
-    write_file_atomically(paths[m], [&](std::ostream& o) {
+    files.add(paths[m], [&](std::ostream& o) {
       if (gltf)
         write_gltf(textured.mesh, textured.attributes, o,
                    {.binary = format == MeshFormat::kGlb,
@@ -220,12 +225,15 @@ int run_decode(const DecodeArgs& args) {
           {"folded_after", untangled.folded_after}, {"moved", untangled.moved},
           {"max_move", untangled.max_move},         {"sweeps", untangled.sweeps}};
     if (!args.quiet && !args.json) {
-      std::printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",
-                  codec::one_line(decoded.models[m].name).c_str(), codec::one_line(paths[m]).c_str(),
-                  written.num_triangles(), args.level < 0 ? grid_level : args.level,
-                  decoded.models[m].detail_level, decoded.models[m].geometry_passes);
+      report +=
+          string_printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",
+                        codec::one_line(decoded.models[m].name).c_str(), codec::one_line(paths[m]).c_str(),
+                        written.num_triangles(), args.level < 0 ? grid_level : args.level,
+                        decoded.models[m].detail_level, decoded.models[m].geometry_passes);
     }
   }
+  files.commit();
+  std::fputs(report.c_str(), stdout);
   if (args.json) {
     std::cout << nlohmann::json{{"pack", args.pack},
                                 {"status", std::string(codec::status_message(decoded.status))},

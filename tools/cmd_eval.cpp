@@ -101,18 +101,19 @@ int run_eval(EvalArgs args) {
     ErrorMapOptions map_options;
     map_options.scale = scale;
     map_options.diagonal = d.bbox_diagonal;
+    AtomicFileSet files;  // both maps or neither
     if (!args.error_map.empty()) {
       map_options.comment = args.approx + " (distance to " + args.original + ")";
-      write_file_atomically(args.error_map, [&](std::ostream& out) {
-        write_error_map(approx, d.approx_to_original, map_options, out);
-      });
+      files.add(args.error_map,
+                [&](std::ostream& out) { write_error_map(approx, d.approx_to_original, map_options, out); });
     }
     if (!args.error_map_original.empty()) {
       map_options.comment = args.original + " (distance to " + args.approx + ")";
-      write_file_atomically(args.error_map_original, [&](std::ostream& out) {
+      files.add(args.error_map_original, [&](std::ostream& out) {
         write_error_map(original, d.original_to_approx, map_options, out);
       });
     }
+    files.commit();
   }
 
   if (args.json) {

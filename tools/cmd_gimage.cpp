@@ -10,6 +10,7 @@
 #include "tools/commands.h"
 #include "tools/model_inputs.h"
 #include "tools/progress.h"
+#include "tools/report.h"
 
 #include <nlohmann/json.hpp>
 
@@ -61,6 +62,9 @@ int run_gimage(const GimageArgs& args) {
   make_output_directory(args.common.output);
 
   nlohmann::json summary = nlohmann::json::array();
+  // Every model's two images or none: an image that cannot be written leaves no other behind.
+  AtomicFileSet files;
+  std::string report;  // printed once the files are in place
   for (std::size_t i = 0; i < result.size(); ++i) {
     t0 = std::chrono::steady_clock::now();
     ResampleOptions resample;
@@ -81,12 +85,14 @@ int run_gimage(const GimageArgs& args) {
     info.source_mesh = std::filesystem::path(models.paths[i]).filename().string();
     info.adjacency = images.adjacency;
     t0 = std::chrono::steady_clock::now();
-    write_geometry_image_exr(stem + ".geometry.exr", images.geometry, info);
+    const auto geometry_bytes = files.add_file(stem + ".geometry.exr", [&](const std::string& file) {
+      write_geometry_image_exr(file, images.geometry, info);
+    });
     info.kind = "normals";
-    write_geometry_image_exr(stem + ".normals.exr", images.normals, info, {true, 64});
+    const auto normals_bytes = files.add_file(stem + ".normals.exr", [&](const std::string& file) {
+      write_geometry_image_exr(file, images.normals, info, {true, 64});
+    });
     const double write_seconds = seconds_since(t0);
-    const auto geometry_bytes = std::filesystem::file_size(stem + ".geometry.exr");
-    const auto normals_bytes = std::filesystem::file_size(stem + ".normals.exr");
     if (args.common.json) {
       summary.push_back({{"mesh", models.paths[i]},
                          {"geometry", stem + ".geometry.exr"},
@@ -102,16 +108,18 @@ int run_gimage(const GimageArgs& args) {
                          {"fit", args.fit}});
       if (args.fit) summary.back()["fit_seconds"] = fit_seconds;
     } else if (!args.common.quiet) {
-      std::printf(
+      report += string_printf(
           "gimage %s → %s.geometry.exr (%zu patches, %d², %.1f KiB), %s.normals.exr (%d², %.1f KiB); "
           "resampled in %.3f s",
           models.paths[i].c_str(), stem.c_str(), images.geometry.size(), images.geometry.front().size(),
           geometry_bytes / 1024.0, stem.c_str(), images.normals.front().size(), normals_bytes / 1024.0,
           resample_seconds);
-      if (args.fit) std::printf(", fitted in %.3f s", fit_seconds);
-      std::printf("\n");
+      if (args.fit) report += string_printf(", fitted in %.3f s", fit_seconds);
+      report += "\n";
     }
   }
+  files.commit();
+  std::fputs(report.c_str(), stdout);
   if (args.common.json) {
     std::cout << nlohmann::json{{"models", summary}, {"param_seconds", param_seconds}}.dump(
                      2, ' ', false, nlohmann::json::error_handler_t::replace)

@@ -1,12 +1,13 @@
 // geomip param MESH... -o DIR [--points CORR.json]: consistent parameterization (paper §3), written as
 // DIR/<stem>.param.obj (per-patch texture coordinates) and DIR/<stem>.param.json (layout and figures).
+#include "mesh/errors.h"
 #include "param/consistent_parameterization.h"
 #include "param/unit_square.h"
-#include "mesh/errors.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/model_inputs.h"
 #include "tools/progress.h"
+#include "tools/report.h"
 
 #include <nlohmann/json.hpp>
 
@@ -147,29 +148,34 @@ int run_param(const ParamArgs& args) {
   // Only now: a failed run leaves no (empty) output directory behind.
   make_output_directory(args.common.output);
   nlohmann::json summary = nlohmann::json::array();
+  // Every model's .param.obj and .param.json or none: a file that cannot be written leaves no other behind.
+  AtomicFileSet files;
+  std::string report;  // printed once the files are in place
   for (std::size_t i = 0; i < result.size(); ++i) {
     const std::string stem = (std::filesystem::path(args.common.output) / inputs[i].name).string();
-    write_file_atomically(stem + ".param.obj",
-                          [&](std::ostream& out) { write_param_obj(out, result[i], paths[i]); });
+    files.add(stem + ".param.obj", [&](std::ostream& out) { write_param_obj(out, result[i], paths[i]); });
     nlohmann::json j = param_json(result[i], paths[i], inputs[i]);
     if (!inputs[i].layout_quads.empty()) j["layout_quads"] = inputs[i].layout_quads;  // corners: partition_points
     j["seconds"]["total_all_models"] = seconds;
-    write_file_atomically(stem + ".param.json", [&](std::ostream& out) {
+    files.add(stem + ".param.json", [&](std::ostream& out) {
       out << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     });
     if (args.common.json) {
       summary.push_back({{"mesh", paths[i]}, {"obj", stem + ".param.obj"}, {"json", stem + ".param.json"},
                          {"patches", j["patches"].size()}, {"flipped_triangles", j["flipped_triangles"]}});
     } else if (!args.common.quiet) {
-      std::cout << "param " << paths[i] << " → " << stem << ".param.obj\n";
+      report += "param " + paths[i] + " → " + stem + ".param.obj\n";
       for (const auto& p : result[i].patches) {
-        std::printf("  patch: %zu vertices, L2 stretch %.4f, Linf %.3f", p.vertices.size(), p.stretch.l2,
-                    p.stretch.linf);
-        if (p.mvc_stretch.l2 > 0) std::printf(" (MVC: %.4f, %.3f)", p.mvc_stretch.l2, p.mvc_stretch.linf);
-        std::printf(", %zu flipped%s\n", p.flipped, p.mvc_fallback ? ", optimized MVC kept" : "");
+        report += string_printf("  patch: %zu vertices, L2 stretch %.4f, Linf %.3f", p.vertices.size(),
+                                p.stretch.l2, p.stretch.linf);
+        if (p.mvc_stretch.l2 > 0)
+          report += string_printf(" (MVC: %.4f, %.3f)", p.mvc_stretch.l2, p.mvc_stretch.linf);
+        report += string_printf(", %zu flipped%s\n", p.flipped, p.mvc_fallback ? ", optimized MVC kept" : "");
       }
     }
   }
+  files.commit();
+  std::cout << report;
   if (args.common.json) {
     std::cout << nlohmann::json{{"models", summary}, {"seconds", seconds}}.dump(
                      2, ' ', false, nlohmann::json::error_handler_t::replace)

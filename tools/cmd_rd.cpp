@@ -397,7 +397,7 @@ int run_rd(const RdArgs& args) {
     }
   }
 
-  // Render both files first, then write them atomically: a failure leaves neither half-written.
+  // Render both files first, then write them as one set: a failure leaves none of them written.
   std::ostringstream csv, svg;
   write_rd_csv(csv, all);
   RdPlotOptions plot;
@@ -407,14 +407,16 @@ int run_rd(const RdArgs& args) {
   write_rd_svg(svg, all, plot);
   make_output_directory(args.output);
   const std::filesystem::path dir(args.output);
-  write_file_atomically((dir / "rd.csv").string(), [&](std::ostream& out) { out << csv.str(); });
-  write_file_atomically((dir / "rd.svg").string(), [&](std::ostream& out) { out << svg.str(); });
+  AtomicFileSet files;  // the table, the plot and the pack, or none of them
+  files.add((dir / "rd.csv").string(), [&](std::ostream& out) { out << csv.str(); });
+  files.add((dir / "rd.svg").string(), [&](std::ostream& out) { out << svg.str(); });
   const std::string pack_path = (dir / (std::filesystem::path(args.mesh).stem().string() + ".gip")).string();
   if (!pack.empty()) {
-    write_file_atomically(pack_path, [&](std::ostream& out) {
+    files.add(pack_path, [&](std::ostream& out) {
       out.write(reinterpret_cast<const char*>(pack.data()), static_cast<std::streamsize>(pack.size()));
     });
   }
+  files.commit();
 
   // geomip against the Draco envelopes at the sizes issues 5 and 14 name: draco_envelope (meshoptimizer's
   // decimation) always, draco_lt_envelope (Lindstrom–Turk, the stronger baseline) with --lindstrom-turk.

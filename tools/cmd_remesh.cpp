@@ -7,15 +7,16 @@
 #include "gimage/fit.h"
 #include "gimage/resample.h"
 #include "gimage/uniform_remesh.h"
-#include "param/consistent_parameterization.h"
 #include "mesh/errors.h"
 #include "mesh/gltf_io.h"
 #include "mesh/mesh_io.h"
+#include "param/consistent_parameterization.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/model_inputs.h"
 #include "tools/pack_models.h"
 #include "tools/progress.h"
+#include "tools/report.h"
 
 #include <nlohmann/json.hpp>
 
@@ -139,21 +140,21 @@ int run_remesh(const RemeshArgs& args) {
   }
   std::vector<const GeometryImages*> images_of_set;
   for (const auto& g : args.untangle ? as_resampled : uniform_images) images_of_set.push_back(&g);
+  // Every file of the run or none: a .glb that cannot be written leaves no .obj or .ply of this run behind.
+  AtomicFileSet files;
+  std::string report;  // printed once the files are in place
   for (std::size_t i = 0; i < remeshes.size(); ++i) {
     const UniformRemeshResult& remesh = remeshes[i];
     const GeometryImages& images = uniform_images[i];
     const double remesh_seconds = remesh_seconds_of[i], fit_seconds = fit_seconds_of[i];
     const std::string stem = (std::filesystem::path(args.common.output) / models.inputs[i].name).string() +
                              ".M" + std::to_string(args.level);
-    write_file_atomically(stem + ".obj",
-                          [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kObj); });
-    if (args.ply) {
-      write_file_atomically(stem + ".ply",
-                            [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kPly); });
-    }
+    files.add(stem + ".obj", [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kObj); });
+    if (args.ply)
+      files.add(stem + ".ply", [&](std::ostream& out) { write_mesh(remesh.mesh, out, MeshFormat::kPly); });
     if (args.glb) {
       const TexturedMesh textured = textured_mesh(images, split, images_of_set);
-      write_file_atomically(stem + ".glb", [&](std::ostream& out) {
+      files.add(stem + ".glb", [&](std::ostream& out) {
         write_gltf(textured.mesh, textured.attributes, out, {.binary = true, .draco_position_bits = args.draco});
       });
     }
@@ -175,11 +176,11 @@ int run_remesh(const RemeshArgs& args) {
                          {"max_move", untangled[i].max_move}};
       summary.push_back(j);
     } else if (!args.common.quiet) {
-      std::printf("remesh %s → %s.obj: %zu vertices, %zu faces (resampled and remeshed in %.3f s",
-                  models.paths[i].c_str(), stem.c_str(), remesh.mesh.positions.size(),
-                  remesh.mesh.triangles.size(), remesh_seconds);
-      if (args.fit) std::printf(", fitted in %.3f s", fit_seconds);
-      std::printf(")\n");
+      report += string_printf("remesh %s → %s.obj: %zu vertices, %zu faces (resampled and remeshed in %.3f s",
+                              models.paths[i].c_str(), stem.c_str(), remesh.mesh.positions.size(),
+                              remesh.mesh.triangles.size(), remesh_seconds);
+      if (args.fit) report += string_printf(", fitted in %.3f s", fit_seconds);
+      report += ")\n";
     }
   }
   double adaptive_tree_seconds = 0;  // resampling, quad errors and the shared tree, all models
@@ -207,7 +208,7 @@ int run_remesh(const RemeshArgs& args) {
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       const std::string path =
           (std::filesystem::path(args.common.output) / models.inputs[i].name).string() + ".adaptive.obj";
-      write_file_atomically(path, [&](std::ostream& out) { write_mesh(mesh, out, MeshFormat::kObj); });
+      files.add(path, [&](std::ostream& out) { write_mesh(mesh, out, MeshFormat::kObj); });
       if (args.common.json) {
         summary.push_back(nlohmann::json{{"mesh", models.paths[i]},
                                          {"obj", path},
@@ -218,12 +219,15 @@ int run_remesh(const RemeshArgs& args) {
                                          {"faces", mesh.triangles.size()},
                                          {"remesh_seconds", seconds}});
       } else if (!args.common.quiet) {
-        std::printf("remesh %s → %s: %zu vertices, %zu faces (eps %g, %zu leaves; triangulated in %.3f s)\n",
-                    models.paths[i].c_str(), path.c_str(), mesh.positions.size(), mesh.triangles.size(),
-                    args.adaptive, leaves, seconds);
+        report += string_printf(
+            "remesh %s → %s: %zu vertices, %zu faces (eps %g, %zu leaves; triangulated in %.3f s)\n",
+            models.paths[i].c_str(), path.c_str(), mesh.positions.size(), mesh.triangles.size(),
+            args.adaptive, leaves, seconds);
       }
     }
   }
+  files.commit();
+  std::fputs(report.c_str(), stdout);
   if (args.common.json) {
     nlohmann::json j{{"models", summary}, {"param_seconds", param_seconds}};
     if (adaptive) j["adaptive_tree_seconds"] = adaptive_tree_seconds;

@@ -1,5 +1,7 @@
 #include "tools/report.h"
 
+#include <cstdarg>
+#include <cstdio>
 #include <sstream>
 
 namespace geomip::tools {
@@ -47,6 +49,19 @@ std::string topology_to_text(const TopologyReport& r) {
   s.precision(6);
   s << "\n  bounding-box diagonal  " << r.bbox_diagonal << "\n";
   return s.str();
+}
+
+std::string string_printf(const char* format, ...) {
+  std::va_list args;
+  va_start(args, format);
+  std::va_list again;
+  va_copy(again, args);
+  const int size = std::vsnprintf(nullptr, 0, format, args);
+  va_end(args);
+  std::string text(size > 0 ? static_cast<std::size_t>(size) : 0, '\0');
+  if (size > 0) std::vsnprintf(text.data(), text.size() + 1, format, again);
+  va_end(again);
+  return text;
 }
 
 }  // namespace geomip::tools

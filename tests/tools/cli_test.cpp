@@ -2297,5 +2297,95 @@ TEST_F(CliPack, BadPacksExitTwoWithoutOutput) {
     EXPECT_EQ(geomip(args).exit_code, 0) << args;
 }
 
+/// The names in `dir` (not recursive): what a run left there, temporary files included.
+std::set<std::string> names_in(const std::string& dir) {
+  std::set<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+  return names;
+}
+
+// A command's output files are one set, written all or none. `remesh --ply --glb` whose .glb could not be
+// written had written the .obj (over an earlier run's) and the .ply, and left them.
+TEST_F(CliPack, RemeshWritesAllItsFilesOrNone) {
+  const std::string out = dir_ + "/out";
+  fs::create_directories(out + "/spot.M3.glb");
+  file("out/spot.M3.obj", "an earlier run's");
+  expect_bad_input("remesh -q '" + spot_ + "' --level 3 --ply --glb -o '" + out + "'", out + "/spot.M3.glb");
+  EXPECT_EQ(slurp(out + "/spot.M3.obj"), "an earlier run's");
+  EXPECT_EQ(names_in(out), (std::set<std::string>{"spot.M3.glb", "spot.M3.obj"}));
+  // The same with the adaptive remesh's file in the way: no file of the uniform remesh either.
+  fs::remove(out + "/spot.M3.glb");
+  fs::create_directories(out + "/spot.adaptive.obj");
+  expect_bad_input("remesh -q '" + spot_ + "' --level 3 --ply --adaptive 0.01 --max-depth 3 -o '" + out + "'",
+                   out + "/spot.adaptive.obj");
+  EXPECT_EQ(slurp(out + "/spot.M3.obj"), "an earlier run's");
+  EXPECT_EQ(names_in(out), (std::set<std::string>{"spot.adaptive.obj", "spot.M3.obj"}));
+}
+
+// decode of a pack of several models: the last model's mesh not written (its place a directory, a full
+// disk) left the first model's mesh written (over an earlier one), and said "decode ... → ..." for it.
+TEST_F(CliPack, DecodeWritesEveryModelsMeshOrNone) {
+  ASSERT_EQ(geomip("gimage -q '" + spot_ + "' --level 3 -o '" + dir_ + "/gi'").exit_code, 0);
+  const std::string pack = dir_ + "/two.gip";
+  ASSERT_EQ(geomip("encode -q --no-normals '" + dir_ + "/gi' '" + dir_ + "/gi' -o '" + pack + "'").exit_code,
+            0);
+  const std::string out = dir_ + "/o", first = out + "/x.spot.obj", last = out + "/x.spot-1.obj";
+  fs::create_directories(last);
+  file("o/x.spot.obj", "an earlier run's");
+  Outcome r = geomip("decode '" + pack + "' -o '" + out + "/x.obj'");
+  EXPECT_FALSE(r.crashed);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(last), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(r.out, "");  // no "decode spot → ..." for a file that is not there
+  EXPECT_EQ(slurp(first), "an earlier run's");
+  EXPECT_EQ(names_in(out), (std::set<std::string>{"x.spot-1.obj", "x.spot.obj"}));
+  if (fs::is_character_file("/dev/full")) {  // a full disk at the last model
+    fs::remove(last);
+    fs::create_symlink("/dev/full", last);
+    r = geomip("decode '" + pack + "' -o '" + out + "/x.obj'");
+    EXPECT_FALSE(r.crashed);
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find(last + ": write failed (No space left on device)"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(slurp(first), "an earlier run's");
+    EXPECT_TRUE(fs::is_symlink(last));
+    EXPECT_EQ(names_in(out), (std::set<std::string>{"x.spot-1.obj", "x.spot.obj"}));
+  }
+  fs::remove(last);
+  r = geomip("decode '" + pack + "' -o '" + out + "/x.obj'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("→ " + last), std::string::npos) << r.out;
+  EXPECT_EQ(read_mesh(first).triangles, read_mesh(last).triangles);
+  EXPECT_EQ(read_mesh(first).triangles.size(), 2u * 2 * 8 * 8);
+}
+
+// param's .param.obj and .param.json, gimage's two images, eval's two error maps, all or none.
+TEST_F(CliPack, ParamGimageAndEvalWriteAllTheirFilesOrNone) {
+  const std::string param = dir_ + "/param";
+  fs::create_directories(param + "/spot.param.json");
+  expect_bad_input("param -q --no-baseline '" + spot_ + "' -o '" + param + "'", param + "/spot.param.json");
+  EXPECT_EQ(names_in(param), (std::set<std::string>{"spot.param.json"}));
+
+  const std::string gi = dir_ + "/gi";
+  fs::create_directories(gi + "/spot.normals.exr");
+  expect_bad_input("gimage -q '" + spot_ + "' --level 3 -o '" + gi + "'", gi + "/spot.normals.exr");
+  EXPECT_EQ(names_in(gi), (std::set<std::string>{"spot.normals.exr"}));
+
+  if (fs::is_character_file("/dev/full")) {
+    ASSERT_EQ(geomip("remesh -q '" + spot_ + "' --level 3 -o '" + dir_ + "'").exit_code, 0);
+    const std::string approx = dir_ + "/spot.M3.obj", map = dir_ + "/map.ply", full = dir_ + "/full.ply";
+    fs::create_symlink("/dev/full", full);
+    const Outcome r = geomip("eval '" + spot_ + "' '" + approx + "' --error-map '" + map +
+                             "' --error-map-original '" + full + "'");
+    EXPECT_FALSE(r.crashed);
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find(full + ": write failed"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(map));
+  }
+}
+
 }  // namespace
 }  // namespace geomip

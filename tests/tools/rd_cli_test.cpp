@@ -184,6 +184,25 @@ TEST_F(RdCli, ExtentBeyondFloatRangeIsRefusedBeforeDraco) {
   EXPECT_FALSE(fs::exists(out_dir));
 }
 
+// rd.csv, rd.svg and the pack are one set: a pack that could not be written (its place a directory) left the
+// table and the plot of the run written.
+TEST_F(RdCli, APackThatCannotBeWrittenLeavesNoTableOrPlot) {
+  const std::string mesh = dir_ + "/sphere.obj";
+  {
+    std::ofstream out(mesh);
+    write_mesh(test::sphere(3), out, MeshFormat::kObj);
+  }
+  const std::string out_dir = dir_ + "/rd";
+  fs::create_directories(out_dir + "/sphere.gip");
+  std::string err;
+  EXPECT_EQ(geomip("rd -q --quick '" + mesh + "' -o '" + out_dir + "'", err), 2) << err;
+  EXPECT_NE(err.find(out_dir + "/sphere.gip"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  std::set<std::string> names;
+  for (const auto& e : fs::directory_iterator(out_dir)) names.insert(e.path().filename().string());
+  EXPECT_EQ(names, (std::set<std::string>{"sphere.gip"}));
+}
+
 TEST_F(RdCli, MissingMeshFailsCleanly) {
   const std::string out_dir = dir_ + "/rd";
   std::string err;

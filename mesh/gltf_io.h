@@ -50,7 +50,8 @@ struct GltfWriteOptions {
 /// files: tools/ write to a temporary file and rename (atomic output).
 /// With Draco the accessors' counts and POSITION min/max are those of Draco's own decode of the bytes written
 /// (checked in-process before a byte is written: same triangle count, every attribute present).
-/// \throw InvalidInput for an empty mesh, attributes of the wrong size, an index out of range, a coordinate
+/// \throw InvalidInput for an empty mesh, attributes of the wrong size, a normal that is not finite or not of
+///   unit length (within 1e-3), a texture coordinate that is not finite, an index out of range, a coordinate
 ///   outside float range, draco_position_bits outside 0..30 or, with Draco, values whose extent along an
 ///   axis overflows float (check_draco_positions()); SolverFailure when Draco fails to encode or
 ///   its decode disagrees; IoError when the stream fails.

@@ -64,8 +64,8 @@ struct WriteMeshOptions {
 /// Writes `mesh` to `out` in `format` (OBJ, PLY, OFF, or glTF/GLB with area-weighted vertex normals
 /// (vertex_normals()) for smooth shading). Writes every triangle as it is: no manifold
 /// requirement. Does not open or rename files: tools/ write to a temporary file and rename (atomic output).
-/// \throw InvalidInput for STL (not written), an empty mesh or a `vertex_normals` of the wrong size, IoError
-///   when the stream fails.
+/// \throw InvalidInput for STL (not written), an empty mesh or a `vertex_normals` of the wrong size (for glTF
+///   also one not of unit length, as write_gltf()), IoError when the stream fails.
 void write_mesh(const TriMesh& mesh, std::ostream& out, MeshFormat format, const WriteMeshOptions& options = {});
 
 }  // namespace geomip

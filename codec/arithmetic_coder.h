@@ -33,13 +33,26 @@ struct Context {
 
   /// P(bit = 0) · 2^16 in [1, 65535].
   std::uint32_t p0() const { return (static_cast<std::uint32_t>(fast) + slow) >> 1; }
-  void update(int bit) {
-    // Warm-up shifts: fast 1, 2, 3, 4, 5, 5, ...; slow 1, 2, ..., 8, 8, ... (count saturates at 7).
+  [[gnu::always_inline]] void update(int bit) {
+    if (count < 7) [[unlikely]] {
+      warm_up(bit);
+      return;
+    }
+    // Warmed up (all but a context's first 7 updates): shifts 5 and 8. Written as selects rather than
+    // branches: refinement bits are close to random, and a mispredicted branch per symbol would dominate the
+    // decoder's time. The results stay in [1, 65535]: x − (x >> s) ≥ 1 for x ≥ 1 (s ≥ 1), and
+    // x + ((65535 − x) >> s) ≤ 65535.
+    const int f = fast, s = slow;
+    fast = static_cast<std::uint16_t>(bit ? f - (f >> 5) : f + ((65535 - f) >> 5));
+    slow = static_cast<std::uint16_t>(bit ? s - (s >> 8) : s + ((65535 - s) >> 8));
+  }
+
+ private:
+  // Warm-up shifts: fast 1, 2, 3, 4, 5, 5, ...; slow 1, 2, ..., 8, 8, ... (count saturates at 7). Out of
+  // line: the hot loops that inline update() keep only the warmed-up path.
+  [[gnu::noinline]] void warm_up(int bit) {
     const int ss = count + 1, fs = ss < 5 ? ss : 5;
-    count = static_cast<std::uint8_t>(count + (count < 7));
-    // Written as selects rather than branches: refinement bits are close to random, and a mispredicted branch
-    // per symbol would dominate the decoder's time. The results stay in [1, 65535]: x − (x >> s) ≥ 1 for
-    // x ≥ 1 (s ≥ 1), and x + ((65535 − x) >> s) ≤ 65535.
+    ++count;
     const int f = fast, s = slow;
     const int f1 = f - (f >> fs), f0 = f + ((65535 - f) >> fs);
     const int s1 = s - (s >> ss), s0 = s + ((65535 - s) >> ss);

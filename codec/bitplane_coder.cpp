@@ -49,14 +49,16 @@ struct Band {
   std::size_t node(int l, int x, int y) const { return lbase[l] + static_cast<std::size_t>(y) * lw[l] + x; }
   /// Decoder: sets kSig at node (l, x, y) (not significant before) and counts it at its neighbours.
   void mark_significant(int l, int x, int y) {
-    std::uint8_t* const at = state.data() + node(l, x, y);
+    mark_significant_at(state.data() + node(l, x, y), x, y, lw[l], lh[l]);
+  }
+  /// The same for the node at `at`, (x, y) of a w × h level.
+  static void mark_significant_at(std::uint8_t* at, int x, int y, int w, int h) {
     *at |= kSig;
-    const int row = lw[l];
     constexpr std::uint8_t one = 1u << kNbrShift;
     if (x > 0) at[-1] = static_cast<std::uint8_t>(at[-1] + one);
-    if (x + 1 < row) at[1] = static_cast<std::uint8_t>(at[1] + one);
-    if (y > 0) *(at - row) = static_cast<std::uint8_t>(*(at - row) + one);
-    if (y + 1 < lh[l]) at[row] = static_cast<std::uint8_t>(at[row] + one);
+    if (x + 1 < w) at[1] = static_cast<std::uint8_t>(at[1] + one);
+    if (y > 0) *(at - w) = static_cast<std::uint8_t>(*(at - w) + one);
+    if (y + 1 < h) at[w] = static_cast<std::uint8_t>(at[w] + one);
   }
   std::uint32_t grid_index(int x, int y, int size) const {
     return static_cast<std::uint32_t>((y0 + dy * y) * size + x0 + dx * x);
@@ -609,9 +611,9 @@ class PlaneCoder {
     Context* const chan = &chan_ctx_[band.cls * 3 * 2];
     // The band's and its parent's quadtree shapes in locals, and node_context() over them.
     const int levels = band.levels;
-    int lw[kMaxQuadLevels];
+    int lw[kMaxQuadLevels], lh[kMaxQuadLevels];
     std::size_t lbase[kMaxQuadLevels];
-    for (int i = 0; i < levels; ++i) lw[i] = band.lw[i], lbase[i] = band.lbase[i];
+    for (int i = 0; i < levels; ++i) lw[i] = band.lw[i], lh[i] = band.lh[i], lbase[i] = band.lbase[i];
     // Per level nl of this band: the parent band's node covering (x, y) is (x, y) >> pshift[nl] at level
     // nl − 1 (level 0 for nl = 0), inside pw[nl] × ph[nl] (0 × 0 when the parent has no such level).
     const Band* const pb = band.parent >= 0 ? &bands_[static_cast<std::size_t>(band.parent)] : nullptr;
@@ -662,7 +664,8 @@ class PlaneCoder {
           band.lis_next.push_back(pack(l, x, y));
         } else {
           if (!inferred && p > kMaxCoefficientPlane) throw Corrupt{};
-          band.mark_significant(l, x, y);
+          // Over the locals: through the band, each byte store would make the compiler reload its members.
+          Band::mark_significant_at(st + at, x, y, lw[l], lh[l]);
           if (depth > 0) stack[depth - 1].any = true;  // (l, x, y) is a child of the innermost split node
           if (l == 0) {
             Sample sm{band.grid_index(x, y, size_), {0, 0, 0}, {0, 0, 0}, 0};

@@ -563,36 +563,40 @@ struct FrameField {
     const auto sub = static_cast<std::ptrdiff_t>(grid.sub);
     const std::size_t size = static_cast<std::size_t>(m) + 1;
     const std::int32_t* const g = grid.xyz.data();
-    const auto at = [&](int x, int y) {
-      return g + 3 * (static_cast<std::ptrdiff_t>(y >> sh) * sub + (x >> sh));
-    };
+    // The samples of the grid's row y (a multiple of 2^sh) and the offset of its column x in such a row.
+    const auto row_at = [&](int y) { return g + 3 * static_cast<std::ptrdiff_t>(y >> sh) * sub; };
+    const auto col = [&](int x) { return 3 * static_cast<std::ptrdiff_t>(x >> sh); };
     const std::uint8_t* coded = own->coded[p].data();
     std::uint16_t* out = cell[p].get();
     for (int j = 0; j <= m; j += d) {
       const bool odd_row = (j / d) & 1;
-      const int j0 = std::max(j - 2 * d, 0), j1 = std::min(j + 2 * d, m);
       const std::size_t line = static_cast<std::size_t>(j) * size;
+      // Rows j, j ± 2d (clamped) for a row detail; j ± d for the others.
+      const std::int32_t *const mid = odd_row ? nullptr : row_at(j),
+                                *const lo = row_at(odd_row ? j - d : std::max(j - 2 * d, 0)),
+                                *const hi = row_at(odd_row ? j + d : std::min(j + 2 * d, m));
       for (int i = odd_row ? 0 : d; i <= m; i += odd_row ? d : 2 * d) {
         if (!coded[line + static_cast<std::size_t>(i)]) continue;
         std::int64_t a[3], b[3];
         if (!odd_row) {  // a row detail: (i ± d, j) are coarse samples
-          const std::int32_t *l = at(i - d, j), *r = at(i + d, j), *ll = at(i - d, j0), *lr = at(i + d, j0),
-                             *ul = at(i - d, j1), *ur = at(i + d, j1);
+          const std::ptrdiff_t xl = col(i - d), xr = col(i + d);
+          const std::int32_t *l = mid + xl, *r = mid + xr, *ll = lo + xl, *lr = lo + xr, *ul = hi + xl,
+                             *ur = hi + xr;
           for (int c = 0; c < 3; ++c) {
             a[c] = std::int64_t{r[c]} - l[c];
             b[c] = std::int64_t{ul[c]} + ur[c] - ll[c] - lr[c];
           }
         } else if (!((i / d) & 1)) {  // a column detail: (i, j ± d) are coarse samples
-          const int i0 = std::max(i - 2 * d, 0), i1 = std::min(i + 2 * d, m);
-          const std::int32_t *lo = at(i, j - d), *hi = at(i, j + d), *ll = at(i0, j - d), *lr = at(i1, j - d),
-                             *ul = at(i0, j + d), *ur = at(i1, j + d);
+          const std::ptrdiff_t x = col(i), x0 = col(std::max(i - 2 * d, 0)), x1 = col(std::min(i + 2 * d, m));
+          const std::int32_t *l = lo + x, *h = hi + x, *ll = lo + x0, *lr = lo + x1, *ul = hi + x0,
+                             *ur = hi + x1;
           for (int c = 0; c < 3; ++c) {
             a[c] = std::int64_t{lr[c]} + ur[c] - ll[c] - ul[c];
-            b[c] = std::int64_t{hi[c]} - lo[c];
+            b[c] = std::int64_t{h[c]} - l[c];
           }
         } else {  // a centre detail: the cell's corners (i ± d, j ± d)
-          const std::int32_t *ll = at(i - d, j - d), *lr = at(i + d, j - d), *ul = at(i - d, j + d),
-                             *ur = at(i + d, j + d);
+          const std::ptrdiff_t xl = col(i - d), xr = col(i + d);
+          const std::int32_t *ll = lo + xl, *lr = lo + xr, *ul = hi + xl, *ur = hi + xr;
           for (int c = 0; c < 3; ++c) {
             a[c] = std::int64_t{lr[c]} + ur[c] - ll[c] - ul[c];
             b[c] = std::int64_t{ul[c]} + ur[c] - ll[c] - lr[c];

@@ -291,6 +291,12 @@ void check_output_directory(const std::string& dir) {
   }
 }
 
+void check_planned_outputs(const std::string& dir, const std::vector<std::string>& paths) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return;
+  for (const std::string& path : paths) check_output_file(path);
+}
+
 void make_output_directory(const std::string& dir) {
   namespace fs = std::filesystem;
   check_output_directory(dir);  // a file in the way is the user's path

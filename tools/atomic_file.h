@@ -105,6 +105,13 @@ std::vector<std::string> model_file_names(const std::vector<std::string>& names)
 /// \throw InvalidInput naming what is in the way.
 void check_output_directory(const std::string& dir);
 
+/// Checks, before any work, the files a command will write into its output directory `dir` (each of `paths`,
+/// as check_output_file()) when `dir` exists already: a directory or an unwritable file named like an output
+/// is found before minutes of work instead of when the files are written. When `dir` does not exist yet,
+/// nothing can be in the way (the command makes it after the work).
+/// \throw InvalidInput naming the path in the way.
+void check_planned_outputs(const std::string& dir, const std::vector<std::string>& paths);
+
 /// Creates the output directory `dir` and its parents (nothing when it exists).
 /// \throw InvalidInput when it, or a parent, exists and is not a directory; IoError when it cannot be
 /// created.

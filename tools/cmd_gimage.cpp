@@ -48,6 +48,15 @@ int run_gimage(const GimageArgs& args) {
                                                args.common.quiet || args.common.json, args.common.patches,
                                                loop_kind(args.common), args.common.equal_area_layout);
   check_output_directory(args.common.output);
+  {
+    std::vector<std::string> planned;  // the files written below, checked before the work
+    for (const auto& input : models.inputs) {
+      const std::string stem = (std::filesystem::path(args.common.output) / input.name).string();
+      planned.push_back(stem + ".geometry.exr");
+      planned.push_back(stem + ".normals.exr");
+    }
+    check_planned_outputs(args.common.output, planned);
+  }
 
   ParameterizationOptions options;
   apply_sampling(args.common, options);

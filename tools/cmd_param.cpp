@@ -133,6 +133,15 @@ int run_param(const ParamArgs& args) {
                                                loop_kind(args.common), args.common.equal_area_layout);
   const std::vector<ParameterizationInput>& inputs = models.inputs;
   const std::vector<std::string>& paths = models.paths;
+  {
+    std::vector<std::string> planned;  // the files written below, checked before the work
+    for (const auto& input : inputs) {
+      const std::string stem = (std::filesystem::path(args.common.output) / input.name).string();
+      planned.push_back(stem + ".param.obj");
+      planned.push_back(stem + ".param.json");
+    }
+    check_planned_outputs(args.common.output, planned);
+  }
 
   ParameterizationOptions options;
   apply_sampling(args.common, options);

@@ -69,6 +69,18 @@ int run_remesh(const RemeshArgs& args) {
                                                args.common.quiet || args.common.json, args.common.patches,
                                                loop_kind(args.common), args.common.equal_area_layout);
   check_output_directory(args.common.output);
+  {
+    std::vector<std::string> planned;  // the files written below, checked before the work
+    for (const auto& input : models.inputs) {
+      const std::string base = (std::filesystem::path(args.common.output) / input.name).string();
+      const std::string stem = base + ".M" + std::to_string(args.level);
+      if (uniform) planned.push_back(stem + ".obj");
+      if (uniform && args.ply) planned.push_back(stem + ".ply");
+      if (uniform && args.glb) planned.push_back(stem + ".glb");
+      if (adaptive) planned.push_back(base + ".adaptive.obj");
+    }
+    check_planned_outputs(args.common.output, planned);
+  }
   // The remesh spans the input's bounding box: what Draco cannot quantize (--draco) is refused now.
   if (args.draco != 0) {
     for (std::size_t i = 0; i < models.inputs.size(); ++i)

@@ -229,5 +229,23 @@ TEST_F(AtomicFileSetTest, WriteFileAtomicallyStillReplacesOrKeeps) {
   EXPECT_EQ(listing(), (std::set<std::string>{"a.obj"}));
 }
 
+// check_planned_outputs(): remesh, param and gimage check every file they will write before the work, so a
+// directory named like an output is found at once, not after the parameterization (those commands left
+// nothing behind either way, but spent the minutes first).
+TEST_F(AtomicFileSetTest, PlannedOutputsInTheWayAreFoundBeforeTheWork) {
+  fs::create_directory(path("bunny.M6.glb"));  // a directory where an output file goes
+  try {
+    check_planned_outputs(dir_, {path("bunny.M6.obj"), path("bunny.M6.glb")});
+    ADD_FAILURE() << "a directory named like an output was not found";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find(path("bunny.M6.glb")), std::string::npos) << e.what();
+  }
+  check_planned_outputs(dir_, {path("bunny.M6.obj"), path("bunny.M6.ply")});  // nothing in the way
+  EXPECT_EQ(listing(), (std::set<std::string>{"bunny.M6.glb"})) << "the check creates nothing";
+  // An output directory that does not exist yet holds nothing in the way (the command makes it later).
+  check_planned_outputs(path("later"), {path("later/bunny.M6.obj")});
+  EXPECT_FALSE(fs::exists(path("later")));
+}
+
 }  // namespace
 }  // namespace geomip::tools

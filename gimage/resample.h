@@ -100,7 +100,7 @@ struct GridLocation {
 /// sample on an edge or a vertex goes to the triangle that contains the sample moved infinitesimally toward
 /// the square's centre (by (±ε, ±ε·η), ε ≫ η), so on a patch without flipped triangles that tiles the unit
 /// square every sample, boundary included, is claimed exactly once. Triangles with (u,v) area <= 0 claim
-/// nothing. 	hrow InvalidInput for a level outside [0, kMaxGeometryImageLevel] or triangle indices out of
+/// nothing. \throw InvalidInput for a level outside [0, kMaxGeometryImageLevel] or triangle indices out of
 /// range.
 GridLocation locate_grid_samples(const PatchParameterization& patch, int level);
 

@@ -174,16 +174,17 @@ std::string check_quad_layout(const QuadLayout& layout, std::size_t num_vertices
 /// Partitions `closed_manifold` into one quadrilateral disk patch per quad of `layout`, of any genus.
 ///
 /// Layout edges are traced as Dijkstra shortest paths (edge graph, Euclidean lengths): first a spanning
-/// tree of the corners (Kruskal, shortest corner distance first), then the other edges, shortest first. A path never passes through a corner other than its own two, nor through a vertex of an
-/// earlier path. At both of its corners it must leave the corner between the already traced paths that are
-/// its neighbours in the layout's cyclic order around that corner (Praun et al. 2001, §3.3), so that paths
-/// land between the right neighbours and each region between them is bounded by its quad's four paths.
+/// tree of the corners (Kruskal, shortest corner distance first), then the other edges, shortest first. A
+/// path never passes through a corner other than its own two, nor through a vertex of an earlier path. At
+/// both of its corners it must leave the corner between the already traced paths that are its neighbours in
+/// the layout's cyclic order around that corner (Praun et al. 2001, §3.3), so that paths land between the
+/// right neighbours and each region between them is bounded by its quad's four paths.
 ///
 /// Result: patch q is quad q, with corners[s] = layout.corners[layout.quads[q][s]] and side s the path of its
 /// side s; adjacency, face_patch and split vertices as for partition_mesh(). The validation is the same as
 /// partition_mesh()'s, and each region is matched to its quad by its corner cycle and side paths.
 ///
-/// 	hrow InvalidInput with "partition_mesh:" and the reason when the mesh is not one closed, manifold,
+/// \throw InvalidInput with "partition_mesh:" and the reason when the mesh is not one closed, manifold,
 ///   consistently oriented component, a corner is out of range or repeated, the layout is not a closed quad
 ///   surface of the mesh's genus (check_quad_layout()), a path cannot be traced, or the traced paths do not
 ///   cut the mesh into the layout's quads (corner cycles that disagree with the mesh).

@@ -49,18 +49,18 @@ class AtomicFileSet {
   /// flushed and closed. Returns the bytes written. If `write` throws or the stream fails, that temporary
   /// file is removed and the exception (or an IoError naming `path`) propagates; the files added before
   /// stay added, to be committed or dropped.
-  /// 	hrow InvalidInput when `path` cannot be written (check_output_file()) or is a file already in the
+  /// \throw InvalidInput when `path` cannot be written (check_output_file()) or is a file already in the
   /// set (under any name); IoError when the disk is full or the temporary file cannot be created.
   std::uintmax_t add(const std::string& path, const std::function<void(std::ostream&)>& write);
 
   /// add() for a writer that takes a file name, not a stream (write_geometry_image_exr()): `write` is given
   /// the temporary file's name and must create that file. Returns its size.
-  /// 	hrow as add(); IoError when `write` returns without having created the file.
+  /// \throw as add(); IoError when `write` returns without having created the file.
   std::uintmax_t add_file(const std::string& path, const std::function<void(const std::string& file)>& write);
 
   /// Writes the devices and pipes, then renames every temporary file over its target in the order added.
   /// Calling it again does nothing.
-  /// 	hrow InvalidInput when a target has become a directory since add() (nothing replaced); IoError when
+  /// \throw InvalidInput when a target has become a directory since add() (nothing replaced); IoError when
   /// a device write or a rename fails: its message names the failed target and, when some targets were
   /// replaced before it, lists those replaced and those left as they were.
   void commit();

@@ -7,12 +7,15 @@
 #include "mesh/mesh_topology.h"
 #include "param/quad_layout.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 int main(int argc, char** argv) {
   using namespace geomip;
@@ -62,7 +65,33 @@ int main(int argc, char** argv) {
         std::fprintf(f, "]}]}\n");
         std::fclose(f);
       }
-      const PartitionStats stats = partition_stats(partition_mesh_layout(mesh, c.layout));
+      const PartitionResult partition = partition_mesh_layout(mesh, c.layout);
+      {  // corner angles: the 3D angle sum of each patch's triangles at each of its corners (90° on a square)
+        std::vector<double> angles;
+        const auto& m = partition.mesh;
+        for (const Patch& patch : partition.patches) {
+          for (int corner : patch.corners) {
+            double sum = 0.0;
+            for (int f : patch.faces) {
+              const auto& t = m.triangles[f];
+              for (int k = 0; k < 3; ++k) {
+                if (t[k] != corner) continue;
+                const Eigen::Vector3d u = m.positions[t[(k + 1) % 3]] - m.positions[corner];
+                const Eigen::Vector3d w = m.positions[t[(k + 2) % 3]] - m.positions[corner];
+                sum += std::atan2(u.cross(w).norm(), u.dot(w));
+              }
+            }
+            angles.push_back(sum * 180.0 / M_PI);
+          }
+        }
+        std::sort(angles.begin(), angles.end());
+        auto at = [&](double q) { return angles[static_cast<std::size_t>(q * (angles.size() - 1))]; };
+        int over = 0;
+        for (double a : angles) over += a > 180.0;
+        std::printf("  corner angles: min %.0f, median %.0f, 90th %.0f, max %.0f, %d of %zu above 180\n",
+                    at(0), at(0.5), at(0.9), at(1.0), over, angles.size());
+      }
+      const PartitionStats stats = partition_stats(partition);
       for (std::size_t q = 0; q < stats.patches.size(); ++q) {
         std::printf("  patch %zu: area %.6g, boundary %.4g, flatness %.3f\n", q, stats.patches[q].area,
                     stats.patches[q].boundary_length, stats.patches[q].flatness);

@@ -706,7 +706,8 @@ std::string parse_obj_corner(const std::string& corner, long long& vertex) {
   return "malformed face corner '" + corner.substr(0, 24) + "'";
 }
 
-void validate_obj(const std::string& path, std::string_view bytes) {
+// `exact` (when not null) gets every vertex's coordinates as written: OpenMesh's reader rounds them to float.
+void validate_obj(const std::string& path, std::string_view bytes, std::vector<Eigen::Vector3d>* exact) {
   MemoryStream in(bytes);
   LineScanner lines(in, 0);
   std::string line;
@@ -750,6 +751,7 @@ void validate_obj(const std::string& path, std::string_view bytes) {
       const std::string problem = coordinate_problem(v, "vertex");
       if (!problem.empty()) fail(path, at_line(lines.line_no()) + problem);
     }
+    if (exact) exact->emplace_back(xyz[0], xyz[1], xyz[2]);
     ++vertices;
   }
   if (max_index > vertices) {
@@ -995,7 +997,9 @@ class PlyValues {
 
 // Walks every value OpenMesh's PLY reader will read (the elements up to and including "face"), in its order,
 // checking counts, coordinates and face indices before it loops over them.
-PlyHeader validate_ply(const std::string& path, std::string_view bytes) {
+// `exact` (when not null) gets every vertex's x, y, z as stored (doubles stay doubles): OpenMesh's reader
+// rounds them to float.
+PlyHeader validate_ply(const std::string& path, std::string_view bytes, std::vector<Eigen::Vector3d>* exact) {
   MemoryStream in(bytes);
   PlyHeader h;
   std::string problem;
@@ -1011,7 +1015,15 @@ PlyHeader validate_ply(const std::string& path, std::string_view bytes) {
                      e.name.substr(0, 32) + "', more than the " + std::to_string(size - h.header_bytes) +
                      " bytes after it can hold");
     }
-    if (e.name == "vertex") vertices = e.count;
+    if (e.name == "vertex") {
+      vertices = e.count;
+      // Without them OpenMesh's reader leaves every point at the origin.
+      for (const char* axis : {"x", "y", "z"}) {
+        const bool found = std::any_of(e.properties.begin(), e.properties.end(),
+                                       [&](const PlyProperty& p) { return !p.list && p.name == axis; });
+        if (!found) fail(path, std::string("the PLY vertex element has no property '") + axis + "'");
+      }
+    }
   }
   PlyValues values(bytes, h);
   auto truncated = [&](const PlyElement& e, std::uint64_t item) {
@@ -1020,6 +1032,7 @@ PlyHeader validate_ply(const std::string& path, std::string_view bytes) {
   };
   for (const PlyElement& e : h.elements) {
     const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
+    if (is_vertex && exact) exact->assign(static_cast<std::size_t>(e.count), Eigen::Vector3d::Zero());
     for (std::uint64_t item = 0; item < e.count; ++item) {
       for (const PlyProperty& prop : e.properties) {
         double value = 0;
@@ -1031,6 +1044,7 @@ PlyHeader validate_ply(const std::string& path, std::string_view bytes) {
                            e.name.substr(0, 32) + " " + std::to_string(item));
           }
           const bool coordinate = is_vertex && (prop.name == "x" || prop.name == "y" || prop.name == "z");
+          if (coordinate && exact) (*exact)[static_cast<std::size_t>(item)][prop.name[0] - 'x'] = value;
           // Coordinates: NaN, infinite or beyond float range, in either encoding. Other ascii floats too: the
           // reader's `>> float` would fail there and misalign the rest (binary ones it just converts).
           if (ply_is_float(prop.type) && (coordinate || !h.binary)) {
@@ -1216,10 +1230,14 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
   bool binary_stl = false;
   std::string ply_header;  // PLY: the validated header, rewritten (PlyHeader::canonical())
   std::string off_text;    // OFF with '#' comments: the text with them blanked (blank_off_comments())
+  // A UTF-8 byte-order mark (some Windows editors write one) is not part of the first line.
+  if ((format == MeshFormat::kObj || format == MeshFormat::kOff) && bytes.substr(0, 3) == "\xEF\xBB\xBF")
+    bytes.remove_prefix(3);
   std::string_view data = bytes;
+  std::vector<Eigen::Vector3d> exact;  // OBJ and PLY: the coordinates as written (the reader rounds to float)
   switch (format) {
     case MeshFormat::kObj:
-      validate_obj(path, bytes);
+      validate_obj(path, bytes, &exact);
       break;
     case MeshFormat::kOff:
       if (bytes.find('#') != std::string_view::npos) {
@@ -1229,7 +1247,7 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
       validate_off(path, data);
       break;
     case MeshFormat::kPly: {
-      const PlyHeader h = validate_ply(path, bytes);
+      const PlyHeader h = validate_ply(path, bytes, &exact);
       ply_header = h.canonical();
       data = bytes.substr(static_cast<std::size_t>(h.header_bytes));
       break;
@@ -1260,6 +1278,23 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
 
   TriMesh mesh;
   mesh.positions = std::move(importer.points);
+  // The same vertices in the same order, read without the float rounding when the file holds more than float
+  // precision (a mesh 10^6 units from its origin keeps its millimetres). A file of float data written with 9
+  // significant digits (geomip's own outputs, most exporters) is within 5e-9 of its floats everywhere and
+  // reads as those floats, as OFF, STL, glTF and binary PLY floats do: one mesh, the same points in any
+  // format.
+  if (exact.size() == mesh.positions.size()) {
+    bool same = true, finer = false;
+    for (std::size_t v = 0; v < exact.size() && same; ++v) {
+      for (int c = 0; c < 3;
+           ++c) {  // within float rounding of each other (strtof and a rounded strtod may differ)
+        const double gap = std::abs(exact[v][c] - mesh.positions[v][c]);
+        same = same && gap <= 1e-6 * std::abs(exact[v][c]) + 1e-37;
+        finer = finer || gap > 1e-8 * std::abs(exact[v][c]);
+      }
+    }
+    if (same && finer) mesh.positions = std::move(exact);
+  }
   const auto n = static_cast<long long>(mesh.positions.size());
   mesh.triangles.reserve(importer.polygons.size());
   for (std::size_t f = 0; f < importer.polygons.size(); ++f) {

@@ -38,8 +38,12 @@ struct ReadMeshOptions {
 /// least one face, every face index is in range and fits an int (OBJ: the message names the line), every
 /// referenced coordinate is finite and within float range (unless disabled; text formats name the line), and
 /// the file is not truncated (binary PLY with fewer bytes than its header promises).
-/// The file is read once into memory, then parsed as read_mesh_from_memory() does.
-/// \throw InvalidInput with a message naming `path` and the problem.
+/// OBJ and PLY coordinates that hold more than float precision (one of them more than 1e-8 (relative) from
+/// its float) are read as written, as doubles (OpenMesh's readers round them to float, so geomip takes them
+/// from its own pass over the file); float data written with 9 significant digits, OFF and STL as floats.
+/// Text outputs keep 9 significant digits and PLY outputs floats (WriteMeshOptions): a mesh far from its
+/// origin loses precision when written. The file is read once into memory, then parsed as
+/// read_mesh_from_memory() does. \throw InvalidInput with a message naming `path` and the problem.
 TriMesh read_mesh(const std::string& path, const ReadMeshOptions& options = {});
 
 /// Parses the bytes of a mesh file already in memory (`name` only labels the messages): the same checks as

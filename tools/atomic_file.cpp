@@ -10,10 +10,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <mutex>
 #include <sstream>
 
 namespace geomip::tools {
@@ -54,15 +57,37 @@ void write_stream(const std::filesystem::path& file, const std::string& path,
 }
 
 /// The temporary file of target `path`: ".<name>.tmp-<pid>" in its directory (a rename within one file
-/// system).
+/// system); for a name too long to take that suffix within the file system's limit on a name (255 bytes
+/// on most), ".<first bytes of the name>-<hash of the name>.tmp-<pid>".
 std::filesystem::path temporary_beside(const std::string& path) {
   const std::filesystem::path target(path);
   const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
-  std::string name = ".";
-  name += target.filename().string();
-  name += ".tmp-";
-  name += std::to_string(::getpid());
+  const std::string filename = target.filename().string();
+  const std::string suffix = ".tmp-" + std::to_string(::getpid());
+  long limit = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  if (limit <= 0) limit = 255;
+  std::string name(1, '.');
+  name.append(filename);
+  name.append(suffix);
+  if (name.size() > static_cast<std::size_t>(limit)) {
+    char hash[24];
+    std::snprintf(hash, sizeof hash, "-%016zx", std::hash<std::string>{}(filename));
+    name.assign(1, '.');
+    name.append(filename, 0, std::min<std::size_t>(filename.size(), 64));
+    name.append(hash);
+    name.append(suffix);
+  }
   return dir / name;
+}
+
+std::mutex& inputs_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+std::vector<std::string>& noted_inputs() {
+  static std::vector<std::string> inputs;
+  return inputs;
 }
 
 void rename_into_place(const std::filesystem::path& tmp, const std::string& path) {
@@ -102,6 +127,18 @@ void check_output_file(const std::string& path) {
   }
   ::close(fd);
   ::unlink(probe.c_str());
+  std::vector<std::string> inputs;
+  {
+    const std::lock_guard<std::mutex> lock(inputs_mutex());
+    inputs = noted_inputs();
+  }
+  check_output_is_not_an_input(path, inputs);
+}
+
+void note_input_file(const std::string& path) {
+  const std::lock_guard<std::mutex> lock(inputs_mutex());
+  if (std::find(noted_inputs().begin(), noted_inputs().end(), path) == noted_inputs().end())
+    noted_inputs().push_back(path);
 }
 
 void check_output_is_not_an_input(const std::string& path, const std::vector<std::string>& inputs) {
@@ -110,7 +147,7 @@ void check_output_is_not_an_input(const std::string& path, const std::vector<std
   if (!fs::exists(path, ec)) return;
   for (const std::string& input : inputs) {
     if (fs::exists(input, ec) && fs::equivalent(path, input, ec))
-      throw InvalidInput("-o " + path + " is the input " + input + ": writing it would destroy the input");
+      throw InvalidInput(path + " is the input " + input + ": writing it would destroy the input");
   }
 }
 

@@ -87,8 +87,15 @@ void check_pack_output_name(const std::string& path);
 /// Checks, before any work, that `path` can be written: not empty, not an existing directory, its directory
 /// exists, is a directory, is writable and takes a file (a probe file is created and removed: /proc passes
 /// the permission check and takes none); an existing device or pipe: writable itself. \throw InvalidInput
-/// naming what is in the way.
+/// naming what is in the way, or when `path` is a file this run reads (note_input_file(); the same file
+/// under any name).
 void check_output_file(const std::string& path);
+
+/// Notes that this run reads `path` (a mesh, a pack, a correspondence file): from then on every output
+/// checked by check_output_file(), hence every file written by write_file_atomically() or an
+/// AtomicFileSet, is refused when it is that file under any name (`repair a.obj -o a.obj`, `convert --points
+/// c.json -o c.json`). Thread-safe; for the whole process.
+void note_input_file(const std::string& path);
 
 /// Checks, before any work, that the output `path` is none of `inputs` (the same file under any name): an
 /// output written over an input would destroy the data it came from. Inputs that do not exist are skipped.

@@ -99,6 +99,8 @@ void check_level_options(const ConvertArgs& args, int level) {
 
 int run_convert(const ConvertArgs& args) {
   check_pack_output_name(args.common.output);
+  if (!args.common.points.empty()) note_input_file(args.common.points);
+  for (const std::string& mesh : args.common.meshes) note_input_file(mesh);
   check_output_file(args.common.output);
   // The level: --level, else default_grid_level() of --patches (a CORR.json's layout is counted once it is
   // read).
@@ -107,6 +109,8 @@ int run_convert(const ConvertArgs& args) {
   check_level_options(args, level);
   check_quantization_switches(args.quantization_bits, args.normal_bits, args.normal_bits_given,
                               args.no_normals);
+  if (args.no_normals && args.normal_level >= 0)
+    throw InvalidInput("--normal-level sets the normal maps' level, and --no-normals writes none: drop one");
   if (args.tangential_shift < 0 || args.tangential_shift > 8)
     throw InvalidInput("--tangential-shift " + std::to_string(args.tangential_shift) + " is outside [0, 8]");
   if (args.normal_mesh_steps > 0 && (args.common.meshes.size() > 1 || !args.common.points.empty()))
@@ -373,7 +377,9 @@ CommandRunner add_convert_command(CLI::App& app) {
       "Grid level N in [1, 10] (default 8: 257² samples per patch, for two squares; for a K-patch layout "
       "the coarsest level whose K grids hold at least as many samples: K = 3 to 7: 8, 8 to 31: 7, 32 to 121: "
       "6; a stretched shape moved to 16 or 64 patches gets one or two levels below the two squares' N)");
-  cmd->add_option("--normal-level", args->normal_level, "Normal map level in [N, 10] (default N+1, at most 10)");
+  cmd->add_option("--normal-level", args->normal_level,
+                  "Normal map level in [N, 10] (default N+1, at most 10)")
+      ->check(CLI::Range(0, 10));
   cmd->add_option("--bits", args->quantization_bits,
                   "Position quantization bits over the largest bounding-box extent (default 14)");
   CLI::Option* normal_bits = cmd->add_option(

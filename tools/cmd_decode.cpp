@@ -148,10 +148,20 @@ int run_decode(const DecodeArgs& args) {
                          std::to_string(first_level) + " bytes");
     }
   }
-  const int grid_level = decoded.models.front().geometry.front().level;
-  if (args.level > grid_level)
-    throw InvalidInput("--level " + std::to_string(args.level) + " is above the pack's level " +
-                       std::to_string(grid_level));
+  // Models of one pack may have grids of different levels (`geomip encode` of several geometry images).
+  for (const auto& model : decoded.models) {
+    const int level = model.geometry.front().level;
+    if (args.level > level) {
+      throw InvalidInput("--level " + std::to_string(args.level) + " is above " +
+                         (decoded.models.size() == 1
+                              ? std::string("the pack's level ")
+                              : "model '" + codec::one_line(model.name) + "''s level ") +
+                         std::to_string(level));
+    }
+  }
+  auto output_level = [&](const codec::DecodedModel& model) {
+    return args.level < 0 ? model.geometry.front().level : args.level;
+  };
 
   // One model → OUTPUT is the mesh file; several → OUTPUT's stem gets each model's name, made safe and unique
   // (the names come from the pack: a crafted one must not lead outside OUTPUT's directory, and two models
@@ -175,11 +185,13 @@ int run_decode(const DecodeArgs& args) {
   // Untangling opens the folds of the grid that is written: an output level below
   // UntangleOptions::min_level is left as decoded, as grids of those levels always are (and a crafted pack's
   // claimed level 10 written at --level 0 no longer costs minutes).
-  const bool untangle =
-      args.untangle && (args.level < 0 ? grid_level : args.level) >= UntangleOptions{}.min_level;
+  std::vector<char> untangle(decoded.models.size(), 0);
+  for (std::size_t m = 0; m < decoded.models.size(); ++m)
+    untangle[m] = args.untangle && output_level(decoded.models[m]) >= UntangleOptions{}.min_level;
+  const bool any_untangled = std::find(untangle.begin(), untangle.end(), 1) != untangle.end();
   std::vector<codec::DecodedModel> as_decoded;
-  if (untangle) as_decoded = decoded.models;
-  const std::vector<codec::DecodedModel>& choosers = untangle ? as_decoded : decoded.models;
+  if (any_untangled) as_decoded = decoded.models;
+  const std::vector<codec::DecodedModel>& choosers = any_untangled ? as_decoded : decoded.models;
   // Every model's mesh or none: a model that cannot be written leaves the earlier ones unwritten too.
   AtomicFileSet files;
   std::string report;  // printed once the files are in place
@@ -194,7 +206,7 @@ int run_decode(const DecodeArgs& args) {
     }
     const QuadSplitOptions split{.split = quad_split, .chosen_by = same_layout};
     UntangleStats untangled;
-    if (untangle) untangled = untangle_decoded_model(decoded.models[m], split);
+    if (untangle[m]) untangled = untangle_decoded_model(decoded.models[m], split);
     // glTF carries per-patch texture coordinates and the normal maps' normals (seams not welded); the
     // other formats get the welded mesh.
     const TexturedMesh textured = gltf ? decoded_textured_mesh(decoded.models[m], args.level, split) : TexturedMesh{};
@@ -228,7 +240,7 @@ int run_decode(const DecodeArgs& args) {
       report +=
           string_printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",
                         codec::one_line(decoded.models[m].name).c_str(), codec::one_line(paths[m]).c_str(),
-                        written.num_triangles(), args.level < 0 ? grid_level : args.level,
+                        written.num_triangles(), output_level(decoded.models[m]),
                         decoded.models[m].detail_level, decoded.models[m].geometry_passes);
     }
   }

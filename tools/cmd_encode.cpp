@@ -110,6 +110,7 @@ int run_encode(const EncodeArgs& args) {
   for (const std::string& path : files)
     if (ends_with(path, kGeometrySuffix))
       inputs.push_back(path.substr(0, path.size() - std::string(kGeometrySuffix).size()) + ".normals.exr");
+  for (const std::string& input : inputs) note_input_file(input);
   check_output_is_not_an_input(args.output, inputs);
   std::vector<codec::PackModelInput> models;
   bool any_normals = false;

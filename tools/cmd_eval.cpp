@@ -72,11 +72,13 @@ int run_eval(EvalArgs args) {
           std::filesystem::weakly_canonical(args.error_map_original))
     throw InvalidInput("--error-map and --error-map-original are both " + args.error_map +
                        ": one map would overwrite the other");
+  note_input_file(args.original);
+  note_input_file(args.approx);
   for (const std::string* path : {&args.error_map, &args.error_map_original}) {
-    if (!path->empty() && mesh_format_from_path(*path) != MeshFormat::kPly)
+    if (path->empty()) continue;
+    check_output_file(*path);  // a directory is named as one before its missing extension
+    if (mesh_format_from_path(*path) != MeshFormat::kPly)
       throw InvalidInput(*path + ": an error map is written as PLY (.ply)");
-    if (!path->empty()) check_output_file(*path);
-    if (!path->empty()) check_output_is_not_an_input(*path, {args.original, args.approx});
   }
   const TriMesh original = read_mesh(args.original);
   const TriMesh approx = read_mesh(args.approx);

@@ -152,7 +152,8 @@ CommandRunner add_gimage_command(CLI::App& app) {
   add_model_options(cmd, args->common);
   cmd->add_option("--level", args->level, "Grid level N in [0, 10]: (2^N+1)² samples per patch")->required();
   cmd->add_option("--normal-level", args->normal_level,
-                  "Normal map level in [N, 10] (default N+1, at most 10)");
+                  "Normal map level in [N, 10] (default N+1, at most 10)")
+      ->check(CLI::Range(0, 10));
   cmd->add_flag("--fit,!--no-fit", args->fit,
                 "Move every level-N sample along its normal so that the level-N remesh is a least-squares fit of "
                 "the surface, not its interpolant (gimage/fit.h; seams stay bit-identical; coarser MIP levels are "

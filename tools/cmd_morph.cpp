@@ -65,8 +65,21 @@ void unite_hole_masks(codec::DecodedModel& into, const codec::DecodedModel& othe
   into.hole_mask_level = level;
 }
 
+std::string frame_file_name(int k) {
+  char name[32];
+  std::snprintf(name, sizeof name, "morph_%04d.obj", k);
+  return name;
+}
+
 int run_morph(const MorphArgs& args) {
   check_output_directory(args.output);
+  note_input_file(args.pack);
+  {  // an unwritable directory, a directory or the pack at a frame's place: found before the decode
+    std::vector<std::string> frames;
+    for (int k = 0; k < args.frames; ++k)
+      frames.push_back((std::filesystem::path(args.output) / frame_file_name(k)).string());
+    check_planned_outputs(args.output, frames);
+  }
   const std::vector<std::uint8_t> bytes = read_pack_file(args.pack);
   // The manifest first: a pack of one model (or a damaged one) is refused before its grids are decoded.
   codec::PackInfo info;
@@ -121,11 +134,7 @@ int run_morph(const MorphArgs& args) {
         model.geometry.front().level == frame.geometry.front().level)
       same_layout.push_back(&model);
   namespace fs = std::filesystem;
-  const auto frame_name = [](int k) {
-    char name[32];
-    std::snprintf(name, sizeof name, "morph_%04d.obj", k);
-    return std::string(name);
-  };
+  const auto frame_name = frame_file_name;
   // Every frame's place must take a file (a directory of that name would stop the run half-way, leaving
   // this run's first frames beside an earlier run's last ones).
   for (int k = 0; k < args.frames; ++k) {
@@ -138,7 +147,9 @@ int run_morph(const MorphArgs& args) {
   // The frames go to a staging directory beside them first and are moved into place only when all are
   // written: a run that fails (a full disk) leaves an earlier run's frames as they were, not a mix of both.
   const fs::path staging = fs::path(args.output) / (".morph-partial-" + std::to_string(::getpid()));
-  fs::create_directory(staging);
+  if (std::error_code ec; !fs::create_directory(staging, ec) && ec)
+    throw IoError(args.output + ": cannot create the frames' staging directory " + staging.string() + ": " +
+                  ec.message());
   struct RemoveStaging {
     fs::path path;
     ~RemoveStaging() {

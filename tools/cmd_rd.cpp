@@ -328,6 +328,7 @@ int run_rd(const RdArgs& args) {
     throw InvalidInput("--search chooses the layout and the fit itself: not with --patches, --tip-loop, "
                        "--end-loop or --fit");
   const auto start = std::chrono::steady_clock::now();
+  note_input_file(args.mesh);
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
   check_draco_positions(original->positions, args.mesh);  // every series codes with Draco: refused now
   const unsigned threads =
@@ -543,8 +544,11 @@ CommandRunner add_rd_command(CLI::App& app) {
       "--lindstrom-turk", args->lindstrom_turk,
       "Also decimate with CGAL's Lindstrom-Turk edge collapse (series draco_lt, same faces x Q) and "
       "write draco_lt_envelope over draco, draco_qem and draco_lt (needs a manifold MESH)");
+  // Bounded as `geomip eval --samples`: each sample is a closest-point query and 56 bytes.
   cmd->add_option("--samples", args->samples,
-                  "Face samples per surface for the evaluation (default: as `geomip eval`; --quick: 20000)");
+                  "Face samples per surface for the evaluation, in [1, 10^8] (default: as `geomip eval`; "
+                  "--quick: 20000)")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{100000000}));
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)");
   CLI::Option* level =
       cmd->add_option(

@@ -266,7 +266,8 @@ CommandRunner add_remesh_command(CLI::App& app) {
       "patch until the plane-fit error is below EPS, restricted and crack-free: DIR/<stem>.adaptive.obj. "
       "Watertight and oriented, with one face list for all models of a consistent set.");
   add_model_options(cmd, args->common);
-  cmd->add_option("--level", args->level, "Level K in [0, 10]: (2^K)² quads per patch");
+  cmd->add_option("--level", args->level, "Level K in [0, 10]: (2^K)² quads per patch")
+      ->check(CLI::Range(0, kMaxGeometryImageLevel));
   cmd->add_option("--adaptive", args->adaptive,
                   "Adaptive remesh (paper §4, eq. 4-6) with error bound EPS (fraction of the bounding-box "
                   "diagonal): DIR/<stem>.adaptive.obj, one face list for a consistent set")

@@ -47,8 +47,14 @@ std::string summary(const RepairResult& r) {
 }
 
 int run_repair(const RepairArgs& args) {
+  note_input_file(args.input);
   check_output_file(args.output);
-  const MeshFormat out_format = mesh_format_from_path(args.output);  // fail before the work
+  MeshFormat out_format = MeshFormat::kObj;
+  try {
+    out_format = mesh_format_from_path(args.output);  // fail before the work
+  } catch (const InvalidInput&) {  // its message lists the formats geomip reads, STL among them
+    throw InvalidInput(args.output + ": not a mesh format geomip writes (.obj, .ply, .off, .gltf or .glb)");
+  }
   if (out_format == MeshFormat::kStl) {
     std::cerr << "geomip repair: " << args.output
               << ": STL output is not supported (use .obj, .ply, .off, .gltf or .glb)\n";

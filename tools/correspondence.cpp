@@ -1,6 +1,7 @@
 #include "tools/correspondence.h"
 
 #include "mesh/errors.h"
+#include "tools/atomic_file.h"
 
 #include <nlohmann/json.hpp>
 
@@ -77,6 +78,9 @@ std::vector<PointSpec> points(const std::string& path, const nlohmann::json& mod
 }  // namespace
 
 std::vector<ModelSpec> read_correspondence(const std::string& path) {
+  note_input_file(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a correspondence file");
   std::ifstream in(path);
   if (!in) fail(path, std::filesystem::exists(path) ? "cannot open for reading" : "no such file");
   nlohmann::json j;

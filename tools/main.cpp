@@ -6,6 +6,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <new>
 #include <vector>
@@ -58,7 +61,18 @@ int main(int argc, char** argv) {
     if (!c.cmd->parsed()) continue;
     const std::string name = "geomip " + c.cmd->get_name();
     try {
-      return c.run();
+      const int code = c.run();
+      // A report that did not reach its reader (a full disk, /dev/full, a closed pipe) is a failed run: the
+      // caller would read a truncated JSON as the answer.
+      errno = 0;
+      std::cout.flush();
+      if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+        const int error = errno;
+        std::cerr << name << ": cannot write to standard output"
+                  << (error != 0 ? std::string(" (") + std::strerror(error) + ")" : std::string()) << "\n";
+        return code != kExitOk ? code : kExitFailure;
+      }
+      return code;
     } catch (const geomip::InvalidInput& e) {
       std::cerr << name << ": " << geomip::codec::one_line(e.what()) << "\n";
       return kExitBadInput;

@@ -252,6 +252,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
 
   for (std::size_t m = 0; m < specs.size(); ++m) {
     const ModelSpec& spec = specs[m];
+    note_input_file(spec.mesh);
     const TriMesh input = read_mesh(spec.mesh);
     ParameterizationInput in;
     in.mesh = prepare_mesh(spec.mesh, input, command, quiet);

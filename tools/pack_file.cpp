@@ -1,6 +1,7 @@
 #include "tools/pack_file.h"
 
 #include "mesh/errors.h"
+#include "tools/atomic_file.h"
 
 #include <cerrno>
 #include <cstring>
@@ -11,6 +12,7 @@ namespace geomip::tools {
 
 std::vector<std::uint8_t> read_pack_file(const std::string& path) {
   namespace fs = std::filesystem;
+  note_input_file(path);
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (status.type() == fs::file_type::not_found) throw InvalidInput(path + ": no such file");

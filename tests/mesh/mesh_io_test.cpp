@@ -335,6 +335,55 @@ TEST_F(MeshIo, PlyListsReadWithEveryLengthTypeName) {
   }
 }
 
+// OpenMesh's OBJ and PLY readers round coordinates to float: a mesh a million units from its origin (a
+// georeferenced scan) lost everything below 0.06 units, and a 1-unit cube at 10^8 read as 12 degenerate
+// faces. OBJ and PLY (ascii or binary double properties) are now read as written; a UTF-8 byte-order mark
+// before an OBJ's first line no longer hides its first vertex.
+TEST_F(MeshIo, ObjAndPlyCoordinatesAreReadAsWritten) {
+  const double offset = 123456789.0123;  // float spacing there: 8
+  const std::vector<Eigen::Vector3d> corners = {{offset, 0.5, -offset},
+                                                {offset + 1.25, 0.5, -offset},
+                                                {offset, 1.75, -offset},
+                                                {offset, 0.5, -offset + 0.001}};
+  std::ostringstream obj, ply;
+  obj.precision(17);
+  ply.precision(17);
+  ply << "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+         "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const auto& p : corners) {
+    obj << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+    ply << p.x() << " " << p.y() << " " << p.z() << "\n";
+  }
+  obj << "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  ply << "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  // Binary little-endian doubles.
+  std::string bin =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty double x\n"
+      "property double y\nproperty double z\nelement face 4\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  for (const auto& p : corners)
+    for (int c = 0; c < 3; ++c) bin.append(reinterpret_cast<const char*>(&p[c]), sizeof(double));
+  for (const std::array<int, 3>& t : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}) {
+    bin += static_cast<char>(3);
+    for (int v : t) bin.append(reinterpret_cast<const char*>(&v), sizeof(int));
+  }
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"far.obj", obj.str()},
+                                   {"bom.obj", "\xEF\xBB\xBF" + obj.str()},
+                                   {"far.ply", ply.str()},
+                                   {"far_bin.ply", bin}}) {
+    const TriMesh m = read_mesh(write_text(dir_, name, text));
+    ASSERT_EQ(m.positions.size(), corners.size()) << name;
+    for (std::size_t v = 0; v < corners.size(); ++v)
+      EXPECT_EQ(m.positions[v], corners[v]) << name << " " << v;
+    EXPECT_EQ(m.triangles.size(), 4u) << name;
+  }
+  expect_rejected(write_text(dir_, "noz.ply",
+                             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0\n1 0\n"
+                             "0 1\n3 0 1 2\n"),
+                  "no property 'z'");
+}
+
 // Geomview's OFF allows comments from '#' to the end of a line; they were refused ("the vertex count '#' is
 // not a count"). Comment lines anywhere after the magic and trailing comments read as if absent; a problem
 // after a comment still names its line.

@@ -264,6 +264,102 @@ TEST_F(Cli, RepairWritesAtomicallyAndNeverLeavesPartialFiles) {
   }
 }
 
+// Found by a review on 2026-12-06: an output that is an input of the same run is refused, whatever the
+// command (repair's input, convert's --points file, under any name), and nothing is written.
+TEST_F(Cli, AnOutputIsNeverAnInputOfTheSameRun) {
+  const std::string mesh = dir_ + "/a.obj";
+  fs::copy_file(std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj", mesh);
+  const std::string before = slurp(mesh);
+  fs::create_hard_link(mesh, dir_ + "/hard.obj");
+  for (const std::string& out : {mesh, dir_ + "/./a.obj", dir_ + "/hard.obj"}) {
+    expect_bad_input("repair '" + mesh + "' -q -o '" + out + "'", "would destroy the input");
+    EXPECT_EQ(slurp(mesh), before) << out;
+  }
+  const std::string points = file("keep.json", "{\"models\": [{\"mesh\": \"a.obj\"}]}");
+  expect_bad_input("convert --points '" + points + "' --level 3 -q -o '" + points + "'",
+                   "would destroy the input");
+  EXPECT_EQ(slurp(points), "{\"models\": [{\"mesh\": \"a.obj\"}]}");
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+}
+
+// A report that cannot be written (a full disk) fails the run: exit 1 and one line, not exit 0 with a
+// truncated JSON.
+TEST_F(Cli, AReportThatCannotBeWrittenFailsTheRun) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const std::string spot = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
+  const std::string cmd =
+      "'" + std::string(GEOMIP_BINARY) + "' info --json '" + spot + "' > /dev/full 2> '" + dir_ + "/stderr'";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  const std::string err = slurp(dir_ + "/stderr");
+  EXPECT_NE(err.find("cannot write to standard output"), std::string::npos) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  // The same report to a file is written whole, exit 0.
+  EXPECT_EQ(geomip("info --json '" + spot + "'").exit_code, 0);
+}
+
+// Inputs and outputs the review found handled badly: a directory as --points (an exception's text, exit 1),
+// an unwritable morph directory (found only after the decode, exit 1), a UTF-8 byte-order mark before an
+// OBJ's first vertex (the vertex lost, every index shifted), a PLY without coordinates (every point at the
+// origin), out-of-range option values taken as "not given", and an output name of 255 bytes (its temporary
+// name was too long: exit 1 after the work).
+TEST_F(Cli, ReviewedInputsAndOptionsSayWhatIsWrong) {
+  fs::create_directories(dir_ + "/pts");
+  expect_bad_input("param --points '" + dir_ + "/pts' -o '" + dir_ + "/o'", "is a directory");
+  expect_bad_input("convert --points '" + dir_ + "/pts' -o '" + dir_ + "/o.gip'", "is a directory");
+  if (fs::is_directory("/proc/self")) {
+    const std::string junk = file("junk.gip", "not a pack");
+    expect_bad_input("morph '" + junk + "' -o /proc", "/proc");
+  }
+  const std::string plain = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 5\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n";
+  const Outcome without = geomip("info --json '" + file("plain.obj", plain) + "'");
+  const Outcome with = geomip("info --json '" + file("bom.obj", "\xEF\xBB\xBF" + plain) + "'");
+  ASSERT_EQ(without.exit_code, 0) << without.err;
+  ASSERT_EQ(with.exit_code, 0) << with.err;
+  auto drop_input = [](nlohmann::json j) {
+    j.erase("file");
+    return j;
+  };
+  EXPECT_EQ(drop_input(nlohmann::json::parse(with.out)), drop_input(nlohmann::json::parse(without.out)));
+  expect_bad_input("info '" +
+                       file("noxyz.ply",
+                            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float a\n"
+                            "property float b\nproperty float c\nelement face 1\n"
+                            "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n"
+                            "0 1 0\n3 0 1 2\n") +
+                       "'",
+                   "no property 'x'");
+  const std::string spot = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
+  for (const std::string& args :
+       {"remesh '" + spot + "' --level -1 --adaptive 0.01 -o '" + dir_ + "/r'",
+        "convert '" + spot + "' --level 3 --normal-level -1 -o '" + dir_ + "/n.gip'",
+        "gimage '" + spot + "' --level 3 --normal-level -1 -o '" + dir_ + "/g'",
+        "rd '" + spot + "' --samples 0 --no-geomip -o '" + dir_ + "/rd'",
+        "rd '" + spot + "' --samples 150000000 --no-geomip -o '" + dir_ + "/rd'",
+        "convert '" + spot + "' --level 3 --no-normals --normal-level 4 -o '" + dir_ + "/m.gip'"}) {
+    const Outcome r = geomip(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir_ + "/r"));
+  EXPECT_FALSE(fs::exists(dir_ + "/n.gip"));
+  EXPECT_FALSE(fs::exists(dir_ + "/m.gip"));
+  // repair's output formats: not the list of those geomip reads (STL among them, then refused).
+  const Outcome xyz = geomip("repair '" + spot + "' -o '" + dir_ + "/out.xyz'");
+  EXPECT_EQ(xyz.exit_code, 2);
+  EXPECT_NE(xyz.err.find("geomip writes"), std::string::npos) << xyz.err;
+  EXPECT_EQ(xyz.err.find(".stl"), std::string::npos) << xyz.err;
+  // 255 bytes, the longest name most file systems take.
+  const std::string longest = dir_ + "/" + std::string(251, 'b') + ".obj";
+  const Outcome r = geomip("repair -q '" + spot + "' -o '" + longest + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(longest));
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+}
+
 TEST_F(Cli, RepairCowThenInfoSaysManifold) {
   GEOMIP_REQUIRE_SHARED_MESH(cow, "cow.obj");
   const std::string out = dir_ + "/cow.ply";
@@ -1894,6 +1990,34 @@ TEST_F(CliPack, InfoDescribesAPack) {
   const Outcome text = geomip("info '" + pack + "'");
   EXPECT_NE(text.out.find("first level of detail after " + std::to_string(first) + " bytes"), std::string::npos) << text.out;
   expect_bad_input("info '" + file("junk.gip", "not a pack") + "'", "junk.gip");
+}
+
+// A pack of models whose grids have different levels (`encode` of two geometry-image sets): each model is
+// decoded at its own level, and --level above a model's level is refused naming that model (it took the first
+// model's level for all of them, so the second was reported at the wrong level or refused by an internal
+// check).
+TEST_F(CliPack, DecodeGivesEachModelOfAMixedLevelPackItsOwnLevel) {
+  ASSERT_EQ(geomip("gimage -q '" + spot_ + "' --level 3 -o '" + dir_ + "/g3'").exit_code, 0);
+  ASSERT_EQ(geomip("gimage -q '" + spot_ + "' --level 4 -o '" + dir_ + "/g4'").exit_code, 0);
+  const std::string pack = dir_ + "/mixed.gip";
+  ASSERT_EQ(geomip("encode -q --no-normals '" + dir_ + "/g4' '" + dir_ + "/g3' -o '" + pack + "'").exit_code,
+            0);
+  Outcome r = geomip("decode --json '" + pack + "' -o '" + dir_ + "/d.obj'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["models"].size(), 2u);
+  // spot's patches: (2^N)² quads of two triangles each, whatever their count.
+  const std::size_t faces4 = j["models"][0]["faces"], faces3 = j["models"][1]["faces"];
+  EXPECT_EQ(faces4, 4 * faces3);
+  r = geomip("decode '" + pack + "' -o '" + dir_ + "/e.obj'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("(level 4,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(level 3,"), std::string::npos) << r.out;
+  r = geomip("decode '" + pack + "' --level 4 -o '" + dir_ + "/f.obj'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("level 3"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("decoded_mesh"), std::string::npos) << r.err;
+  EXPECT_EQ(geomip("decode -q '" + pack + "' --level 3 -o '" + dir_ + "/g.obj'").exit_code, 0);
 }
 
 TEST_F(CliPack, EncodeFromGimageDirectory) {

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -353,7 +354,8 @@ int run(const Options& opt) {
       if (!opt.screenshot.empty() && !last_pixels.empty()) {
         std::string e;
         if (!write_png(opt.screenshot, opt.width, opt.height, last_pixels, e)) {
-          std::cerr << "geomip-view: --screenshot: " << geomip::codec::one_line(e) << "\n";
+          if (exit_code != kExitFailure)  // a failed --first-screenshot said its line already
+            std::cerr << "geomip-view: --screenshot: " << geomip::codec::one_line(e) << "\n";
           exit_code = kExitFailure;
         }
       }
@@ -378,6 +380,8 @@ int run(const Options& opt) {
       std::cerr << "geomip-view: nothing to show"
                 << (err.empty() ? " from " + opt.source + " (no geometry arrived)" : " (" + err + ")") << "\n";
       exit_code = kExitBadInput;
+    } else if (!source.complete() && exit_code == kExitFailure) {
+      // A screenshot that could not be written said its line and set exit 1: exactly one line.
     } else if (!source.complete()) {
       std::cerr << "geomip-view: incomplete stream: kept the level from " << shown_bytes << " of "
                 << (total ? total : source.total()) << " bytes" << (err.empty() ? "" : " (" + err + ")") << "\n";
@@ -518,6 +522,14 @@ int main(int argc, char** argv) {
     std::string e;
     if (app.count(flag) > 0 && !check_png_output(*path, e)) {
       std::cerr << "geomip-view: " << flag << ": " << geomip::codec::one_line(e) << "\n";
+      return kExitBadInput;
+    }
+    // The pack itself (a local file) under any name: the screenshot would replace it.
+    std::error_code ec;
+    if (app.count(flag) > 0 && std::filesystem::exists(*path, ec) &&
+        std::filesystem::exists(opt.source, ec) && std::filesystem::equivalent(*path, opt.source, ec)) {
+      std::cerr << "geomip-view: " << flag << ": " << geomip::codec::one_line(*path) << " is the pack "
+                << geomip::codec::one_line(opt.source) << ": writing it would destroy the pack\n";
       return kExitBadInput;
     }
   }

@@ -64,10 +64,21 @@ bool writes_in_place(const std::string& path) {
 /// Writes the PNG into `file` (created or truncated: `opened`), flushed and closed; false with `problem` set.
 bool write_png_file(const std::string& file, int width, int height, const std::vector<std::uint8_t>& rgb,
                     std::string& problem, bool& opened) {
-  FILE* f = std::fopen(file.c_str(), "wb");
-  opened = f != nullptr;
+  // Opened without blocking: a named pipe that nothing reads fails now (ENXIO) instead of waiting for ever
+  // (probing it beforehand would hand a reader an end of file); then written as usual.
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NONBLOCK | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    opened = false;
+    problem = errno == ENXIO ? "'" + file + "' is a named pipe that nothing reads"
+                             : "cannot create '" + file + "' (" + std::strerror(errno) + ")";
+    return false;
+  }
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  FILE* f = ::fdopen(fd, "wb");
+  opened = true;
   if (f == nullptr) {
-    problem = "cannot create '" + file + "' (" + std::strerror(errno) + ")";
+    problem = "cannot write '" + file + "' (" + std::strerror(errno) + ")";
+    ::close(fd);
     return false;
   }
   bool ok = write_png_stream(f, width, height, rgb, problem);
@@ -103,10 +114,22 @@ bool write_png(const std::string& path, int width, int height, const std::vector
     error = "cannot write " + path + ": " + problem;
     return false;
   }
+  const std::string filename = fs::path(path).filename().string();
+  std::string suffix = ".tmp-";
+  suffix += std::to_string(::getpid());
   std::string tmp_name = ".";  // appended, not "." + ...: GCC 12's -Wrestrict misfires on that
-  tmp_name += fs::path(path).filename().string();
-  tmp_name += ".tmp-";
-  tmp_name += std::to_string(::getpid());
+  tmp_name += filename;
+  tmp_name += suffix;
+  long name_max = ::pathconf(directory_of(path).c_str(), _PC_NAME_MAX);
+  if (name_max <= 0) name_max = 255;
+  if (tmp_name.size() > static_cast<std::size_t>(name_max)) {  // a name near the limit: a shorter temporary
+    char hash[24];
+    std::snprintf(hash, sizeof hash, "-%016zx", std::hash<std::string>{}(filename));
+    tmp_name.assign(1, '.');
+    tmp_name.append(filename, 0, std::min<std::size_t>(filename.size(), 64));
+    tmp_name.append(hash);
+    tmp_name.append(suffix);
+  }
   const fs::path tmp = directory_of(path) / tmp_name;
   bool ok = write_png_file(tmp.string(), width, height, rgb, problem, opened);
   std::error_code ec;
@@ -136,9 +159,11 @@ bool check_png_output(const std::string& path, std::string& error) {
     return false;
   }
   if (writes_in_place(path)) {  // a device or a pipe: written through, its directory is not touched
-    if (::access(path.c_str(), W_OK) == 0) return true;
-    error = path + ": is not writable";
-    return false;
+    if (::access(path.c_str(), W_OK) != 0) {
+      error = path + ": is not writable";
+      return false;
+    }
+    return true;
   }
   const fs::path dir = directory_of(path);
   if (!fs::is_directory(dir, ec)) {

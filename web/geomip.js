@@ -56,6 +56,10 @@ export class GeomipDecoder {
   /// Appends the next bytes of the file (a Uint8Array, another typed array or DataView, or an ArrayBuffer).
   push(bytes) {
     this.check_();
+    // Bytes only: `new Uint8Array(123)` would append 123 zero bytes, and a string or null pushed nothing.
+    if (!(bytes instanceof ArrayBuffer) && !ArrayBuffer.isView(bytes))
+      throw new GeomipError('invalid-argument', 'push() takes a Uint8Array, another typed array, a DataView or ' +
+                            `an ArrayBuffer, not ${bytes === null ? 'null' : typeof bytes}`);
     const view = bytes instanceof Uint8Array ? bytes :
         ArrayBuffer.isView(bytes) ? new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength) :
                                     new Uint8Array(bytes);

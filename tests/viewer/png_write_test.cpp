@@ -127,6 +127,22 @@ TEST_F(PngWrite, APipeIsWrittenThroughNotReplaced) {
   EXPECT_EQ(files(), std::vector<std::string>{"pipe.png"});
 }
 
+// Found by a review on 2026-12-06: a named pipe that nothing reads blocked the write for ever (the viewer
+// hung after rendering), and a 255-byte name failed because its temporary ".<name>.tmp-<pid>" was too long.
+TEST_F(PngWrite, APipeWithoutAReaderFailsAndALongNameIsWritten) {
+  const fs::path fifo = dir_ / "lonely.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string error;
+  EXPECT_FALSE(write_png(fifo.string(), 4, 4, noise(4, 4), error));  // returns: no reader, no wait
+  EXPECT_NE(error.find("nothing reads"), std::string::npos) << error;
+  fs::remove(fifo);
+  const fs::path longest = dir_ / (std::string(251, 'a') + ".png");
+  EXPECT_TRUE(check_png_output(longest.string(), error)) << error;
+  EXPECT_TRUE(write_png(longest.string(), 4, 4, noise(4, 4), error)) << error;
+  EXPECT_EQ(slurp(longest).substr(0, 4), "\x89PNG");
+  EXPECT_EQ(files(), std::vector<std::string>{longest.filename().string()}) << "no temporary file left";
+}
+
 TEST_F(PngWrite, MissingDirectoriesAreSaidBeforeAndNothingIsCreated) {
   const std::string missing = (dir_ / "no-such-dir" / "shot.png").string();
   std::string error;

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -654,6 +655,29 @@ TEST_F(ViewPackTest, MissingOrNonPackSourcesGiveAClearMessage) {
   r = view((work_dir() / "missing.gip").string() + " " + size_args());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("cannot open"), std::string::npos) << r.err;
+}
+
+// Found by a review on 2026-12-06: --screenshot (or --first-screenshot) naming the pack replaced the pack by
+// a PNG, exit 0. Refused before any window, exit 2, one line; the pack stays as it was.
+TEST_F(ViewPackTest, AScreenshotNeverReplacesThePack) {
+  const fs::path pack = work_dir() / "own.gip";
+  fs::copy_file(pack_file(4), pack, fs::copy_options::overwrite_existing);
+  const std::string before = [&] {
+    std::ifstream in(pack, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
+  fs::create_hard_link(pack, work_dir() / "own-link.gip");
+  for (const std::string flag : {"--screenshot", "--first-screenshot"}) {
+    for (const fs::path& target : {pack, work_dir() / "own-link.gip"}) {
+      const ViewRun r = view(pack.string() + " " + size_args() + " " + flag + " " + target.string());
+      EXPECT_EQ(r.code, 2) << flag << ": " << r.err;
+      EXPECT_NE(r.err.find("would destroy the pack"), std::string::npos) << r.err;
+      EXPECT_EQ(lines(r.err), 1u) << r.err;
+    }
+  }
+  std::ifstream in(pack, std::ios::binary);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), before);
+  fs::remove(work_dir() / "own-link.gip");
 }
 
 // NaN and infinities are not numbers for the camera and the timeout (a NaN camera drew a blank frame and

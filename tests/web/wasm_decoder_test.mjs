@@ -47,6 +47,32 @@ function canonicalHashes(words) {
 }
 
 let failures = 0;
+{
+  // push() takes bytes only (found by a review on 2026-12-06: push(123) appended 123 zero bytes, push('abc')
+  // and push(null) were ignored, push(-1) threw a raw RangeError): anything else is a GeomipError
+  // 'invalid-argument' and changes nothing.
+  const decoder = await createDecoder({ coreUrl: pathToFileURL(coreJs).href, wasmBinary });
+  decoder.push(new Uint8Array([1, 2, 3]));
+  for (const bad of [123, -1, 1e10, 'abc', null, undefined, {}, [1, 2]]) {
+    let status = null;
+    try {
+      decoder.push(bad);
+    } catch (e) {
+      status = e.status ?? `${e.name}: ${e.message}`;
+    }
+    if (status !== 'invalid-argument' || decoder.size !== 3) {
+      console.error(`push(${JSON.stringify(bad)}): ${status}, size ${decoder.size} (want invalid-argument, 3)`);
+      ++failures;
+    }
+  }
+  decoder.push(new DataView(new ArrayBuffer(2)));
+  decoder.push(new ArrayBuffer(1));
+  if (decoder.size !== 6) {
+    console.error(`a DataView and an ArrayBuffer pushed: size ${decoder.size}, want 6`);
+    ++failures;
+  }
+  decoder.dispose();
+}
 for (const spec of packs) {
   const [pack, minModelsText, features = ''] = spec.split(':');
   const bytes = readFileSync(pack);

@@ -121,15 +121,40 @@ std::vector<SideLink> adjacency_from_text(const std::string& text) {
     std::istringstream t(token);
     if (!(t >> a.patch >> dot1 >> a.side >> dash >> a.other_patch >> dot2 >> a.other_side) || dot1 != '.' ||
         dash != '-' || dot2 != '.') {
-      throw InvalidInput("adjacency_from_text: malformed entry '" + token + "'");
+      throw InvalidInput("malformed entry '" + token + "' (expected p.s-q.t or p.s-q.tr)");
     }
     std::string rest;
     t >> rest;
-    if (rest != "" && rest != "r") throw InvalidInput("adjacency_from_text: malformed entry '" + token + "'");
+    if (rest != "" && rest != "r")
+      throw InvalidInput("malformed entry '" + token + "' (expected p.s-q.t or p.s-q.tr)");
     a.reversed = rest == "r";
     links.push_back(a);
   }
   return links;
+}
+
+void check_adjacency(const std::vector<SideLink>& links, int num_patches) {
+  if (num_patches < 1 || links.size() != 4 * static_cast<std::size_t>(num_patches))
+    throw InvalidInput(std::to_string(links.size()) + " side links for " + std::to_string(num_patches) +
+                       " patches (one per side: " + std::to_string(4LL * num_patches) + ")");
+  auto name = [](int p, int s) { return std::to_string(p) + "." + std::to_string(s); };
+  for (std::size_t k = 0; k < links.size(); ++k) {
+    const SideLink& a = links[k];
+    const int p = static_cast<int>(k / 4), s = static_cast<int>(k % 4);
+    if (a.patch != p || a.side != s)
+      throw InvalidInput("entry " + std::to_string(k) + " is for side " + name(a.patch, a.side) + ", not " +
+                         name(p, s) + " (one entry per side, in order)");
+    if (a.other_patch < 0 || a.other_patch >= num_patches || a.other_side < 0 || a.other_side > 3)
+      throw InvalidInput("side " + name(p, s) + " is glued to " + name(a.other_patch, a.other_side) +
+                         ", which is not a side of one of the " + std::to_string(num_patches) + " patches");
+    if (a.other_patch == p && a.other_side == s)
+      throw InvalidInput("side " + name(p, s) + " is glued to itself");
+    const SideLink& b = links[4 * static_cast<std::size_t>(a.other_patch) + a.other_side];
+    if (b.other_patch != p || b.other_side != s || b.reversed != a.reversed)
+      throw InvalidInput("side " + name(p, s) + " is glued to " + name(a.other_patch, a.other_side) +
+                         ", which is glued to " + name(b.other_patch, b.other_side) +
+                         (b.reversed != a.reversed ? " in the other direction" : ""));
+  }
 }
 
 std::vector<GeometryImage> finest_grids(const GeometryImageFile& file) {
@@ -214,8 +239,13 @@ GeometryImageFile read_geometry_image_exr(const std::string& path) {
         if (const auto* a = h.findTypedAttribute<Imf::StringAttribute>("geomip:source_mesh"))
           file.info.source_mesh = a->value();
         if (const auto* a = h.findTypedAttribute<Imf::IntAttribute>("geomip:level")) file.info.level = a->value();
-        if (const auto* a = h.findTypedAttribute<Imf::StringAttribute>("geomip:adjacency"))
-          file.info.adjacency = adjacency_from_text(a->value());
+        if (const auto* a = h.findTypedAttribute<Imf::StringAttribute>("geomip:adjacency")) {
+          try {
+            file.info.adjacency = adjacency_from_text(a->value());
+          } catch (const InvalidInput& e) {
+            throw InvalidInput(path + ": geomip:adjacency: " + e.what());
+          }
+        }
         if (const auto* a = h.findTypedAttribute<Imf::M44dAttribute>("geomip:normalization")) {
           for (int r = 0; r < 4; ++r)
             for (int c = 0; c < 4; ++c) file.info.normalization[4 * r + c] = a->value()[r][c];
@@ -281,6 +311,13 @@ GeometryImageFile read_geometry_image_exr(const std::string& path) {
     throw InvalidInput(path + ": not a readable EXR image (" + e.what() + ")");
   }
   if (file.parts.empty()) throw InvalidInput(path + ": no image in the file");
+  if (!file.info.adjacency.empty()) {  // a crafted or edited file: the seams must glue the parts as a surface
+    try {
+      check_adjacency(file.info.adjacency, static_cast<int>(file.parts.size()));
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(path + ": geomip:adjacency: " + e.what());
+    }
+  }
   return file;
 }
 

@@ -45,8 +45,9 @@ struct ExrWriteOptions {
 /// Writes `patches` (all of one level) to `path` as a multipart tiled EXR with one MIP pyramid per patch (see
 /// the file comment). `info.level` is taken from the images. Written to `path + ".tmp-<pid>"` and renamed
 /// over `path`; on failure the temporary file is removed and `path` is untouched. \throw InvalidInput when
-/// `patches` is empty, the images' levels differ or their sizes are wrong. \throw IoError when the file
-/// cannot be written (OpenEXR's message included).
+/// `patches` is empty, the images' levels differ or their sizes are wrong. `info.adjacency` is written as
+/// given (read_geometry_image_exr() checks it). \throw IoError when the file cannot be written (OpenEXR's
+/// message included).
 void write_geometry_image_exr(const std::string& path, const std::vector<GeometryImage>& patches,
                               const GeometryImageFileInfo& info, const ExrWriteOptions& options = {});
 
@@ -70,7 +71,7 @@ struct GeometryImageFile {
 /// not
 ///   an EXR or cannot be read (OpenEXR's message included: truncated or garbage bytes), holds no image, a
 ///   part's channels are not R, G, B, a level is larger than that bound, or the adjacency attribute is
-///   malformed.
+///   malformed or does not glue the parts into a closed surface (check_adjacency()).
 GeometryImageFile read_geometry_image_exr(const std::string& path);
 
 /// The finest MIP level of every part of `file` as GeometryImages (what write_geometry_image_exr() wrote).
@@ -86,5 +87,9 @@ GeometryImage nested_grid(const GeometryImage& image, int level);
 std::string adjacency_to_text(const std::vector<SideLink>& adjacency);
 /// \throw InvalidInput when `text` is not a list of "p.s-q.t[r]" entries.
 std::vector<SideLink> adjacency_from_text(const std::string& text);
+/// Checks that `links` glue `num_patches` quad patches into a closed surface as the writer stores them: one
+/// link per (patch, side) in order, each to a side of another place that links back to it in the same
+/// direction. \throw InvalidInput saying which side is wrong.
+void check_adjacency(const std::vector<SideLink>& links, int num_patches);
 
 }  // namespace geomip

@@ -490,7 +490,9 @@ int main(int argc, char** argv) {
                "decoding) instead of each byte once");
   app.add_flag("--checker", opt.checker, "checkerboard texture in parameter space");
   app.add_flag("--wireframe", opt.wireframe, "wireframe");
-  app.add_option("--limit-rate", opt.limit_rate, "download (or read) at most this many bytes per second");
+  app.add_option("--limit-rate", opt.limit_rate,
+                 "download (or read) at most this many bytes per second (default 0: no limit)")
+      ->check(non_negative("bytes per second"));
   app.add_option("--timeout", opt.timeout, "headless: seconds to wait for the pack")->check(non_negative("seconds"));
   app.add_option(
          "--up", opt.up,

@@ -96,6 +96,17 @@ void rename_into_place(const std::filesystem::path& tmp, const std::string& path
   if (ec) throw IoError(path + ": cannot rename the temporary file into place: " + ec.message());
 }
 
+// The output `path` is none of `inputs` (the same file under any name); inputs that do not exist are skipped.
+void check_output_is_not_an_input(const std::string& path, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return;
+  for (const std::string& input : inputs) {
+    if (fs::exists(input, ec) && fs::equivalent(path, input, ec))
+      throw InvalidInput(path + " is the input " + input + ": writing it would destroy the input");
+  }
+}
+
 }  // namespace
 
 void check_output_file(const std::string& path) {
@@ -105,6 +116,14 @@ void check_output_file(const std::string& path) {
   if (dir.empty()) dir = ".";
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw InvalidInput(path + ": is a directory, not a file to write");
+  {
+    std::vector<std::string> inputs;
+    {
+      const std::lock_guard<std::mutex> lock(inputs_mutex());
+      inputs = noted_inputs();
+    }
+    check_output_is_not_an_input(path, inputs);
+  }
   if (writes_in_place(path)) {  // a device or a pipe: written through, its directory is not touched
     if (::access(path.c_str(), W_OK) != 0) throw InvalidInput(path + ": is not writable");
     return;
@@ -127,28 +146,12 @@ void check_output_file(const std::string& path) {
   }
   ::close(fd);
   ::unlink(probe.c_str());
-  std::vector<std::string> inputs;
-  {
-    const std::lock_guard<std::mutex> lock(inputs_mutex());
-    inputs = noted_inputs();
-  }
-  check_output_is_not_an_input(path, inputs);
 }
 
 void note_input_file(const std::string& path) {
   const std::lock_guard<std::mutex> lock(inputs_mutex());
   if (std::find(noted_inputs().begin(), noted_inputs().end(), path) == noted_inputs().end())
     noted_inputs().push_back(path);
-}
-
-void check_output_is_not_an_input(const std::string& path, const std::vector<std::string>& inputs) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return;
-  for (const std::string& input : inputs) {
-    if (fs::exists(input, ec) && fs::equivalent(path, input, ec))
-      throw InvalidInput(path + " is the input " + input + ": writing it would destroy the input");
-  }
 }
 
 std::vector<std::string> model_file_names(const std::vector<std::string>& names) {
@@ -334,12 +337,33 @@ void check_planned_outputs(const std::string& dir, const std::vector<std::string
   for (const std::string& path : paths) check_output_file(path);
 }
 
-void make_output_directory(const std::string& dir) {
+CreatedDirectories::CreatedDirectories(std::vector<std::string> created)
+    : created_(std::move(created)), exceptions_(std::uncaught_exceptions()) {}
+
+CreatedDirectories::CreatedDirectories(CreatedDirectories&& other) noexcept
+    : created_(std::move(other.created_)), exceptions_(other.exceptions_) {
+  other.created_.clear();
+}
+
+CreatedDirectories::~CreatedDirectories() {
+  if (std::uncaught_exceptions() <= exceptions_) return;  // the command ended normally
+  for (auto it = created_.rbegin(); it != created_.rend(); ++it) {
+    std::error_code ignored;
+    std::filesystem::remove(*it, ignored);  // only an empty directory goes
+  }
+}
+
+CreatedDirectories make_output_directory(const std::string& dir) {
   namespace fs = std::filesystem;
   check_output_directory(dir);  // a file in the way is the user's path
+  std::vector<std::string> missing;  // outermost first
   std::error_code ec;
+  for (fs::path p = fs::path(dir).lexically_normal(); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    missing.insert(missing.begin(), p.string());
+    if (p == p.parent_path()) break;
+  }
   fs::create_directories(dir, ec);
-  if (!ec) return;
+  if (!ec) return CreatedDirectories(std::move(missing));
   check_output_directory(
       dir);  // it may have appeared since; anything else (permissions, a full disk) is the machine's
   throw IoError(dir + ": cannot create the output directory: " + ec.message());

@@ -97,11 +97,6 @@ void check_output_file(const std::string& path);
 /// c.json -o c.json`). Thread-safe; for the whole process.
 void note_input_file(const std::string& path);
 
-/// Checks, before any work, that the output `path` is none of `inputs` (the same file under any name): an
-/// output written over an input would destroy the data it came from. Inputs that do not exist are skipped.
-/// \throw InvalidInput naming both.
-void check_output_is_not_an_input(const std::string& path, const std::vector<std::string>& inputs);
-
 /// File-name parts for models whose names come from files (a pack's manifest, a mesh's stem): each name made
 /// safe (no '/', '\\', control bytes or invalid UTF-8, which become '_'; "", "." and ".." become "model<i>")
 /// and made unique (a repeated name gets "-<i>", i its index), in the order given.
@@ -119,9 +114,29 @@ void check_output_directory(const std::string& dir);
 /// \throw InvalidInput naming the path in the way.
 void check_planned_outputs(const std::string& dir, const std::vector<std::string>& paths);
 
-/// Creates the output directory `dir` and its parents (nothing when it exists).
+/// The directories make_output_directory() created. When the command fails after that (its destructor runs
+/// while an exception unwinds: a full disk, a file that cannot be written), those of them that are empty are
+/// removed again, so a failed run leaves no empty output directory behind; a run that ends normally keeps
+/// them.
+class CreatedDirectories {
+ public:
+  CreatedDirectories() = default;
+  explicit CreatedDirectories(std::vector<std::string> created);
+  CreatedDirectories(CreatedDirectories&& other) noexcept;
+  CreatedDirectories& operator=(CreatedDirectories&&) = delete;
+  CreatedDirectories(const CreatedDirectories&) = delete;
+  CreatedDirectories& operator=(const CreatedDirectories&) = delete;
+  ~CreatedDirectories();
+
+ private:
+  std::vector<std::string> created_;  ///< outermost first
+  int exceptions_ = 0;                ///< std::uncaught_exceptions() when made
+};
+
+/// Creates the output directory `dir` and its parents (nothing when it exists); keep the result alive until
+/// the command's outputs are written (see CreatedDirectories).
 /// \throw InvalidInput when it, or a parent, exists and is not a directory; IoError when it cannot be
 /// created.
-void make_output_directory(const std::string& dir);
+[[nodiscard]] CreatedDirectories make_output_directory(const std::string& dir);
 
 }  // namespace geomip::tools

@@ -64,8 +64,8 @@ MeshFormat format_of(const std::string& path) {
 }
 
 int run_decode(const DecodeArgs& args) {
+  note_input_file(args.pack);  // so that no output of this run, under any name, replaces it
   check_output_file(args.output);
-  check_output_is_not_an_input(args.output, {args.pack});
   const MeshFormat format = format_of(args.output);
   const bool gltf = format == MeshFormat::kGltf || format == MeshFormat::kGlb;
   if (args.draco != 0 && !gltf)
@@ -176,7 +176,7 @@ int run_decode(const DecodeArgs& args) {
             ? args.output
             : (out.parent_path() / (out.stem().string() + "." + file_names[m] + out.extension().string()))
                   .string());
-    check_output_is_not_an_input(paths.back(), {args.pack});
+    check_output_file(paths.back());
   }
   const QuadSplit quad_split = args.quad_split == "fixed" ? QuadSplit::kFixed : QuadSplit::kShorter;
   nlohmann::json j_models = nlohmann::json::array();

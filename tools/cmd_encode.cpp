@@ -102,7 +102,6 @@ GeometryImages load_images(const std::string& geometry_path, bool normals, std::
 
 int run_encode(const EncodeArgs& args) {
   check_pack_output_name(args.output);
-  check_output_file(args.output);
   check_quantization_switches(args.quantization_bits, args.normal_bits, args.normal_bits_given,
                               args.no_normals);
   const std::vector<std::string> files = geometry_files(args.inputs);
@@ -111,7 +110,7 @@ int run_encode(const EncodeArgs& args) {
     if (ends_with(path, kGeometrySuffix))
       inputs.push_back(path.substr(0, path.size() - std::string(kGeometrySuffix).size()) + ".normals.exr");
   for (const std::string& input : inputs) note_input_file(input);
-  check_output_is_not_an_input(args.output, inputs);
+  check_output_file(args.output);  // refuses an output that is one of the inputs noted above
   std::vector<codec::PackModelInput> models;
   bool any_normals = false;
   for (const std::string& path : files) {

@@ -68,7 +68,7 @@ int run_gimage(const GimageArgs& args) {
   const double param_seconds = seconds_since(t0);
   bar.finish();
   // Only now: a failed parameterization leaves no (empty) output directory behind.
-  make_output_directory(args.common.output);
+  const CreatedDirectories created = make_output_directory(args.common.output);
 
   nlohmann::json summary = nlohmann::json::array();
   // Every model's two images or none: an image that cannot be written leaves no other behind.

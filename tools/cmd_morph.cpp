@@ -123,7 +123,7 @@ int run_morph(const MorphArgs& args) {
   codec::DecodedModel frame = decoded.models[args.from];
   unite_hole_masks(frame, decoded.models[args.to]);
 
-  make_output_directory(args.output);
+  const CreatedDirectories created = make_output_directory(args.output);
   const auto schedule = wavelet ? morph::MorphSchedule::kWavelet : morph::MorphSchedule::kLinear;
   // Every frame gets the same face list, and it is `geomip decode`'s for this pack: the quad split is chosen
   // by all the models of the morph's layout together, as decode chooses it (so attributes carry between a
@@ -179,10 +179,8 @@ int run_morph(const MorphArgs& args) {
   // (morph_*.obj): those files, and only files of exactly that name, go.
   std::size_t stale = 0;
   for (int k = args.frames; k <= 9999; ++k) {
-    char name[32];
-    std::snprintf(name, sizeof name, "morph_%04d.obj", k);
     std::error_code ignored;
-    const std::filesystem::path path = std::filesystem::path(args.output) / name;
+    const std::filesystem::path path = std::filesystem::path(args.output) / frame_file_name(k);
     if (!std::filesystem::is_regular_file(path, ignored)) break;
     if (std::filesystem::remove(path, ignored)) ++stale;
   }

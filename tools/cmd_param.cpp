@@ -155,7 +155,7 @@ int run_param(const ParamArgs& args) {
   bar.finish();
 
   // Only now: a failed run leaves no (empty) output directory behind.
-  make_output_directory(args.common.output);
+  const CreatedDirectories created = make_output_directory(args.common.output);
   nlohmann::json summary = nlohmann::json::array();
   // Every model's .param.obj and .param.json or none: a file that cannot be written leaves no other behind.
   AtomicFileSet files;

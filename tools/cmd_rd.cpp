@@ -406,7 +406,7 @@ int run_rd(const RdArgs& args) {
   plot.title = "Rate-distortion: " + std::filesystem::path(args.mesh).filename().string() + " (" +
                std::to_string(original->num_triangles()) + " faces)";
   write_rd_svg(svg, all, plot);
-  make_output_directory(args.output);
+  const CreatedDirectories created = make_output_directory(args.output);
   const std::filesystem::path dir(args.output);
   AtomicFileSet files;  // the table, the plot and the pack, or none of them
   files.add((dir / "rd.csv").string(), [&](std::ostream& out) { out << csv.str(); });

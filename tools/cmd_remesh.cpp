@@ -97,7 +97,7 @@ int run_remesh(const RemeshArgs& args) {
   const double param_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bar.finish();
   // Only now: a failed parameterization leaves no (empty) output directory behind.
-  make_output_directory(args.common.output);
+  const CreatedDirectories created = make_output_directory(args.common.output);
 
   nlohmann::json summary = nlohmann::json::array();
   // Uniform: every model's images and remesh first, so that the models of a set choose the quad split

@@ -10,8 +10,31 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <memory>
 #include <new>
+#include <string>
 #include <vector>
+
+namespace {
+
+// CLI11 names a negated flag's value in the help ("--fit,--no-fit{false}"): the names alone are what a user
+// types.
+class HelpFormatter : public CLI::Formatter {
+ public:
+  std::string make_option_name(const CLI::Option* opt, bool is_positional) const override {
+    const std::string name = CLI::Formatter::make_option_name(opt, is_positional);
+    std::string out;
+    int depth = 0;
+    for (const char c : name) {
+      if (c == '{') ++depth;
+      if (depth == 0) out += c;
+      if (c == '}' && depth > 0) --depth;
+    }
+    return out;
+  }
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace geomip::tools;
@@ -19,6 +42,7 @@ int main(int argc, char** argv) {
                "Exit codes: 0 ok, 1 internal failure, 2 bad input or usage.",
                "geomip"};
   app.require_subcommand(1);
+  app.formatter(std::make_shared<HelpFormatter>());  // subcommands added below share it
   app.set_version_flag("--version", "geomip 0.1.0");
 
   struct Entry {

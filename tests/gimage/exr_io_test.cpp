@@ -114,6 +114,7 @@ TEST_F(Exr, HalfNormalsRoundTripAsHalves) {
   }
   GeometryImageFileInfo info = sample_info();
   info.kind = "normals";
+  info.adjacency.clear();  // sample_info()'s links glue 2 patches, not 4
   const std::string path = dir_ + "/m.normals.exr";
   write_geometry_image_exr(path, patches, info, {true, 32});
   const GeometryImageFile file = read_geometry_image_exr(path);
@@ -192,6 +193,45 @@ TEST(ExrAdjacencyText, RoundTripsAndRejectsGarbage) {
   for (const char* bad : {"0.0-1", "0,0-1.3r", "0.0-1.3x", "a.b-c.d"}) {
     EXPECT_THROW(adjacency_from_text(bad), InvalidInput) << bad;
   }
+}
+
+// An edited or crafted adjacency attribute that does not glue the parts into a closed surface (a side glued
+// to itself, to a side that is glued elsewhere, in the other direction, or to a patch that is not there) is
+// refused by the reader, naming the file and the side: `geomip encode` coded such files (exit 0) or failed
+// with "encode_geometry: seam references a bad patch or side", no file named.
+TEST_F(Exr, AnAdjacencyThatDoesNotCloseTheSurfaceIsRefusedNamingTheFile) {
+  const auto good = sample_info();
+  ASSERT_NO_THROW(check_adjacency(good.adjacency, 2));
+  auto edited = [&](int k, int other_patch, int other_side, bool reversed) {
+    GeometryImageFileInfo info = good;
+    info.adjacency[static_cast<std::size_t>(k)].other_patch = other_patch;
+    info.adjacency[static_cast<std::size_t>(k)].other_side = other_side;
+    info.adjacency[static_cast<std::size_t>(k)].reversed = reversed;
+    return info;
+  };
+  const SideLink first = good.adjacency[0];
+  const std::vector<std::pair<GeometryImageFileInfo, std::string>> cases = {
+      {edited(0, 0, 0, first.reversed), "glued to itself"},
+      {edited(0, first.other_patch, (first.other_side + 1) % 4, first.reversed), "which is glued to"},
+      {edited(0, first.other_patch, first.other_side, !first.reversed), "in the other direction"},
+      {edited(0, 7, 0, first.reversed), "not a side of one of the 2 patches"},
+  };
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    const std::string path = dir_ + "/edited" + std::to_string(c) + ".exr";
+    write_geometry_image_exr(path, random_patches(2, 3, 1), cases[c].first);
+    try {
+      read_geometry_image_exr(path);
+      ADD_FAILURE() << cases[c].second << ": read";
+    } catch (const InvalidInput& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(path + ": geomip:adjacency: "), std::string::npos) << what;
+      EXPECT_NE(what.find(cases[c].second), std::string::npos) << what;
+    }
+  }
+  GeometryImageFileInfo three = good;  // the 2-patch links on a file of 3 parts
+  const std::string path = dir_ + "/three.exr";
+  write_geometry_image_exr(path, random_patches(3, 3, 1), three);
+  EXPECT_THROW(read_geometry_image_exr(path), InvalidInput);
 }
 
 TEST(NestedGrid, TakesEveryStepthSample) {

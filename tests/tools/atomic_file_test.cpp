@@ -43,6 +43,34 @@ class AtomicFileSetTest : public ::testing::Test {
   }
 };
 
+// A command that fails after making its output directory (a full disk while writing) left it behind, empty:
+// the directories it made go again when empty, those that were there stay, and a run that ends keeps them.
+TEST_F(AtomicFileSetTest, AFailedRunLeavesNoEmptyOutputDirectory) {
+  fs::create_directories(path("there"));
+  try {
+    const CreatedDirectories created = make_output_directory(path("there/a/b/c"));
+    ASSERT_TRUE(fs::is_directory(path("there/a/b/c")));
+    throw IoError("disk full");
+  } catch (const IoError&) {
+  }
+  EXPECT_EQ(listing(), std::set<std::string>{"there"});
+  try {  // a directory that holds a file by then stays, with its parents
+    const CreatedDirectories created = make_output_directory(path("there/x/y"));
+    put("there/x/keep", "k");
+    throw IoError("later failure");
+  } catch (const IoError&) {
+  }
+  EXPECT_EQ(listing(), (std::set<std::string>{"there", "there/x", "there/x/keep"}));
+  { const CreatedDirectories created = make_output_directory(path("there/ok/d")); }
+  EXPECT_TRUE(fs::is_directory(path("there/ok/d")));
+  try {  // made while another exception was already being handled: only its own failure counts
+    throw std::runtime_error("outer");
+  } catch (const std::runtime_error&) {
+    const CreatedDirectories created = make_output_directory(path("there/inner"));
+  }
+  EXPECT_TRUE(fs::is_directory(path("there/inner")));
+}
+
 TEST_F(AtomicFileSetTest, CommitReplacesEveryTargetOnlyThen) {
   put("a.obj", "old a");
   fs::create_directory(path("sub"));

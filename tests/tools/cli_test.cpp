@@ -128,6 +128,21 @@ TEST_F(Cli, HelpOnEveryCommand) {
   EXPECT_EQ(geomip("info").exit_code, 2);          // missing argument
 }
 
+// Every command's help names its options as a user types them: CLI11 printed negated flags with their value
+// ("--fit,--no-fit{false}", "--untangle,--no-untangle{false}").
+TEST_F(Cli, HelpNamesOptionsAsTheyAreTyped) {
+  for (const char* command : {"info", "repair", "param", "gimage", "remesh", "eval", "convert", "encode",
+                              "decode", "rd", "morph"}) {
+    const Outcome r = geomip(std::string(command) + " --help");
+    ASSERT_EQ(r.exit_code, 0) << command;
+    for (std::size_t at = r.out.find("\n  -"); at != std::string::npos; at = r.out.find("\n  -", at + 1)) {
+      const std::string names = r.out.substr(at + 1, r.out.find(' ', at + 4) - at - 1);
+      EXPECT_EQ(names.find('{'), std::string::npos) << command << ": " << names;
+    }
+  }
+  EXPECT_NE(geomip("decode --help").out.find("--untangle,--no-untangle "), std::string::npos);
+}
+
 TEST_F(Cli, InfoJsonHasTheDocumentedKeys) {
   const std::string mesh = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
   const Outcome r = geomip("info --json '" + mesh + "'");

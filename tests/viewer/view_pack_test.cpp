@@ -693,6 +693,14 @@ TEST_F(ViewPackTest, NanCameraAndTimeoutAreRefused) {
   }
 }
 
+// A negative rate was taken (as a huge unsigned number: no limit at all).
+TEST_F(ViewPackTest, ANegativeRateLimitIsRefused) {
+  const ViewRun r = view(pack_file(4).string() + " " + size_args() + " --limit-rate -5");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("negative"), std::string::npos) << r.err;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+}
+
 TEST_F(ViewPackTest, BenchTwoModelLevel8MorphAt1280x720) {
   const fs::path pack = pack_file(8);
   for (std::string schedule : {"linear", "wavelet"}) {

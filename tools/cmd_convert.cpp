@@ -384,7 +384,7 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "Position quantization bits over the largest bounding-box extent (default 14)");
   CLI::Option* normal_bits = cmd->add_option(
       "--normal-bits", args->normal_bits,
-      "Normal-map quantization bits in [6, 16] (default 10; each bit fewer: about 0.8x the normal "
+      "Normal-map quantization bits in [6, 16] (default 10; each bit fewer: about 0.8-0.9x the normal "
       "bytes of the whole pack and a coarser shading; streamed prefixes hardly change)");
   cmd->add_option("--hole-mask-level", args->hole_mask_level,
                   "Grid level in [0, 10] of the mask of filled holes (default: N; coarser costs fewer bytes; "
@@ -422,16 +422,16 @@ CommandRunner add_convert_command(CLI::App& app) {
                 "Weigh row/column and diagonal detail bands alike (ablations)");
   cmd->add_flag("--no-lifting-update", args->no_lifting_update,
                 "Code the geometry with the plain interpolating wavelet, without the update step (ablations; "
-                "the pack is still format 8)");
+                "the pack's format is the same)");
   cmd->add_flag("--no-cell-frames", args->no_cell_frames,
                 "Build the local frames as pack format 7 did (per sample, from the finest reconstruction) "
                 "instead of from the coarse grid and a table of direction cells (ablations; decodes slower; "
-                "the pack is still format 8)");
+                "the pack's format is the same)");
   cmd->add_flag(
       "--short-filter", args->short_filter,
       "Code the geometry with pack format 5's 4-point wavelet filter on every step and its 2-tap update, "
-      "not the 6-point prediction of the coarser steps and the 4-tap update (ablations; the pack is "
-      "still format 8)");
+      "not the 6-point prediction of the coarser steps and the 4-tap update (ablations; the pack's "
+      "format is the same)");
   cmd->add_flag("--choose-loop", args->choose_loop,
                 "One mesh, two squares: build the pack with the plain loop, with --tip-loop and with --end-loop "
                 "(each when the mesh has tips) and keep the one whose 2, 4, 8 and 16 KB prefixes are closest to "

@@ -194,6 +194,8 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
   std::set<std::size_t> sizes;
   if (!quick)
     for (std::size_t s : kComparisonSizes) sizes.insert(s);
+  else  // three rows of the table (the others are left out of it)
+    sizes.insert({2000, 8800, 32000});
   const double lo = static_cast<double>(manifest_end + 100), hi = static_cast<double>(pack_size);
   const int count = quick ? 4 : 20;
   for (int k = 0; k < count && lo < hi; ++k)
@@ -421,10 +423,10 @@ int run_rd(const RdArgs& args) {
 
   // geomip against the Draco envelopes at the sizes issues 5 and 14 name: draco_envelope (meshoptimizer's
   // decimation) always, draco_lt_envelope (Lindstrom–Turk, the stronger baseline) with --lindstrom-turk.
-  // geomip is measured at exactly these sizes (prefix_sizes), so its staircase is its prefix there (the whole
-  // pack above the pack's size); the envelopes are interpolated in log(bytes) between their points, as
-  // scripts/prefix-vs-envelope and the README read them (a staircase reading put Draco up to a few KB short
-  // of the size and overstated geomip's margin by up to 1.7 dB).
+  // geomip is measured at exactly these sizes (prefix_sizes; --quick: only the rows it measured), so its
+  // staircase is its prefix there (the whole pack above the pack's size); the envelopes are interpolated in
+  // log(bytes) between their points, as scripts/prefix-vs-envelope and the README read them (a staircase
+  // reading put Draco up to a few KB short of the size and overstated geomip's margin by up to 1.7 dB).
   std::vector<RdPoint> geomip_points, envelope_points, lt_points;
   for (const RdPoint& p : all) {
     if (p.method == "geomip") geomip_points.push_back(p);
@@ -440,7 +442,13 @@ int run_rd(const RdArgs& args) {
     comparison_text += "\n";
     const std::vector<RdPoint> envelope_front = upper_envelope(envelope_points),
                                lt_front = upper_envelope(lt_points);
+    std::set<std::size_t> measured;  // --quick measures only a few prefixes
+    for (const RdPoint& p : geomip_points) measured.insert(p.bytes);
     for (std::size_t size : kComparisonSizes) {
+      // A size geomip was not measured at (a --quick run) has no row: the staircase would show a smaller
+      // prefix's PSNR there against the envelope at the size. From the pack's size on, the pack is the
+      // prefix.
+      if (!measured.count(size) && size < pack.size()) continue;
       const double g = envelope_at(geomip_front, size), d = envelope_interpolated(envelope_front, size);
       comparison.push_back({{"bytes", size}, {"geomip_db", g}, {"draco_envelope_db", d}, {"margin_db", g - d}});
       comparison_text += format("%-9zu %12.2f %16.2f %+8.2f", size, g, d, g - d);

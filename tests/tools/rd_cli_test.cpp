@@ -37,15 +37,17 @@ class RdCli : public ::testing::Test {
     err = slurp(fs::path(dir_) / "stderr");
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   }
+  /// A closed sphere of 3072 faces, written as OBJ.
+  std::string sphere_obj() const {
+    const std::string mesh = dir_ + "/sphere.obj";
+    std::ofstream out(mesh);
+    write_mesh(test::sphere(4), out, MeshFormat::kObj);
+    return mesh;
+  }
 };
 
 TEST_F(RdCli, QuickRunWritesCsvAndSvg) {
-  // A closed sphere of 3072 faces, written as OBJ.
-  const std::string mesh = dir_ + "/sphere.obj";
-  {
-    std::ofstream out(mesh);
-    write_mesh(test::sphere(4), out, MeshFormat::kObj);
-  }
+  const std::string mesh = sphere_obj();
   const std::string out_dir = dir_ + "/rd";
   std::string err;
   ASSERT_EQ(geomip("rd --quick '" + mesh + "' -o '" + out_dir + "'", err), 0) << err;
@@ -90,11 +92,7 @@ TEST_F(RdCli, QuickRunWritesCsvAndSvg) {
 // prefixes, and its table showed a smaller prefix's PSNR at 4.7, 8.8 and 12 KB against the envelope there
 // (margins of −22 dB). Every row is a measured prefix of that size, or the whole pack from its size on.
 TEST_F(RdCli, TheTableReadsGeomipAtExactlyItsSizes) {
-  const std::string mesh = dir_ + "/sphere.obj";
-  {
-    std::ofstream out(mesh);
-    write_mesh(test::sphere(4), out, MeshFormat::kObj);
-  }
+  const std::string mesh = sphere_obj();
   const std::string out_dir = dir_ + "/rd";
   std::string err;
   ASSERT_EQ(geomip("rd --quick --json '" + mesh + "' -o '" + out_dir + "'", err), 0) << err;
@@ -127,11 +125,7 @@ TEST_F(RdCli, TheTableReadsGeomipAtExactlyItsSizes) {
 // `rd --fit` codes samples fitted to the surface by least squares (as `convert --fit`): on a sphere the whole
 // pack decodes closer to the mesh than without, and the flag takes no value.
 TEST_F(RdCli, FitRaisesTheWholePack) {
-  const std::string mesh = dir_ + "/sphere.obj";
-  {
-    std::ofstream out(mesh);
-    write_mesh(test::sphere(4), out, MeshFormat::kObj);
-  }
+  const std::string mesh = sphere_obj();
   auto whole_pack_psnr = [&](const std::string& flag) {
     const std::string out_dir = dir_ + "/rd" + flag;
     std::string err;

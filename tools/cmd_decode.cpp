@@ -182,9 +182,10 @@ int run_decode(const DecodeArgs& args) {
   nlohmann::json j_models = nlohmann::json::array();
   // The grids as decoded choose the quad split, also when their folds are opened before writing: the face
   // list stays what it was (the web loader's and `--no-untangle`'s), the same for every model of a layout.
-  // Untangling opens the folds of the grid that is written: an output level below
-  // UntangleOptions::min_level is left as decoded, as grids of those levels always are (and a crafted pack's
-  // claimed level 10 written at --level 0 no longer costs minutes).
+  // Untangling opens the folds of the model's decoded grid (the pack's level); a coarser --level writes every
+  // 2^k-th of those samples, and the report's counts (`untangle.level`) are the decoded grid's. An output
+  // level below UntangleOptions::min_level is left as decoded, as grids of those levels always are (and a
+  // crafted pack's claimed level 10 written at --level 0 no longer costs minutes).
   std::vector<char> untangle(decoded.models.size(), 0);
   for (std::size_t m = 0; m < decoded.models.size(); ++m)
     untangle[m] = args.untangle && output_level(decoded.models[m]) >= UntangleOptions{}.min_level;
@@ -232,10 +233,13 @@ int run_decode(const DecodeArgs& args) {
                         {"detail_level", decoded.models[m].detail_level},
                         {"geometry_passes", decoded.models[m].geometry_passes}});
     if (args.untangle)
-      j_models.back()["untangle"] = {
-          {"applied", untangled.applied},           {"folded_before", untangled.folded_before},
-          {"folded_after", untangled.folded_after}, {"moved", untangled.moved},
-          {"max_move", untangled.max_move},         {"sweeps", untangled.sweeps}};
+      j_models.back()["untangle"] = {{"applied", untangled.applied},
+                                     {"folded_before", untangled.folded_before},
+                                     {"folded_after", untangled.folded_after},
+                                     {"moved", untangled.moved},
+                                     {"max_move", untangled.max_move},
+                                     {"sweeps", untangled.sweeps},
+                                     {"level", decoded.models[m].geometry.front().level}};
     if (!args.quiet && !args.json) {
       report +=
           string_printf("decode %s → %s: %zu faces (level %d, detail up to level %d, %zu geometry passes)\n",

@@ -27,6 +27,7 @@ struct EvalArgs {
   SurfaceDistanceOptions options;
   bool no_vertices = false;
   bool json = false;
+  bool quiet = false;
   std::string error_map;           // APPROX coloured by its distance to ORIGINAL
   std::string error_map_original;  // ORIGINAL coloured by its distance to APPROX
   double error_map_scale_pct = 0;  // full red, % of the diagonal; 0 = the 99th percentile of the face RMS
@@ -136,6 +137,7 @@ int run_eval(EvalArgs args) {
     std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     return kExitOk;
   }
+  if (args.quiet) return kExitOk;  // the error maps are written; nothing to say
   auto row = [&](const char* name, const OneSidedDistance& s) {
     std::cout << format("%s  %8zu samples  max %.6g  mean %.6g  rms %.6g  (max at %.6g %.6g %.6g)\n", name,
                         s.samples(), s.max, s.mean, s.rms, s.max_at.x(), s.max_at.y(), s.max_at.z());
@@ -190,6 +192,8 @@ CommandRunner add_eval_command(CLI::App& app) {
   cmd->add_flag("--json", args->json,
                 "Machine-readable output: hausdorff_pct, rms_pct, psnr_db (null = +inf), raw values, "
                 "per-direction max/mean/rms and sample counts, bbox_diagonal");
+  cmd->add_flag("-q,--quiet", args->quiet,
+                "No report (--error-map files are still written; --json still prints)");
   return [args] { return run_eval(*args); };
 }
 

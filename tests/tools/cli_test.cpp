@@ -141,6 +141,13 @@ TEST_F(Cli, HelpNamesOptionsAsTheyAreTyped) {
     }
   }
   EXPECT_NE(geomip("decode --help").out.find("--untangle,--no-untangle "), std::string::npos);
+  // eval was the one command without -q (scripts that pass -q everywhere failed on it).
+  const std::string spot = std::string(GEOMIP_SOURCE_DIR) + "/data/spot.obj";
+  const Outcome quiet =
+      geomip("eval -q '" + spot + "' '" + spot + "' --samples 2000 --error-map '" + dir_ + "/map.ply'");
+  EXPECT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.out, "");
+  EXPECT_TRUE(fs::exists(dir_ + "/map.ply"));
 }
 
 TEST_F(Cli, InfoJsonHasTheDocumentedKeys) {
@@ -1526,6 +1533,7 @@ TEST_F(CliPack, DecodeOpensFoldsKeepingFacesAndDistance) {
   const auto stats = nlohmann::json::parse(d.out)["models"][0]["untangle"];
   EXPECT_GT(stats["folded_before"].get<int>(), 0);
   EXPECT_LT(stats["folded_after"].get<int>(), stats["folded_before"].get<int>());
+  EXPECT_EQ(stats["level"].get<int>(), 6);  // the grid the counts are on
   ASSERT_EQ(geomip("decode -q --no-untangle '" + pack + "' -o '" + dir_ + "/raw.obj'").exit_code, 0);
   const TriMesh open = read_mesh(dir_ + "/open.obj"), raw = read_mesh(dir_ + "/raw.obj");
   EXPECT_EQ(open.triangles, raw.triangles);

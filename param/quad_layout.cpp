@@ -907,11 +907,13 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
     if ((pin_tips && tips.empty()) || (!pin_tips && options.only_pinned_tips && !tips.empty())) continue;
     QuadLayoutChoice group;
     double group_cost = 0.0;
-    // Equal error: one coarse mesh (the error picks the survivor of a collapse); the equal-area ones, by
-    // either rule, only when none of its pairings partitions the mesh.
+    // Equal error: one coarse mesh per error weight (the error picks the survivor of a collapse); the
+    // equal-area ones, by either rule, only when none of their pairings partitions the mesh.
     const bool by_error = options.error_weight > 0.0 && k >= options.min_error_patches;
     std::vector<std::pair<bool, double>> simplifications;  // (centroid rule, error weight)
-    if (by_error) simplifications.emplace_back(true, options.error_weight);
+    if (by_error)
+      for (double factor : options.error_weight_factors)
+        if (factor > 0.0) simplifications.emplace_back(true, options.error_weight * factor);
     simplifications.emplace_back(true, 0.0);
     simplifications.emplace_back(false, 0.0);
     for (const auto& [centroid_rule, error_weight] : simplifications) {

@@ -104,6 +104,30 @@ TEST(QuadLayout, EqualErrorSpendsFewCornersOnFlatParts) {
   EXPECT_EQ(choose_quad_layout(m, few).layout.corners, choose_quad_layout(m, few_by_area).layout.corners);
 }
 
+// Equal-error layouts from several error weights: every pairing of one weight's coarse mesh is among the
+// candidates, so the layout kept is never worse by the objective than that weight's alone, and more
+// pairings compete (one weight's layout was fragile: a 1e-7 jitter of the horse cost 3–6 dB).
+TEST(QuadLayout, SeveralErrorWeightsNeverChooseWorseThanOne) {
+  TriMesh m = test::sphere(4);
+  for (auto& p : m.positions) {  // a bumpy, stretched shape, so that the weights give different meshes
+    p = Eigen::Vector3d(2.0 * p.x(), p.y(), 0.7 * p.z());
+    p *= 1.0 + 0.08 * std::sin(5.0 * p.x()) * std::cos(4.0 * p.y());
+  }
+  QuadLayoutOptions one, several;
+  one.patches = several.patches = 16;
+  one.balance_steps = several.balance_steps = 0;  // the candidates as paired
+  one.shape_steps = several.shape_steps = 0;
+  one.shape_weight = several.shape_weight = 0.0;  // the objective is the sampling cost alone
+  one.error_weight_factors = {1.0};
+  ASSERT_GT(several.error_weight_factors.size(), 1u);
+  const QuadLayoutChoice a = choose_quad_layout(m, one), b = choose_quad_layout(m, several);
+  std::printf("one weight: %zu candidates, cost %.4f; %zu weights: %zu candidates, cost %.4f\n", a.candidates,
+              a.sampling_cost, several.error_weight_factors.size(), b.candidates, b.sampling_cost);
+  EXPECT_GT(b.candidates, a.candidates);
+  EXPECT_LE(b.sampling_cost, a.sampling_cost + 1e-12);
+  expect_valid_layout(m, 16, 0.0);
+}
+
 TEST(QuadLayout, BalancingEvensOutPatchAreas) {
   TriMesh m = test::sphere(3);
   for (auto& p : m.positions) p = Eigen::Vector3d(2.5 * p.x(), p.y(), 0.6 * p.z());

@@ -60,12 +60,14 @@ struct QuadLayoutOptions {
   /// layouts"): see there for the figures behind the default.
   double error_weight = 1000.0;
   /// Equal error: the mesh is simplified once with each of these multiples of error_weight (those ≤ 0
-  /// skipped), and every pairing of every coarse mesh competes by the objective. One weight alone is
-  /// fragile: the horse with every coordinate moved by up to 1e-7 of itself got a layout of sampling cost
-  /// 2.12 instead of 1.70 and prefixes 3.3–6.5 dB lower; with these five, 1.92, and the means of three such
-  /// copies' prefixes rose 1.6–2.6 dB (horse) and 0.3–0.6 dB (armadillo; docs/measurements.md, "How much a
-  /// prefix moves when the input moves by 1e-7").
-  std::vector<double> error_weight_factors = {1.0, 0.5, 2.0, 0.25, 4.0};
+  /// skipped), and every pairing of every coarse mesh competes by the objective. One weight (the default)
+  /// is fragile: the horse with every coordinate moved by up to 1e-7 of itself got a layout of sampling cost
+  /// 2.12 instead of 1.70 and prefixes 3.3–6.5 dB lower. Five ({1, 0.5, 2, 0.25, 4}) raised the means of
+  /// three such copies' prefixes by 1.6–2.6 dB (horse) and 0.3–0.6 dB (armadillo) but lowered the cow's by
+  /// 0.8–3.3 dB (one copy's layout of lowest sampling cost coded 9 dB worse at 32 KB): the objective does not
+  /// predict the codec well enough to choose among more candidates (docs/measurements.md, "How much a prefix
+  /// moves when the input moves by 1e-7").
+  std::vector<double> error_weight_factors = {1.0};
   /// Equal error from this many patches up; fewer are simplified by equal area whatever error_weight says.
   /// With so few coarse vertices the equal-error ones go to the tips (hooves, ears, nose) and the patches
   /// run along the limbs: the horse's 8-patch equal-error layout measured 4.7 dB below its equal-area one.

@@ -106,7 +106,8 @@ TEST(QuadLayout, EqualErrorSpendsFewCornersOnFlatParts) {
 
 // Equal-error layouts from several error weights: every pairing of one weight's coarse mesh is among the
 // candidates, so the layout kept is never worse by the objective than that weight's alone, and more
-// pairings compete (one weight's layout was fragile: a 1e-7 jitter of the horse cost 3–6 dB).
+// pairings compete (one weight's layout is fragile: a 1e-7 jitter of the horse cost 3–6 dB; more weights
+// are not the default, since the objective picked a much worse layout for a jittered cow).
 TEST(QuadLayout, SeveralErrorWeightsNeverChooseWorseThanOne) {
   TriMesh m = test::sphere(4);
   for (auto& p : m.positions) {  // a bumpy, stretched shape, so that the weights give different meshes
@@ -119,7 +120,7 @@ TEST(QuadLayout, SeveralErrorWeightsNeverChooseWorseThanOne) {
   one.shape_steps = several.shape_steps = 0;
   one.shape_weight = several.shape_weight = 0.0;  // the objective is the sampling cost alone
   one.error_weight_factors = {1.0};
-  ASSERT_GT(several.error_weight_factors.size(), 1u);
+  several.error_weight_factors = {1.0, 0.5, 2.0, 0.25, 4.0};
   const QuadLayoutChoice a = choose_quad_layout(m, one), b = choose_quad_layout(m, several);
   std::printf("one weight: %zu candidates, cost %.4f; %zu weights: %zu candidates, cost %.4f\n", a.candidates,
               a.sampling_cost, several.error_weight_factors.size(), b.candidates, b.sampling_cost);

@@ -66,7 +66,9 @@ struct QuadLayoutOptions {
   /// three such copies' prefixes by 1.6–2.6 dB (horse) and 0.3–0.6 dB (armadillo) but lowered the cow's by
   /// 0.8–3.3 dB (one copy's layout of lowest sampling cost coded 9 dB worse at 32 KB): the objective does not
   /// predict the codec well enough to choose among more candidates (docs/measurements.md, "How much a prefix
-  /// moves when the input moves by 1e-7").
+  /// moves when the input moves by 1e-7"). So `convert` and `rd` build a stretched shape's layouts with one
+  /// weight and with five and keep the one whose prefixes measure better (tools/convert_pipeline.h,
+  /// kStretchedLayoutErrorWeights; `--layout-error-weights` sets these factors).
   std::vector<double> error_weight_factors = {1.0};
   /// Equal error from this many patches up; fewer are simplified by equal area whatever error_weight says.
   /// With so few coarse vertices the equal-error ones go to the tips (hooves, ears, nose) and the patches

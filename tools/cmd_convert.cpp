@@ -122,9 +122,12 @@ int run_convert(const ConvertArgs& args) {
     throw InvalidInput("--choose-loop compares the automatic two-square loops of one mesh: give one MESH, "
                        "without --points, --patches, --tip-loop or --end-loop");
   if (args.search && (args.choose_loop || args.common.meshes.size() != 1 || !args.common.points.empty() ||
-                      args.common.patches != 2 || loop_asked != LoopKind::kPlain || args.fit))
-    throw InvalidInput("--search chooses the layout and the fit of one mesh itself: give one MESH, without "
-                       "--points, --patches, --tip-loop, --end-loop, --fit or --choose-loop");
+                      args.common.patches != 2 || args.common.layout_error_weights_given ||
+                      loop_asked != LoopKind::kPlain || args.fit))
+    throw InvalidInput(
+        "--search chooses the layout and the fit of one mesh itself: give one MESH, without "
+        "--points, --patches, --layout-error-weights, --tip-loop, --end-loop, --fit or "
+        "--choose-loop");
   const bool report = !args.common.quiet && !args.common.json;
   const auto t_start = std::chrono::steady_clock::now();
   auto slide_rounds = [&](LoopKind kind) {
@@ -134,8 +137,9 @@ int run_convert(const ConvertArgs& args) {
   // Without a search: the models now, so that bad input fails before the frame checks below.
   PreparedModels models;
   if (!searching)
-    models = prepare_models(args.common.meshes, args.common.points, "geomip convert", !report,
-                            args.common.patches, loop_asked, args.common.equal_area_layout);
+    models =
+        prepare_models(args.common.meshes, args.common.points, "geomip convert", !report, args.common.patches,
+                       loop_asked, args.common.equal_area_layout, args.common.layout_error_weights);
   if (!args.level_given && !models.inputs.empty() && !models.inputs.front().layout_quads.empty()) {
     level = default_grid_level(models.inputs.front().layout_quads.size());
     check_level_options(args, level);
@@ -219,9 +223,12 @@ int run_convert(const ConvertArgs& args) {
     };
     converted = convert_relayout_when_stretched(
         models, options, level_for,
-        [&](int patches) {
+        args.common.layout_error_weights_given
+            ? std::vector<std::vector<double>>{args.common.layout_error_weights}
+            : kStretchedLayoutErrorWeights,
+        [&](int patches, const std::vector<double>& weights) {
           return prepare_models(args.common.meshes, "", "geomip convert", true, patches, LoopKind::kPlain,
-                                args.common.equal_area_layout);
+                                args.common.equal_area_layout, weights);
         },
         [&](double stretch, const std::vector<int>& layouts) {
           bar.finish();
@@ -240,19 +247,22 @@ int run_convert(const ConvertArgs& args) {
     if (!relayout_choice.candidates.empty() && report) {
       bar.finish();
       for (const RelayoutChoice::Candidate& c : relayout_choice.candidates) {
+        const std::string name = relayout_choice.name(c);
         if (!c.not_built.empty())
-          std::printf("layout: %d patches: not built (%s)\n", c.patches, c.not_built.c_str());
+          std::printf("layout: %s: not built (%s)\n", name.c_str(), c.not_built.c_str());
         else if (std::isfinite(c.mean_psnr_db))
-          std::printf(
-              "layout: %d patches at level %d: %.2f dB mean PSNR of the geometry prefixes (%zu B)%s\n",
-              c.patches, c.level, c.mean_psnr_db, c.geometry_bytes,
-              c.patches == relayout_choice.chosen_patches ? ", kept" : "");
-        else if (c.patches == relayout_choice.chosen_patches)
-          std::printf("layout: %d patches at level %d, kept (the only layout built)\n", c.patches, c.level);
+          std::printf("layout: %s at level %d: %.2f dB mean PSNR of the geometry prefixes (%zu B)%s\n",
+                      name.c_str(), c.level, c.mean_psnr_db, c.geometry_bytes,
+                      relayout_choice.kept(c) ? ", kept" : "");
+        else if (relayout_choice.kept(c))
+          std::printf("layout: %s at level %d, kept (the only layout built)\n", name.c_str(), c.level);
       }
       if (relayouted && !relayout_choice.sizes.empty())
-        std::printf("layout: chosen in %.1f s (--patches 16 or --patches 64 skips the choice)\n",
-                    relayout_choice.seconds);
+        std::printf(
+            "layout: chosen in %.1f s (--patches %d --layout-error-weights %s gives this layout without "
+            "the choice)\n",
+            relayout_choice.seconds, relayout_choice.chosen_patches,
+            error_weights_text(relayout_choice.chosen_error_weights).c_str());
       if (!relayouted) std::printf("layout: keeping the two squares\n");
     }
     level = options.level;

@@ -44,9 +44,10 @@ int run_gimage(const GimageArgs& args) {
     throw InvalidInput("--normal-level " + std::to_string(args.normal_level) + " is outside [" +
                        std::to_string(args.level) + ", " + std::to_string(kMaxGeometryImageLevel) + "]");
   }
-  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip gimage",
-                                               args.common.quiet || args.common.json, args.common.patches,
-                                               loop_kind(args.common), args.common.equal_area_layout);
+  const PreparedModels models =
+      prepare_models(args.common.meshes, args.common.points, "geomip gimage",
+                     args.common.quiet || args.common.json, args.common.patches, loop_kind(args.common),
+                     args.common.equal_area_layout, args.common.layout_error_weights);
   check_output_directory(args.common.output);
   {
     std::vector<std::string> planned;  // the files written below, checked before the work

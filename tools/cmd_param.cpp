@@ -128,9 +128,10 @@ nlohmann::json param_json(const ModelParameterization& m, const std::string& mes
 
 int run_param(const ParamArgs& args) {
   check_output_directory(args.common.output);  // before the work, not after it
-  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip param",
-                                               args.common.quiet || args.common.json, args.common.patches,
-                                               loop_kind(args.common), args.common.equal_area_layout);
+  const PreparedModels models =
+      prepare_models(args.common.meshes, args.common.points, "geomip param",
+                     args.common.quiet || args.common.json, args.common.patches, loop_kind(args.common),
+                     args.common.equal_area_layout, args.common.layout_error_weights);
   const std::vector<ParameterizationInput>& inputs = models.inputs;
   const std::vector<std::string>& paths = models.paths;
   {

@@ -63,6 +63,8 @@ struct RdArgs {
   int patches = 2;          // geomip: patches of the automatic layout (--patches)
   bool patches_given = false;      // --patches given (else a stretched shape moves to 16 or 64 patches)
   bool equal_area_layout = false;  // geomip: --equal-area-layout
+  std::vector<double> layout_error_weights = {1.0};  // geomip: --layout-error-weights
+  bool layout_error_weights_given = false;  // (else a stretched shape tries kStretchedLayoutErrorWeights)
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
   bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)
   bool end_loop = false;    // geomip: the loop through the ends (--end-loop, as `geomip convert`)
@@ -212,24 +214,24 @@ std::vector<std::size_t> prefix_sizes(std::size_t manifest_end, std::size_t pack
 /// `relayout`: the layout was left to us (no --patches, the plain loop), so a shape that two squares stretch
 /// moves to 16 or 64 patches, whichever codes it better, as `geomip convert` does
 /// (convert_relayout_when_stretched()); `moved` then reports the choice (chosen_patches 0: not moved).
-Series geomip_series(const std::string& mesh_path, int level, int patches, bool equal_area_layout,
-                     LoopKind loop, int normal_mesh_steps, bool fit, bool search, bool quick, bool relayout,
-                     std::vector<std::uint8_t>& pack_out, std::optional<SearchResult>& chosen,
-                     RelayoutChoice& moved, ProgressBar& progress) {
+Series geomip_series(const RdArgs& args, LoopKind loop, bool relayout, std::vector<std::uint8_t>& pack_out,
+                     std::optional<SearchResult>& chosen, RelayoutChoice& moved, ProgressBar& progress) {
+  const std::string& mesh_path = args.mesh;
+  const int level = args.level, normal_mesh_steps = args.normal_mesh_steps;
   ConvertOptions options;
   options.seam_slide_rounds = default_seam_slide_rounds(loop);
   options.level = level;
   options.normals = false;
   options.normal_mesh_steps = normal_mesh_steps;
-  options.fit = fit;
+  options.fit = args.fit;
   options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
   std::shared_ptr<const std::vector<std::uint8_t>> pack;
-  if (search) {
+  if (args.search) {
     chosen = search_conversion(mesh_path, options, full_search_options(), true);
     pack = std::make_shared<const std::vector<std::uint8_t>>(chosen->converted.pack);
   } else {
-    PreparedModels models =
-        prepare_models({mesh_path}, "", "geomip rd", true, patches, loop, equal_area_layout);
+    PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, args.patches, loop,
+                                           args.equal_area_layout, args.layout_error_weights);
     ConvertResult converted = convert_relayout_when_stretched(
         models, options,
         [&](int k, std::string& why_not) {
@@ -242,8 +244,11 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, bool 
           }
           return coarser;
         },
-        [&](int k) {
-          return prepare_models({mesh_path}, "", "geomip rd", true, k, LoopKind::kPlain, equal_area_layout);
+        args.layout_error_weights_given ? std::vector<std::vector<double>>{args.layout_error_weights}
+                                        : kStretchedLayoutErrorWeights,
+        [&](int k, const std::vector<double>& weights) {
+          return prepare_models({mesh_path}, "", "geomip rd", true, k, LoopKind::kPlain,
+                                args.equal_area_layout, weights);
         },
         {}, moved);
     pack = std::make_shared<const std::vector<std::uint8_t>>(std::move(converted.pack));
@@ -252,7 +257,7 @@ Series geomip_series(const std::string& mesh_path, int level, int patches, bool 
   codec::PackInfo info;
   codec::read_pack_info(*pack, info);
   Series series{"geomip", {}};
-  for (std::size_t size : prefix_sizes(info.manifest_end, pack->size(), quick)) {
+  for (std::size_t size : prefix_sizes(info.manifest_end, pack->size(), args.quick)) {
     series.jobs.push_back([pack, size] {
       codec::PackDecodeOptions decode;
       decode.max_bytes = size;
@@ -326,9 +331,11 @@ int run_rd(const RdArgs& args) {
   const LoopKind loop = loop_kind(args.tip_loop, args.end_loop);
   check_loop_patches(loop, args.patches);
   check_output_directory(args.output);
-  if (args.search && (args.patches != 2 || loop != LoopKind::kPlain || args.fit))
-    throw InvalidInput("--search chooses the layout and the fit itself: not with --patches, --tip-loop, "
-                       "--end-loop or --fit");
+  if (args.search &&
+      (args.patches != 2 || args.layout_error_weights_given || loop != LoopKind::kPlain || args.fit))
+    throw InvalidInput(
+        "--search chooses the layout and the fit itself: not with --patches, "
+        "--layout-error-weights, --tip-loop, --end-loop or --fit");
   const auto start = std::chrono::steady_clock::now();
   note_input_file(args.mesh);
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
@@ -343,10 +350,8 @@ int run_rd(const RdArgs& args) {
   std::optional<SearchResult> searched;
   RelayoutChoice moved;  // the layout chosen for a shape two squares stretch
   if (!args.no_geomip)
-    plan.push_back(geomip_series(args.mesh, args.level, args.patches, args.equal_area_layout, loop,
-                                 args.normal_mesh_steps, args.fit, args.search, args.quick,
-                                 !args.patches_given && loop == LoopKind::kPlain, pack, searched, moved,
-                                 progress));
+    plan.push_back(geomip_series(args, loop, !args.patches_given && loop == LoopKind::kPlain, pack, searched,
+                                 moved, progress));
 
   // Code and measure every job: one job per worker, each distance query single-threaded.
   struct Slot {
@@ -442,13 +447,13 @@ int run_rd(const RdArgs& args) {
     comparison_text += "\n";
     const std::vector<RdPoint> envelope_front = upper_envelope(envelope_points),
                                lt_front = upper_envelope(lt_points);
-    std::set<std::size_t> measured;  // --quick measures only a few prefixes
-    for (const RdPoint& p : geomip_points) measured.insert(p.bytes);
+    std::set<std::size_t> geomip_sizes;  // --quick measures only a few prefixes
+    for (const RdPoint& p : geomip_points) geomip_sizes.insert(p.bytes);
     for (std::size_t size : kComparisonSizes) {
       // A size geomip was not measured at (a --quick run) has no row: the staircase would show a smaller
       // prefix's PSNR there against the envelope at the size. From the pack's size on, the pack is the
       // prefix.
-      if (!measured.count(size) && size < pack.size()) continue;
+      if (!geomip_sizes.count(size) && size < pack.size()) continue;
       const double g = envelope_at(geomip_front, size), d = envelope_interpolated(envelope_front, size);
       comparison.push_back({{"bytes", size}, {"geomip_db", g}, {"draco_envelope_db", d}, {"margin_db", g - d}});
       comparison_text += format("%-9zu %12.2f %16.2f %+8.2f", size, g, d, g - d);
@@ -477,6 +482,7 @@ int run_rd(const RdArgs& args) {
     if (searched) j["search"] = search_json(*searched, args.level);
     if (moved.chosen_patches > 0)
       j["geomip_moved_to_patches"] = {{"patches", moved.chosen_patches},
+                                      {"error_weights", moved.chosen_error_weights},
                                       {"level", moved.chosen_level},
                                       {"two_squares_l2_stretch", moved.two_squares_l2_stretch}};
     if (!moved.candidates.empty()) j["geomip_layout_choice"] = relayout_json(moved);
@@ -509,17 +515,17 @@ int run_rd(const RdArgs& args) {
     std::string scores, not_built;
     for (const RelayoutChoice::Candidate& c : moved.candidates) {
       if (!c.not_built.empty())
-        not_built +=
-            (not_built.empty() ? "" : "; ") + format("%d patches not built: ", c.patches) + c.not_built;
+        not_built += (not_built.empty() ? "" : "; ") + moved.name(c) + " not built: " + c.not_built;
       else if (std::isfinite(c.mean_psnr_db))
-        scores += (scores.empty() ? "" : ", ") + format("%d patches %.2f dB", c.patches, c.mean_psnr_db);
+        scores += (scores.empty() ? "" : ", ") + moved.name(c) + format(" %.2f dB", c.mean_psnr_db);
     }
     const std::string why = scores.empty() ? not_built : "mean PSNR of the prefixes: " + scores;
     if (moved.chosen_patches > 0)
       std::cout << format(
-          "geomip pack: %d patches at level %d (the two squares stretch this shape: L2 stretch %.2f; %s; "
-          "--patches 2 keeps the two squares)\n",
-          moved.chosen_patches, moved.chosen_level, moved.two_squares_l2_stretch, why.c_str());
+          "geomip pack: %d patches, error weights %s, at level %d (the two squares stretch this shape: L2 "
+          "stretch %.2f; %s; --patches 2 keeps the two squares)\n",
+          moved.chosen_patches, error_weights_text(moved.chosen_error_weights).c_str(), moved.chosen_level,
+          moved.two_squares_l2_stretch, why.c_str());
     else
       std::cout << format("geomip pack: two squares (they stretch this shape, L2 stretch %.2f, but %s)\n",
                           moved.two_squares_l2_stretch, not_built.c_str());
@@ -571,7 +577,8 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_flag("--fit,!--no-fit", args->fit,
                 "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip "
                 "convert --fit`; slower: about 30 s at level 8); --no-fit: samples on the surface (default)");
-  add_patches_option(cmd, args->patches, args->patches_given, args->equal_area_layout);
+  add_patches_option(cmd, args->patches, args->patches_given, args->equal_area_layout,
+                     args->layout_error_weights, args->layout_error_weights_given);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");
   cmd->add_flag("--end-loop", args->end_loop, "geomip: the two-square loop through the ends (as `geomip convert --end-loop`)");
   cmd->add_flag("--search", args->search,

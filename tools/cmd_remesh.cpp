@@ -65,9 +65,10 @@ int run_remesh(const RemeshArgs& args) {
     throw InvalidInput("--max-depth " + std::to_string(args.max_depth) + " is outside [0, " +
                        std::to_string(kMaxGeometryImageLevel) + "]");
   }
-  const PreparedModels models = prepare_models(args.common.meshes, args.common.points, "geomip remesh",
-                                               args.common.quiet || args.common.json, args.common.patches,
-                                               loop_kind(args.common), args.common.equal_area_layout);
+  const PreparedModels models =
+      prepare_models(args.common.meshes, args.common.points, "geomip remesh",
+                     args.common.quiet || args.common.json, args.common.patches, loop_kind(args.common),
+                     args.common.equal_area_layout, args.common.layout_error_weights);
   check_output_directory(args.common.output);
   {
     std::vector<std::string> planned;  // the files written below, checked before the work

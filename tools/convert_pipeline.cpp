@@ -11,8 +11,10 @@
 #include "tools/pack_models.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <utility>
@@ -182,9 +184,28 @@ SurfaceDistanceOptions relayout_distance_options() {
   return o;
 }
 
+std::string error_weights_text(const std::vector<double>& weights) {
+  std::string text;
+  for (double w : weights) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%g", w);
+    text += (text.empty() ? "" : ",") + std::string(buffer);
+  }
+  return text;
+}
+
+std::string RelayoutChoice::name(const Candidate& c) const {
+  bool weights_vary = false;
+  for (const Candidate& other : candidates)
+    weights_vary = weights_vary || other.error_weights != c.error_weights;
+  return std::to_string(c.patches) + " patches" +
+         (weights_vary ? " (error weights " + error_weights_text(c.error_weights) + ")" : "");
+}
+
 ConvertResult convert_relayout_when_stretched(
     PreparedModels& models, ConvertOptions& options, const RelayoutLevel& level_for,
-    const std::function<PreparedModels(int patches)>& prepare,
+    const std::vector<std::vector<double>>& error_weight_sets,
+    const std::function<PreparedModels(int patches, const std::vector<double>& error_weights)>& prepare,
     const std::function<void(double stretch, const std::vector<int>& layouts)>& before_switch,
     RelayoutChoice& choice) {
   choice = {};
@@ -197,7 +218,10 @@ ConvertResult convert_relayout_when_stretched(
     c.level = level_for(k, c.not_built);
     left_to_us = left_to_us || c.level >= 0;
     if (c.level >= 1) tried.push_back(k);
-    candidates.push_back(c);
+    for (const std::vector<double>& weights : error_weight_sets) {
+      c.error_weights = weights;
+      candidates.push_back(c);
+    }
   }
   if (!left_to_us || models.inputs.size() != 1) return convert_models(models, options);
   // The two squares' parameterization tells; the rest of their pipeline runs only when they stay.
@@ -221,17 +245,42 @@ ConvertResult convert_relayout_when_stretched(
   std::vector<std::size_t> built_candidate;  // index into choice.candidates
   if (!tried.empty() && before_switch) before_switch(stretch, tried);
   std::size_t attempt = 0;  // layouts started, for the progress bar
+  const double attempts =
+      static_cast<double>(tried.size() * std::max<std::size_t>(error_weight_sets.size(), 1));
+  // The layouts prepared so far (patches, corners, quads, error weights): another set of weights that
+  // chooses the same layout is not converted again.
+  struct Prepared {
+    int patches;
+    std::vector<int> corners;
+    std::vector<std::array<int, 4>> quads;
+    std::vector<double> error_weights;
+  };
+  std::vector<Prepared> prepared;
   for (RelayoutChoice::Candidate& c : candidates) {
     if (c.level >= 1) {
       try {
-        Built b{prepare(c.patches), options, {}, {}};
+        Built b{prepare(c.patches, c.error_weights), options, {}, {}};
+        const ParameterizationInput& in = b.models.inputs.front();
+        const auto same = std::find_if(prepared.begin(), prepared.end(), [&](const Prepared& p) {
+          return p.patches == c.patches && p.corners == in.partition_points && p.quads == in.layout_quads;
+        });
+        if (same != prepared.end()) {
+          c.not_built = "the same layout as with error weights " + error_weights_text(same->error_weights);
+          choice.candidates.push_back(c);
+          continue;
+        }
+        prepared.push_back({c.patches, in.partition_points, in.layout_quads, c.error_weights});
         b.options.level = c.level;
         b.options.keep_inputs = true;  // the geometry-only pack is encoded again from them
         if (options.progress) {
           // One bar over all layouts: layout i of n fills 0.9·[i/n, (i+1)/n), its stages named after it; the
           // measurements the last tenth.
-          const double n = static_cast<double>(tried.size()), i = static_cast<double>(attempt);
-          const std::string prefix = std::to_string(c.patches) + " patches: ";
+          const double n = attempts, i = static_cast<double>(attempt);
+          const std::string prefix =
+              std::to_string(c.patches) + " patches" +
+              (error_weight_sets.size() > 1 ? " (error weights " + error_weights_text(c.error_weights) + ")"
+                                            : "") +
+              ": ";
           b.options.progress = [&options, prefix, n, i](const char* stage, double f) {
             options.progress((prefix + stage).c_str(), 0.9 * (i + f) / n);
           };
@@ -295,6 +344,7 @@ ConvertResult convert_relayout_when_stretched(
   choice.seconds = seconds_since(t_choice);
   Built& winner = built[best];
   choice.chosen_patches = choice.candidates[built_candidate[best]].patches;
+  choice.chosen_error_weights = choice.candidates[built_candidate[best]].error_weights;
   choice.chosen_level = winner.options.level;
   ConvertResult result = std::move(winner.result);
   result.two_squares_l2_stretch = stretch;

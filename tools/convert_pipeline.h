@@ -140,6 +140,19 @@ inline constexpr double kStretchedTwoSquares = 1.5;
 /// closer to the mesh.
 inline constexpr int kStretchedShapeLayouts[] = {16, 64};
 
+/// The error weights (QuadLayoutOptions::error_weight_factors) each of those layouts is built with when
+/// --layout-error-weights is not given: one weight, and five, whose simplifications all compete by the
+/// layout's sampling cost. The sampling cost is a loose guide to the codec: measured on three copies each
+/// of the horse, the armadillo and the cow (each coordinate moved by up to 1e-7 of itself), the five-weight
+/// layouts coded the horse 1.6–2.6 dB and the armadillo 0.3–0.6 dB better on the mean, the cow 0.8–3.3 dB
+/// worse (docs/measurements.md, "How much a prefix moves when the input moves by 1e-7"). So both are built
+/// and measured, the five-weight one only where its layout differs from the one-weight layout.
+inline const std::vector<std::vector<double>> kStretchedLayoutErrorWeights = {{1.0},
+                                                                              {1.0, 0.5, 2.0, 0.25, 4.0}};
+
+/// `weights` as --layout-error-weights takes them ("1", "1,0.5,2,0.25,4").
+std::string error_weights_text(const std::vector<double>& weights);
+
 /// The prefix sizes that choice scores (issue #14's range, as `--search`'s kSearchSizes).
 inline constexpr std::size_t kStretchedChoiceSizes[] = {1500, 2000, 4700, 8800, 16000, 32000};
 
@@ -166,6 +179,7 @@ struct RelayoutChoice {
   std::vector<std::size_t> sizes;
   struct Candidate {
     int patches = 0;
+    std::vector<double> error_weights;  ///< its layout's QuadLayoutOptions::error_weight_factors
     int level = 0;
     double mean_psnr_db = NAN;
     std::vector<double> psnr_db;     ///< per size
@@ -174,7 +188,14 @@ struct RelayoutChoice {
   };
   std::vector<Candidate> candidates;
   int chosen_patches = 0;  ///< 0: the two squares were kept
+  std::vector<double> chosen_error_weights;  ///< the error weights of the layout kept
   int chosen_level = 0;
+  /// "16 patches", with " (error weights 1,0.5,2,0.25,4)" when the candidates' weights differ.
+  std::string name(const Candidate& c) const;
+  /// `c` is the layout kept.
+  bool kept(const Candidate& c) const {
+    return chosen_patches > 0 && c.patches == chosen_patches && c.error_weights == chosen_error_weights;
+  }
   double seconds = 0;  ///< building and measuring the layouts (the two squares' parameterization not counted)
 };
 
@@ -216,7 +237,9 @@ using RelayoutLevel = std::function<int(int patches, std::string& why_not)>;
 
 /// convert_models(models, options), except that one mesh whose two squares have an L2 stretch of at least
 /// kStretchedTwoSquares is, right after that parameterization, converted again on each layout of
-/// kStretchedShapeLayouts whose `level_for` is ≥ 1 (`prepare(patches)` prepares it; `before_switch(stretch,
+/// kStretchedShapeLayouts whose `level_for` is ≥ 1, each with every set of `error_weight_sets` (in order;
+/// a set whose layout is that of an earlier set of the same patch count is not converted again: its
+/// candidate's not_built says so) (`prepare(patches, error_weights)` prepares it; `before_switch(stretch,
 /// layouts)` is called once before the first, with the patch counts to be tried). When more than one layout
 /// is built, the one whose geometry-only prefixes at kStretchedChoiceSizes (those below the larger pack; its
 /// whole pack where smaller) have the higher mean PSNR against the mesh (relayout_distance_options()) is
@@ -228,7 +251,8 @@ using RelayoutLevel = std::function<int(int patches, std::string& why_not)>;
 /// loop).
 ConvertResult convert_relayout_when_stretched(
     PreparedModels& models, ConvertOptions& options, const RelayoutLevel& level_for,
-    const std::function<PreparedModels(int patches)>& prepare,
+    const std::vector<std::vector<double>>& error_weight_sets,
+    const std::function<PreparedModels(int patches, const std::vector<double>& error_weights)>& prepare,
     const std::function<void(double stretch, const std::vector<int>& layouts)>& before_switch,
     RelayoutChoice& choice);
 

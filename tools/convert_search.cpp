@@ -255,6 +255,7 @@ nlohmann::json relayout_json(const RelayoutChoice& choice) {
     for (double p : c.psnr_db) psnr.push_back(number(p));
     layouts.push_back(
         {{"patches", c.patches},
+         {"error_weights", c.error_weights},
          {"level", c.level},
          {"mean_psnr_db", number(c.mean_psnr_db)},
          {"psnr_db", psnr},
@@ -264,6 +265,7 @@ nlohmann::json relayout_json(const RelayoutChoice& choice) {
   return {{"two_squares_l2_stretch", choice.two_squares_l2_stretch},
           {"sizes", choice.sizes},
           {"chosen_patches", choice.chosen_patches},
+          {"chosen_error_weights", choice.chosen_error_weights},
           {"seconds", choice.seconds},
           {"layouts", layouts}};
 }

@@ -163,24 +163,37 @@ std::vector<int> resolve_points(const std::vector<PointSpec>& specs, const TriMe
 }
 
 // Options of an automatic K-quad layout: the defaults, by equal area when `equal_area_layout`.
-QuadLayoutOptions automatic_layout_options(int patches, bool equal_area_layout) {
+QuadLayoutOptions automatic_layout_options(int patches, bool equal_area_layout,
+                                           const std::vector<double>& error_weights) {
   QuadLayoutOptions options;
   options.patches = patches;
   if (equal_area_layout) options.error_weight = 0.0;
+  options.error_weight_factors = error_weights;
   return options;
+}
+
+void check_layout_error_weights(const std::vector<double>& weights) {
+  if (weights.empty() || weights.size() > kMaxLayoutErrorWeights)
+    throw InvalidInput("--layout-error-weights: give 1 to " + std::to_string(kMaxLayoutErrorWeights) +
+                       " weights (" + std::to_string(weights.size()) + " given)");
+  for (double w : weights)
+    if (!std::isfinite(w) || w <= 0.0)
+      throw InvalidInput("--layout-error-weights: every weight must be a finite number > 0");
 }
 
 // Genus ≥ 2 has no two-square (or 2×2 periodic) layout: quad layouts of increasing K, from the smallest the
 // genus allows (K + 2 − 2g = 4 coarse vertices), until one partitions the mesh.
 QuadLayoutChoice layout_for_high_genus(const TriMesh& mesh, int genus, const std::string& name,
-                                       const std::string& command, bool quiet, bool equal_area_layout) {
+                                       const std::string& command, bool quiet, bool equal_area_layout,
+                                       const std::vector<double>& error_weights) {
   std::vector<int> ks;
   for (int k : {2 * genus + 2, 4 * genus, 6 * genus, 8 * genus, 12 * genus, 16 * genus, 24 * genus, 32 * genus})
     if (k + 2 - 2 * genus <= static_cast<int>(mesh.positions.size()) && (ks.empty() || k > ks.back())) ks.push_back(k);
   std::string tried;
   for (int k : ks) {
     try {
-      QuadLayoutChoice chosen = choose_quad_layout(mesh, automatic_layout_options(k, equal_area_layout));
+      QuadLayoutChoice chosen =
+          choose_quad_layout(mesh, automatic_layout_options(k, equal_area_layout, error_weights));
       if (!quiet)
         std::cerr << command << ": " << name << " has genus " << genus << ": automatic layout of " << k
                   << " patches (--patches K chooses another)\n";
@@ -222,7 +235,7 @@ void check_loop_patches(LoopKind loop, int patches) {
 
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file_arg,
                               const std::string& command, bool quiet, int patches, LoopKind loop,
-                              bool equal_area_layout) {
+                              bool equal_area_layout, const std::vector<double>& error_weights) {
   const bool tip_loop = loop != LoopKind::kPlain;
   PreparedModels models;
   std::vector<ParameterizationInput>& inputs = models.inputs;
@@ -231,6 +244,7 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
   const std::string& points_file = points_file_arg;
   if (patches < 2) throw InvalidInput("--patches " + std::to_string(patches) + ": a layout needs at least 2");
   check_loop_patches(loop, patches);
+  check_layout_error_weights(error_weights);
   if (!points_file_arg.empty()) {
     if (!meshes.empty()) {
       throw InvalidInput("give either meshes or --points CORR.json (which names the meshes), not both");
@@ -268,13 +282,14 @@ PreparedModels prepare_models(const std::vector<std::string>& meshes, const std:
     const int genus = spec.partition_points.empty() && patches == 2 ? analyze_topology(in.mesh).genus.value_or(0) : 0;
     if (genus >= 2) {
       const QuadLayoutChoice chosen =
-          layout_for_high_genus(in.mesh, genus, spec.mesh, command, quiet, equal_area_layout);
+          layout_for_high_genus(in.mesh, genus, spec.mesh, command, quiet, equal_area_layout, error_weights);
       in.partition_points = chosen.layout.corners;
       in.layout_quads = chosen.layout.quads;
     } else if (spec.partition_points.empty() && patches != 2) {
       QuadLayoutChoice chosen;
       try {
-        chosen = choose_quad_layout(in.mesh, automatic_layout_options(patches, equal_area_layout));
+        chosen =
+            choose_quad_layout(in.mesh, automatic_layout_options(patches, equal_area_layout, error_weights));
       } catch (const InvalidInput& e) {  // name the mesh: the message is the layout's
         throw InvalidInput(spec.mesh + ": " + e.what());
       }
@@ -357,7 +372,8 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
                   "Sweeps of the L-infinity pass after the stretch optimization: lowers each patch's worst "
                   "stretch (never raises it), raises the L2 stretch (default 0: off)")
       ->check(CLI::Range(0, 10000));
-  add_patches_option(cmd, args.patches, args.patches_given, args.equal_area_layout);
+  add_patches_option(cmd, args.patches, args.patches_given, args.equal_area_layout, args.layout_error_weights,
+                     args.layout_error_weights_given);
   cmd->add_flag("--tip-loop", args.tip_loop,
                 "Two squares (genus 0): route the cut down each protrusion (legs, ears) to its tip and back, "
                 "splitting it lengthwise between the squares (default off: helps some shapes, hurts others; "
@@ -372,7 +388,8 @@ void add_model_options(CLI::App* cmd, ModelArgs& args) {
       ->check(CLI::Range(0, 1000));
 }
 
-void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_area_layout) {
+void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_area_layout,
+                        std::vector<double>& error_weights, bool& weights_given) {
   cmd->add_option(
          "--patches", patches,
          "Patches of the automatic layout: 2 (default) cuts the mesh into two squares along one loop "
@@ -386,6 +403,15 @@ void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_ar
       "--equal-area-layout", equal_area_layout,
       "K-quad layouts: simplify to the coarse mesh by equal area (the layouts before 2026-12-04) instead "
       "of equal error (patches crowd where the surface bends)");
+  cmd->add_option(
+         "--layout-error-weights", error_weights,
+         "K-quad layouts by equal error: simplify the mesh once with each of these multiples of the error "
+         "weight (comma-separated, at most 8) and keep the pairing of least sampling cost among all (default "
+         "1). convert and rd without --patches try both 1 and 1,0.5,2,0.25,4 on a stretched shape and keep "
+         "the layout whose prefixes measure closer to the mesh")
+      ->delimiter(',')
+      ->check(finite_range(1e-6, 1e6))
+      ->each([&weights_given](const std::string&) { weights_given = true; });
 }
 
 void apply_sampling(const ModelArgs& args, ParameterizationOptions& options) {

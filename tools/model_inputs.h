@@ -62,6 +62,11 @@ struct ModelArgs {
   /// --equal-area-layout: the K-quad layout's coarse mesh by equal area (QuadLayoutOptions::error_weight 0)
   /// instead of equal error.
   bool equal_area_layout = false;
+  /// --layout-error-weights: QuadLayoutOptions::error_weight_factors of an automatic K-quad layout.
+  std::vector<double> layout_error_weights = {1.0};
+  /// --layout-error-weights was on the command line (`convert` and `rd` then try only those weights when
+  /// they move a stretched shape; else one weight and kLayoutErrorWeightSets' others).
+  bool layout_error_weights_given = false;
   /// --tip-loop: PartitionPointsOptions::tip_loop for automatic two-square points (genus 0, no CORR.json).
   bool tip_loop = false;
   /// --end-loop: LoopKind::kEnds (not with --tip-loop).
@@ -97,14 +102,21 @@ CLI::Validator finite_range(double lo, double hi);
 /// \throw InvalidInput when both or neither are given, several meshes come without CORR.json, a file is
 ///   unreadable, a point is out of range, `patches` < 2, `patches` ≠ 2 comes with CORR.json, or no K-quad
 ///   layout fits the mesh (choose_quad_layout()), or `loop` is not kPlain with CORR.json or `patches` ≠ 2.
-/// `loop`: the automatically chosen two-square loop (LoopKind). `equal_area_layout`: see
-/// ModelArgs::equal_area_layout.
+/// `loop`: the automatically chosen two-square loop (LoopKind). `equal_area_layout`, `error_weights`: see
+/// ModelArgs::equal_area_layout, ModelArgs::layout_error_weights (\throw InvalidInput when empty, longer than
+/// kMaxLayoutErrorWeights or not all finite and > 0).
 PreparedModels prepare_models(const std::vector<std::string>& meshes, const std::string& points_file,
                               const std::string& command, bool quiet, int patches = 2,
-                              LoopKind loop = LoopKind::kPlain, bool equal_area_layout = false);
+                              LoopKind loop = LoopKind::kPlain, bool equal_area_layout = false,
+                              const std::vector<double>& error_weights = {1.0});
 
-/// Registers `--patches K` and `--equal-area-layout` on `cmd` (same names and help in every command);
-/// `given` is set when --patches is on the command line.
-void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_area_layout);
+/// At most this many --layout-error-weights (each simplifies the mesh once more).
+inline constexpr std::size_t kMaxLayoutErrorWeights = 8;
+
+/// Registers `--patches K`, `--equal-area-layout` and `--layout-error-weights` on `cmd` (same names and help
+/// in every command); `given` is set when --patches is on the command line, `weights_given` when
+/// --layout-error-weights is.
+void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_area_layout,
+                        std::vector<double>& error_weights, bool& weights_given);
 
 }  // namespace geomip::tools

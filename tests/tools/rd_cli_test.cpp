@@ -186,7 +186,14 @@ TEST_F(RdCli, StretchedShapeIsMeasuredOnConvertsLayout) {
   const nlohmann::json c = nlohmann::json::parse(slurp(fs::path(dir_) / "stdout"));
   ASSERT_TRUE(c["moved_to_patches"].get<bool>());
   ASSERT_EQ(geomip("rd --quick --level 4 '" + cow + "' -o '" + dir_ + "/rd'", err), 0) << err;
-  const std::string said = "geomip pack: " + std::to_string(c["patches"].get<int>()) + " patches at level " +
+  std::string weights;  // as --layout-error-weights takes them
+  for (const nlohmann::json& w : c["layout_choice"]["chosen_error_weights"]) {
+    std::ostringstream one;
+    one << w.get<double>();
+    weights += (weights.empty() ? "" : ",") + one.str();
+  }
+  const std::string said = "geomip pack: " + std::to_string(c["patches"].get<int>()) +
+                           " patches, error weights " + weights + ", at level " +
                            std::to_string(c["level"].get<int>());
   EXPECT_NE(slurp(fs::path(dir_) / "stdout").find(said), std::string::npos) << said;
   EXPECT_EQ(slurp(fs::path(dir_) / "rd" / "cow.gip"), slurp(fs::path(dir_) / "c.gip"));

@@ -410,7 +410,8 @@ void add_patches_option(CLI::App* cmd, int& patches, bool& given, bool& equal_ar
          "1). convert and rd without --patches try both 1 and 1,0.5,2,0.25,4 on a stretched shape and keep "
          "the layout whose prefixes measure closer to the mesh")
       ->delimiter(',')
-      ->check(finite_range(1e-6, 1e6))
+      ->type_name("W")
+      ->check(finite_range(1e-6, 1e6).description(""))
       ->each([&weights_given](const std::string&) { weights_given = true; });
 }
 

@@ -194,12 +194,21 @@ std::string error_weights_text(const std::vector<double>& weights) {
   return text;
 }
 
+namespace {
+
+// "16 patches", with " (error weights 1,0.5,2,0.25,4)" when `name_weights`.
+std::string layout_name(int patches, const std::vector<double>& weights, bool name_weights) {
+  return std::to_string(patches) + " patches" +
+         (name_weights ? " (error weights " + error_weights_text(weights) + ")" : "");
+}
+
+}  // namespace
+
 std::string RelayoutChoice::name(const Candidate& c) const {
   bool weights_vary = false;
   for (const Candidate& other : candidates)
     weights_vary = weights_vary || other.error_weights != c.error_weights;
-  return std::to_string(c.patches) + " patches" +
-         (weights_vary ? " (error weights " + error_weights_text(c.error_weights) + ")" : "");
+  return layout_name(c.patches, c.error_weights, weights_vary);
 }
 
 ConvertResult convert_relayout_when_stretched(
@@ -277,10 +286,7 @@ ConvertResult convert_relayout_when_stretched(
           // measurements the last tenth.
           const double n = attempts, i = static_cast<double>(attempt);
           const std::string prefix =
-              std::to_string(c.patches) + " patches" +
-              (error_weight_sets.size() > 1 ? " (error weights " + error_weights_text(c.error_weights) + ")"
-                                            : "") +
-              ": ";
+              layout_name(c.patches, c.error_weights, error_weight_sets.size() > 1) + ": ";
           b.options.progress = [&options, prefix, n, i](const char* stage, double f) {
             options.progress((prefix + stage).c_str(), 0.9 * (i + f) / n);
           };

@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <queue>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -33,10 +34,11 @@ struct Connectivity {
   std::vector<int> opposite;
   std::vector<int> out_begin;  // #V + 1
   std::vector<int> out;
+  std::vector<int> out_to;  // he_to of out[i], beside it: the scans below read contiguous memory
 
-  int find(const TriMesh& m, int a, int b) const {  // half-edge a→b or -1
+  int find(const TriMesh&, int a, int b) const {  // half-edge a→b or -1
     for (int i = out_begin[a]; i < out_begin[a + 1]; ++i) {
-      if (he_to(m, out[i]) == b) return out[i];
+      if (out_to[i] == b) return out[i];
     }
     return -1;
   }
@@ -51,52 +53,69 @@ Connectivity build_connectivity(const TriMesh& m) {
   for (int h = 0; h < nh; ++h) ++c.out_begin[he_from(m, h) + 1];
   for (int v = 0; v < nv; ++v) c.out_begin[v + 1] += c.out_begin[v];
   c.out.resize(nh);
+  c.out_to.resize(nh);
   std::vector<int> fill(c.out_begin.begin(), c.out_begin.end() - 1);
-  for (int h = 0; h < nh; ++h) c.out[fill[he_from(m, h)]++] = h;
-  c.opposite.assign(nh, -1);
   for (int h = 0; h < nh; ++h) {
-    const int a = he_from(m, h), b = he_to(m, h);
-    int found = -1, same_direction = 0;
-    for (int i = c.out_begin[b]; i < c.out_begin[b + 1]; ++i) {
-      if (he_to(m, c.out[i]) == a) {
-        if (found >= 0) same_direction = 1;
-        found = c.out[i];
-      }
-    }
+    const int i = fill[he_from(m, h)]++;
+    c.out[i] = h;
+    c.out_to[i] = he_to(m, h);
+  }
+  c.opposite.assign(nh, -1);
+  // Vertex by vertex: the half-edges a→b out of a, each looked up among b's (contiguous lists).
+  for (int a = 0; a < nv; ++a) {
     for (int i = c.out_begin[a]; i < c.out_begin[a + 1]; ++i) {
-      if (c.out[i] != h && he_to(m, c.out[i]) == b) same_direction = 1;
+      const int h = c.out[i], b = c.out_to[i];
+      int found = -1, same_direction = 0;
+      for (int k = c.out_begin[b]; k < c.out_begin[b + 1]; ++k) {
+        if (c.out_to[k] == a) {
+          if (found >= 0) same_direction = 1;
+          found = c.out[k];
+        }
+      }
+      for (int k = c.out_begin[a]; k < c.out_begin[a + 1]; ++k) {
+        if (k != i && c.out_to[k] == b) same_direction = 1;
+      }
+      if (found < 0 || same_direction) {
+        throw InvalidInput(
+            std::string(kFn) + "edge (" + std::to_string(a) + "," + std::to_string(b) +
+            ") is not shared by exactly two oppositely oriented triangles: the triangles must be "
+            "consistently oriented");
+      }
+      c.opposite[h] = found;
     }
-    if (found < 0 || same_direction) {
-      throw InvalidInput(
-          std::string(kFn) + "edge (" + std::to_string(a) + "," + std::to_string(b) +
-          ") is not shared by exactly two oppositely oriented triangles: the triangles must be "
-          "consistently oriented");
-    }
-    c.opposite[h] = found;
   }
   return c;
 }
 
-// Splits every listed edge at its midpoint; returns the number of vertices appended. Triangles keep their id
-// for their first piece (other pieces appended) and their orientation; untouched triangles stay as they are.
-std::size_t split_edges(TriMesh& m, const std::vector<std::pair<int, int>>& edges) {
-  std::unordered_map<std::uint64_t, int> mid;
+// Splits every listed edge (each an edge of `m`, whose connectivity is `conn`) at its midpoint; returns the
+// number of vertices appended (in list order). Triangles keep their id for their first piece (other pieces
+// appended, in triangle order) and their orientation; untouched triangles stay as they are. Cost: the split
+// edges' triangles.
+std::size_t split_edges(TriMesh& m, const Connectivity& conn, const std::vector<std::pair<int, int>>& edges) {
+  std::vector<int> he_mid(3 * m.triangles.size(), -1);  // per half-edge: the midpoint of its edge, or -1
+  std::vector<int> affected;
+  std::size_t added = 0;
   for (const auto& [a, b] : edges) {
-    if (mid.count(edge_key(a, b))) continue;
-    mid[edge_key(a, b)] = static_cast<int>(m.positions.size());
+    const int h = conn.find(m, a, b);
+    if (h < 0) throw std::logic_error("split_edges: not an edge of the mesh");
+    if (he_mid[h] >= 0) continue;
+    he_mid[h] = he_mid[conn.opposite[h]] = static_cast<int>(m.positions.size());
     m.positions.push_back(0.5 * (m.positions[a] + m.positions[b]));
+    affected.push_back(h / 3);
+    affected.push_back(conn.opposite[h] / 3);
+    ++added;
   }
-  const std::size_t nf = m.triangles.size();
-  for (std::size_t f = 0; f < nf; ++f) {
+  std::sort(affected.begin(), affected.end());
+  affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
+  for (const int fi : affected) {
+    const auto f = static_cast<std::size_t>(fi);
     const auto t = m.triangles[f];
     std::array<int, 3> mids;  // mids[k]: midpoint of edge t[k]→t[k+1], or -1
     int count = 0;
     for (int k = 0; k < 3; ++k) {
-      const auto it = mid.find(edge_key(t[k], t[(k + 1) % 3]));
-      mids[k] = it == mid.end() ? -1 : it->second;
+      mids[k] = he_mid[3 * f + static_cast<std::size_t>(k)];
       count += mids[k] >= 0;
     }
-    if (count == 0) continue;
     std::vector<std::array<int, 3>> pieces;
     if (count == 3) {
       pieces = {{t[0], mids[0], mids[2]},
@@ -118,7 +137,7 @@ std::size_t split_edges(TriMesh& m, const std::vector<std::pair<int, int>>& edge
     m.triangles[f] = pieces[0];
     m.triangles.insert(m.triangles.end(), pieces.begin() + 1, pieces.end());
   }
-  return mid.size();
+  return added;
 }
 
 // Dijkstra on the edge graph with Euclidean lengths, reusing its arrays between queries.
@@ -153,7 +172,7 @@ class PathTracer {
       if (d > dist_[v]) continue;
       if (v == target) break;
       for (int i = c.out_begin[v]; i < c.out_begin[v + 1]; ++i) {
-        const int u = he_to(m, c.out[i]);
+        const int u = c.out_to[i];
         if (blocked[u] && u != target) continue;
         if ((v == source && !listed(first_ok, u)) || (u == target && !listed(last_ok, v))) continue;
         const double du = d + (m.positions[u] - m.positions[v]).norm();
@@ -433,7 +452,7 @@ class Partitioner {
     mark_cut();
     const auto list = chords();
     if (list.empty()) return;
-    result_.split_vertices += split_edges(result_.mesh, list);
+    result_.split_vertices += split_edges(result_.mesh, conn_, list);
     conn_ = build_connectivity(result_.mesh);
     blocked_.resize(result_.mesh.positions.size(), 0);
     mark_cut();

@@ -19,6 +19,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <mutex>
 #include <ostream>
 #include <sstream>
 #include <string_view>
@@ -48,6 +49,13 @@ void silence_openmesh() {
     return true;
   }();
   (void)done;
+}
+
+// OpenMesh's IOManager is one shared object whose readers and writers keep state, and SilencedCerr swaps
+// std::cerr's buffer: one OpenMesh read or write at a time (convert builds several layouts on threads).
+std::mutex& openmesh_mutex() {
+  static std::mutex m;
+  return m;
 }
 
 // Some of OpenMesh's readers also write to std::cerr directly (the OFF reader's "Error in file format"):
@@ -1267,6 +1275,7 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
   bool ok = false;
   try {
     JoinedStream in(ply_header, data);
+    const std::lock_guard<std::mutex> lock(openmesh_mutex());
     const SilencedCerr quiet;
     // OpenMesh picks the reader by extension; STL variants all go through "stl".
     ok = OpenMesh::IO::IOManager().read(in, extension_of(format), importer, io_options);
@@ -1345,6 +1354,7 @@ void write_mesh(const TriMesh& mesh, std::ostream& out, MeshFormat format, const
     io_options += OpenMesh::IO::Options::Binary;
     io_options += OpenMesh::IO::Options::LSB;
   }
+  const std::lock_guard<std::mutex> lock(openmesh_mutex());
   if (!OpenMesh::IO::IOManager().write(out, extension_of(format), exporter, io_options, options.precision) || !out) {
     throw IoError("write_mesh: writing the " + std::string(extension_of(format)) + " stream failed");
   }

@@ -45,6 +45,7 @@ struct ConvertArgs {
   bool no_lifting_update = false;
   bool no_cell_frames = false;
   bool short_filter = false;
+  int threads = 0;  ///< --threads: the layout choice's (0 = one per hardware thread)
   bool fit = false;
   bool choose_loop = false;  ///< --choose-loop: the plain, tip or end loop, whichever prefixes are closest
   bool search =
@@ -181,6 +182,7 @@ int run_convert(const ConvertArgs& args) {
   options.up = up;
   options.front = front;
   options.progress = bar.callback();
+  options.threads = args.threads;
   ConvertResult converted;
   std::optional<SearchResult> searched;
   const int named_level = level;  // the level the search names its candidates against
@@ -433,6 +435,12 @@ CommandRunner add_convert_command(CLI::App& app) {
   cmd->add_flag("--no-lifting-update", args->no_lifting_update,
                 "Code the geometry with the plain interpolating wavelet, without the update step (ablations; "
                 "the pack's format is the same)");
+  cmd->add_option(
+         "--threads", args->threads,
+         "Worker threads of the layout choice of a shape that two squares stretch (its layouts built "
+         "side by side; default: all cores, fewer for meshes of over a million faces); the pack does "
+         "not depend on it")
+      ->check(CLI::Range(1, 1024));
   cmd->add_flag("--no-cell-frames", args->no_cell_frames,
                 "Build the local frames as pack format 7 did (per sample, from the finest reconstruction) "
                 "instead of from the coarse grid and a table of direction cells (ablations; decodes slower; "

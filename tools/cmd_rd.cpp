@@ -224,6 +224,7 @@ Series geomip_series(const RdArgs& args, LoopKind loop, bool relayout, std::vect
   options.normals = false;
   options.normal_mesh_steps = normal_mesh_steps;
   options.fit = args.fit;
+  options.threads = static_cast<int>(args.threads);
   options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
   std::shared_ptr<const std::vector<std::uint8_t>> pack;
   if (args.search) {

@@ -15,8 +15,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <utility>
 
 namespace geomip::tools {
@@ -253,11 +255,8 @@ ConvertResult convert_relayout_when_stretched(
   std::vector<Built> built;
   std::vector<std::size_t> built_candidate;  // index into choice.candidates
   if (!tried.empty() && before_switch) before_switch(stretch, tried);
-  std::size_t attempt = 0;  // layouts started, for the progress bar
-  const double attempts =
-      static_cast<double>(tried.size() * std::max<std::size_t>(error_weight_sets.size(), 1));
-  // The layouts prepared so far (patches, corners, quads, error weights): another set of weights that
-  // chooses the same layout is not converted again.
+  // The layouts prepared (patches, corners, quads, error weights): another set of weights that chooses the
+  // same layout is not converted again.
   struct Prepared {
     int patches;
     std::vector<int> corners;
@@ -265,56 +264,99 @@ ConvertResult convert_relayout_when_stretched(
     std::vector<double> error_weights;
   };
   std::vector<Prepared> prepared;
-  for (RelayoutChoice::Candidate& c : candidates) {
-    if (c.level >= 1) {
-      try {
-        Built b{prepare(c.patches, c.error_weights), options, {}, {}};
-        const ParameterizationInput& in = b.models.inputs.front();
-        const auto same = std::find_if(prepared.begin(), prepared.end(), [&](const Prepared& p) {
-          return p.patches == c.patches && p.corners == in.partition_points && p.quads == in.layout_quads;
-        });
-        if (same != prepared.end()) {
-          c.not_built = "the same layout as with error weights " + error_weights_text(same->error_weights);
-          choice.candidates.push_back(c);
-          continue;
-        }
-        prepared.push_back({c.patches, in.partition_points, in.layout_quads, c.error_weights});
-        b.options.level = c.level;
-        b.options.keep_inputs = true;  // the geometry-only pack is encoded again from them
-        if (options.progress) {
-          // One bar over all layouts: layout i of n fills 0.9·[i/n, (i+1)/n), its stages named after it; the
-          // measurements the last tenth.
-          const double n = attempts, i = static_cast<double>(attempt);
-          const std::string prefix =
-              layout_name(c.patches, c.error_weights, error_weight_sets.size() > 1) + ": ";
-          b.options.progress = [&options, prefix, n, i](const char* stage, double f) {
-            options.progress((prefix + stage).c_str(), 0.9 * (i + f) / n);
-          };
-        }
-        ++attempt;
-        b.result = convert_models(b.models, b.options);
-        b.options.progress = options.progress;
-        if (options.normals) {
-          ConvertOptions geometry = b.options;
-          geometry.normals = false;
-          b.geometry_pack = codec::write_pack(
-              b.result.inputs, pack_write_options(geometry, b.result.inputs.front().geometry.size()));
-        } else {
-          b.geometry_pack = b.result.pack;
-        }
-        if (!options.keep_inputs) b.result.inputs.clear();
-        b.options.keep_inputs = options.keep_inputs;
-        c.geometry_bytes = b.geometry_pack.size();
-        built.push_back(std::move(b));
-        built_candidate.push_back(choice.candidates.size());
-      } catch (const InvalidInput& e) {  // no such layout fits this mesh (too few vertices, paths that fail)
-        c.not_built = e.what();
-      } catch (const SolverFailure& e) {
-        c.not_built = e.what();
-      }
+  // Three phases. (1) On threads: each candidate's layout — its mesh read and prepared, its quads chosen
+  // (most of the choice's time). (2) In candidate order: a layout that an earlier candidate chose already is
+  // not converted again. (3) On threads: the other layouts converted. Every candidate is computed on its
+  // own, so the packs do not depend on the threads (the same bytes as one after the other). Threads: one per
+  // candidate up to options.threads (0: the hardware's), fewer on meshes of over a million faces, so that the
+  // choice's peak memory stays about that of one conversion there.
+  const std::size_t faces = models.inputs.front().mesh.triangles.size();
+  const int threads = std::max(
+      1, std::min({options.threads > 0 ? options.threads
+                                       : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())),
+                   static_cast<int>(
+                       std::max<std::size_t>(1, kRelayoutFacesPerThread / std::max<std::size_t>(faces, 1))),
+                   static_cast<int>(candidates.size())}));
+  std::vector<std::optional<PreparedModels>> layouts(candidates.size());
+  std::mutex progress_mutex;
+  if (options.progress) options.progress("choose layouts", 0.0);
+  codec::parallel_for(static_cast<int>(candidates.size()), threads, [&](int i) {
+    RelayoutChoice::Candidate& c = candidates[static_cast<std::size_t>(i)];
+    if (c.level < 1) return;
+    try {
+      layouts[static_cast<std::size_t>(i)] = prepare(c.patches, c.error_weights);
+    } catch (const InvalidInput& e) {  // no such layout fits this mesh (too few vertices, paths that fail)
+      c.not_built = e.what();
+    } catch (const SolverFailure& e) {
+      c.not_built = e.what();
     }
-    choice.candidates.push_back(c);
+  });
+  std::vector<std::size_t> to_build;  // candidate indices
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const RelayoutChoice::Candidate& c = candidates[i];
+    if (!layouts[i]) continue;
+    const ParameterizationInput& in = layouts[i]->inputs.front();
+    const auto same = std::find_if(prepared.begin(), prepared.end(), [&](const Prepared& p) {
+      return p.patches == c.patches && p.corners == in.partition_points && p.quads == in.layout_quads;
+    });
+    if (same != prepared.end()) {
+      candidates[i].not_built =
+          "the same layout as with error weights " + error_weights_text(same->error_weights);
+      layouts[i].reset();
+      continue;
+    }
+    prepared.push_back({c.patches, in.partition_points, in.layout_quads, c.error_weights});
+    to_build.push_back(i);
   }
+  std::vector<std::optional<Built>> builds(to_build.size());
+  std::vector<double> done(to_build.size(), 0.0);  // each conversion's progress, for one bar over all
+  codec::parallel_for(static_cast<int>(to_build.size()), threads, [&](int t) {
+    const std::size_t i = to_build[static_cast<std::size_t>(t)];
+    RelayoutChoice::Candidate& c = candidates[i];
+    try {
+      Built b{std::move(*layouts[i]), options, {}, {}};
+      layouts[i].reset();
+      b.options.level = c.level;
+      b.options.keep_inputs = true;  // the geometry-only pack is encoded again from them
+      if (options.progress) {
+        // One bar over all layouts: the conversions fill 0.9 of it, each named after its layout; the
+        // measurements the last tenth.
+        const std::string prefix =
+            layout_name(c.patches, c.error_weights, error_weight_sets.size() > 1) + ": ";
+        b.options.progress = [&options, &progress_mutex, &done, prefix, t](const char* stage, double f) {
+          const std::lock_guard<std::mutex> lock(progress_mutex);
+          done[static_cast<std::size_t>(t)] = f;
+          double sum = 0;
+          for (double d : done) sum += d;
+          options.progress((prefix + stage).c_str(), 0.9 * sum / static_cast<double>(done.size()));
+        };
+      }
+      b.result = convert_models(b.models, b.options);
+      b.options.progress = options.progress;
+      if (options.normals) {
+        ConvertOptions geometry = b.options;
+        geometry.normals = false;
+        b.geometry_pack = codec::write_pack(
+            b.result.inputs, pack_write_options(geometry, b.result.inputs.front().geometry.size()));
+      } else {
+        b.geometry_pack = b.result.pack;
+      }
+      if (!options.keep_inputs) b.result.inputs.clear();
+      b.options.keep_inputs = options.keep_inputs;
+      c.geometry_bytes = b.geometry_pack.size();
+      builds[static_cast<std::size_t>(t)] = std::move(b);
+    } catch (const InvalidInput& e) {
+      c.not_built = e.what();
+    } catch (const SolverFailure& e) {
+      c.not_built = e.what();
+    }
+  });
+  for (std::size_t t = 0; t < to_build.size(); ++t) {
+    if (!builds[t]) continue;
+    built.push_back(std::move(*builds[t]));
+    built_candidate.push_back(to_build[t]);
+  }
+  choice.candidates = candidates;
   if (built.empty()) {
     // Two squares after all: their whole pipeline (the note on the stretch is the caller's).
     ConvertResult result = convert_models(models, options);

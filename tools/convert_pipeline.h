@@ -95,6 +95,9 @@ struct ConvertOptions {
   /// zero (default) for the shape's rule.
   Eigen::Vector3d front = Eigen::Vector3d::Zero();
   ProgressCallback progress;  ///< stages "parameterize …", "resample", "encode" (and "measure layouts")
+  /// Threads of convert_relayout_when_stretched()'s layout choice (its candidates built side by side);
+  /// 0: one per hardware thread. The packs do not depend on it.
+  int threads = 0;
   /// Keep the pack's inputs (geometry images, normal maps, hole masks before coding) in
   /// ConvertResult::inputs (codec_bench --normals measures the coded normal maps against them).
   bool keep_inputs = false;
@@ -149,6 +152,12 @@ inline constexpr int kStretchedShapeLayouts[] = {16, 64};
 /// and measured, the five-weight one only where its layout differs from the one-weight layout.
 inline const std::vector<std::vector<double>> kStretchedLayoutErrorWeights = {{1.0},
                                                                               {1.0, 0.5, 2.0, 0.25, 4.0}};
+
+/// The layout choice builds its candidates side by side on at most this many faces' worth of threads
+/// (kRelayoutFacesPerThread / faces threads, at least one): a conversion's peak memory grows with the faces
+/// (1.75 GB for a million, docs/measurements.md), so a mesh of a million faces or more is converted one
+/// layout after another, as before threads.
+inline constexpr std::size_t kRelayoutFacesPerThread = 1'000'000;
 
 /// `weights` as --layout-error-weights takes them ("1", "1,0.5,2,0.25,4").
 std::string error_weights_text(const std::vector<double>& weights);

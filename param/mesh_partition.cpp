@@ -224,6 +224,11 @@ class Partitioner {
     result_.mesh = mesh;
     conn_ = build_connectivity(result_.mesh);
   }
+  // With the mesh's connectivity already built (PartitionMeshCache).
+  Partitioner(const TriMesh& mesh, const Connectivity& conn, const PartitionOptions& options)
+      : options_(options), conn_(conn) {
+    result_.mesh = mesh;
+  }
 
   // Traces `specs` in order; every path avoids all special points but its own and the interior vertices of
   // earlier paths. `special` lists every partition and auxiliary point.
@@ -730,8 +735,8 @@ std::string layout_half_edges(const QuadLayout& l, LayoutHalfEdges& he) {
 }
 
 PartitionResult partition_layout(const TriMesh& mesh, const QuadLayout& layout, const LayoutHalfEdges& he,
-                                 const PartitionOptions& options) {
-  Partitioner part(mesh, options);
+                                 const PartitionOptions& options, const Connectivity* conn = nullptr) {
+  Partitioner part = conn ? Partitioner(mesh, *conn, options) : Partitioner(mesh, options);
   // One path per layout edge, stored from its lower-numbered half-edge's start, shortest corners first.
   const int ne = he.num_edges;
   std::vector<int> edge_half(ne, -1);
@@ -952,6 +957,35 @@ PartitionResult partition_mesh_layout(const TriMesh& closed_manifold, const Quad
   LayoutHalfEdges he;
   layout_half_edges(layout, he);
   return partition_layout(closed_manifold, layout, he, options);
+}
+
+struct PartitionMeshCache::Impl {
+  const TriMesh* mesh = nullptr;
+  int genus = 0;
+  Connectivity conn;
+};
+
+PartitionMeshCache::PartitionMeshCache(const TriMesh& closed_manifold) : impl_(std::make_unique<Impl>()) {
+  impl_->mesh = &closed_manifold;
+  impl_->genus = checked_genus(closed_manifold);
+  impl_->conn = build_connectivity(closed_manifold);
+}
+
+PartitionMeshCache::~PartitionMeshCache() = default;
+
+const TriMesh& PartitionMeshCache::mesh() const {
+  return *impl_->mesh;
+}
+
+PartitionResult partition_mesh_layout(const PartitionMeshCache& cache, const QuadLayout& layout,
+                                      const PartitionOptions& options) {
+  const TriMesh& mesh = cache.mesh();
+  check_points(mesh, layout.corners, {});
+  const std::string why = check_quad_layout(layout, mesh.positions.size(), cache.impl_->genus);
+  if (!why.empty()) throw InvalidInput(std::string(kFn) + why);
+  LayoutHalfEdges he;
+  layout_half_edges(layout, he);
+  return partition_layout(mesh, layout, he, options, &cache.impl_->conn);
 }
 
 PartitionResult partition_mesh(const TriMesh& closed_manifold, const std::vector<int>& partition_points,

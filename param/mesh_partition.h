@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -189,6 +190,31 @@ std::string check_quad_layout(const QuadLayout& layout, std::size_t num_vertices
 ///   surface of the mesh's genus (check_quad_layout()), a path cannot be traced, or the traced paths do not
 ///   cut the mesh into the layout's quads (corner cycles that disagree with the mesh).
 PartitionResult partition_mesh_layout(const TriMesh& closed_manifold, const QuadLayout& layout,
+                                      const PartitionOptions& options = {});
+
+/// What partition_mesh_layout() derives from the mesh alone — its checks, its genus, its half-edge
+/// connectivity — computed once for many layouts of one mesh (choose_quad_layout() partitions the same mesh
+/// for every pairing and corner move it tries: a fifth of its time went to these). Refers to the mesh, which
+/// must outlive it unchanged.
+class PartitionMeshCache {
+ public:
+  /// \throw InvalidInput as partition_mesh_layout() when the mesh is not one closed, manifold, consistently
+  ///   oriented component.
+  explicit PartitionMeshCache(const TriMesh& closed_manifold);
+  ~PartitionMeshCache();
+  PartitionMeshCache(const PartitionMeshCache&) = delete;
+  PartitionMeshCache& operator=(const PartitionMeshCache&) = delete;
+  const TriMesh& mesh() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  friend PartitionResult partition_mesh_layout(const PartitionMeshCache&, const QuadLayout&,
+                                               const PartitionOptions&);
+};
+
+/// partition_mesh_layout() of cache.mesh(): the same result, without checking and connecting the mesh again.
+PartitionResult partition_mesh_layout(const PartitionMeshCache& cache, const QuadLayout& layout,
                                       const PartitionOptions& options = {});
 
 /// Quality figures of a partition, in the mesh's units.

@@ -489,9 +489,10 @@ void even_quads_at_two_quad_corners(QuadLayout& layout) {
 
 // Pairs `coarse` (closed, 2k triangles over mesh vertices) into k quads by each greedy score completed to a
 // perfect matching; every pairing that partitions `mesh` is measured and kept in `best` if more balanced.
-void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int, 3>>& coarse, long long k,
-                           const Objective& objective,
-                           QuadLayoutChoice& best, double& best_cost, std::string& last_error) {
+void pair_coarse_triangles(const TriMesh& mesh, const PartitionMeshCache& cache,
+                           const std::vector<std::array<int, 3>>& coarse, long long k,
+                           const Objective& objective, QuadLayoutChoice& best, double& best_cost,
+                           std::string& last_error) {
   const int nf = static_cast<int>(coarse.size());
   // Dual graph: triangles sharing an edge.
   std::unordered_map<std::uint64_t, int> by_edge;
@@ -556,7 +557,7 @@ void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int
     }
     even_quads_at_two_quad_corners(layout);
     try {
-      const PartitionResult partition = partition_mesh_layout(mesh, layout);
+      const PartitionResult partition = partition_mesh_layout(cache, layout);
       const PartitionStats stats = partition_stats(partition);
       const double cost = objective(partition, stats);
       ++best.candidates;
@@ -569,7 +570,6 @@ void pair_coarse_triangles(const TriMesh& mesh, const std::vector<std::array<int
     }
   }
 }
-
 
 // The tips of the shape's protrusions (legs, ears, head, tail): the maxima of the geodesic distance (Dijkstra
 // on the edge graph) from the vertex nearest the area centroid whose persistence (how far the distance
@@ -619,10 +619,11 @@ struct EvaluatedLayout {
 
 // Partitions `mesh` by `layout` and measures it; nullopt when the layout cuts the mesh into other regions
 // than its quads (partition_mesh_layout() refuses it).
-std::optional<EvaluatedLayout> evaluate_layout(const TriMesh& mesh, const Objective& objective, QuadLayout layout) {
+std::optional<EvaluatedLayout> evaluate_layout(const PartitionMeshCache& cache, const Objective& objective,
+                                               QuadLayout layout) {
   try {
     EvaluatedLayout e;
-    e.partition = partition_mesh_layout(mesh, layout);
+    e.partition = partition_mesh_layout(cache, layout);
     e.stats = partition_stats(e.partition);
     e.cost = objective(e.partition, e.stats);
     e.layout = std::move(layout);
@@ -691,7 +692,7 @@ struct PatchGeometry {
 // with a lower area_spread(). Each round tries all corners at once, then the corners of one patch at a time,
 // the patch farthest from the mean area first (up to 3 patches); when nothing is kept the step is halved.
 // At most `evaluations` partitions are tried. Returns the number of moves kept.
-int relax_corners(const TriMesh& mesh, const Objective& objective,
+int relax_corners(const TriMesh& mesh, const PartitionMeshCache& cache, const Objective& objective,
                   const std::vector<int>& locked, QuadLayout& layout, PartitionResult& partition,
                   PartitionStats& stats, int evaluations) {
   const int nc = static_cast<int>(layout.corners.size());
@@ -743,7 +744,8 @@ int relax_corners(const TriMesh& mesh, const Objective& objective,
       }
       if (moved.corners == layout.corners) continue;
       ++tried;
-      if (auto candidate = evaluate_layout(mesh, objective, std::move(moved)); candidate && candidate->cost < spread) {
+      if (auto candidate = evaluate_layout(cache, objective, std::move(moved));
+          candidate && candidate->cost < spread) {
         spread = candidate->cost;
         layout = std::move(candidate->layout);
         partition = std::move(candidate->partition);
@@ -766,9 +768,9 @@ int relax_corners(const TriMesh& mesh, const Objective& objective,
 // `step`/2 of the way towards and away from each corner it shares a side with; the best candidate that
 // lowers the objective is kept. When no corner improves the step is halved. At most `evaluations`
 // partitions are tried. Returns the number of moves kept.
-int reshape_corners(const TriMesh& mesh, const Objective& objective, const QuadLayoutOptions& options,
-                    const std::vector<int>& locked, QuadLayout& layout, PartitionResult& partition,
-                    PartitionStats& stats, int evaluations) {
+int reshape_corners(const TriMesh& mesh, const PartitionMeshCache& cache, const Objective& objective,
+                    const QuadLayoutOptions& options, const std::vector<int>& locked, QuadLayout& layout,
+                    PartitionResult& partition, PartitionStats& stats, int evaluations) {
   const int nc = static_cast<int>(layout.corners.size());
   const int nq = static_cast<int>(layout.quads.size());
   std::vector<std::vector<int>> quads_at(nc), side_neighbours(nc);
@@ -842,7 +844,7 @@ int reshape_corners(const TriMesh& mesh, const Objective& objective, const QuadL
         QuadLayout moved = layout;
         moved.corners[c] = v;
         ++tried;
-        auto candidate = evaluate_layout(mesh, objective, std::move(moved));
+        auto candidate = evaluate_layout(cache, objective, std::move(moved));
         if (candidate && candidate->cost < (best ? best->cost : cost)) best = std::move(candidate);
       }
       if (best) {
@@ -885,6 +887,7 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
     throw InvalidInput(std::string(kFn) + std::to_string(k) + " patches need " + std::to_string(target) +
                        " corners but the mesh has " + std::to_string(vertices) + " vertices");
   }
+  const PartitionMeshCache cache(mesh);  // every partition below is of this mesh
   const std::function<double(const PartitionStats&)> base =
       options.objective == LayoutObjective::kSamplingCost ? sampling_cost : area_spread;
   const Objective objective = [&](const PartitionResult& partition, const PartitionStats& stats) {
@@ -925,22 +928,22 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
       }
       std::vector<std::array<int, 3>> coarse = simplifier.triangles();
       delaunay_flips(mesh.positions, coarse);
-      pair_coarse_triangles(mesh, coarse, k, objective, group, group_cost, last_error);
+      pair_coarse_triangles(mesh, cache, coarse, k, objective, group, group_cost, last_error);
     }
     if (group.candidates == 0) continue;
     candidates += group.candidates;
     if (options.balance_steps > 0) {
-      PartitionResult partition = partition_mesh_layout(mesh, group.layout);
+      PartitionResult partition = partition_mesh_layout(cache, group.layout);
       PartitionStats stats = partition_stats(partition);
       group.balance_steps =
-          relax_corners(mesh, objective, tips, group.layout, partition, stats, options.balance_steps);
+          relax_corners(mesh, cache, objective, tips, group.layout, partition, stats, options.balance_steps);
       group_cost = objective(partition, stats);
     }
     if (options.shape_weight > 0.0 && options.shape_steps > 0) {
-      PartitionResult partition = partition_mesh_layout(mesh, group.layout);
+      PartitionResult partition = partition_mesh_layout(cache, group.layout);
       PartitionStats stats = partition_stats(partition);
-      group.shape_steps =
-          reshape_corners(mesh, objective, options, tips, group.layout, partition, stats, options.shape_steps);
+      group.shape_steps = reshape_corners(mesh, cache, objective, options, tips, group.layout, partition,
+                                          stats, options.shape_steps);
       group_cost = objective(partition, stats);
     }
     if (best.candidates == 0 || group_cost < best_cost) {
@@ -956,7 +959,7 @@ QuadLayoutChoice choose_quad_layout(const TriMesh& mesh, const QuadLayoutOptions
   best.candidates = candidates;
   best.tips = tips;
   {
-    const PartitionResult partition = partition_mesh_layout(mesh, best.layout);
+    const PartitionResult partition = partition_mesh_layout(cache, best.layout);
     const PartitionStats stats = partition_stats(partition);
     best.area_balance = stats.area_balance;
     best.area_spread = area_spread(stats);

@@ -658,6 +658,50 @@ TEST(PartitionLayout, TorusGridLayoutOfNineQuads) {
   EXPECT_EQ(embedding_problems(r), "");
 }
 
+// A PartitionMeshCache (the mesh checked and connected once, as choose_quad_layout() partitions it many
+// times) gives every layout the same partition, bit for bit, and every bad layout the same error.
+TEST(PartitionLayout, ACachedMeshGivesTheSamePartitionsAndErrors) {
+  TriMesh m = sphere(4);
+  const Eigen::Matrix3d rot =
+      (Eigen::AngleAxisd(0.7, Eigen::Vector3d(3, 1, 2).normalized())).toRotationMatrix();
+  for (auto& p : m.positions) p = rot * p;  // paths off the mesh lines: chords to split
+  const PartitionMeshCache cache(m);
+  EXPECT_EQ(&cache.mesh(), &m);
+  QuadLayout moved = cube_layout();
+  moved.corners[2] = nearest_vertex(m, rot * Eigen::Vector3d(0.2, 0.9, -0.4).normalized());
+  QuadLayout inside_out = cube_layout();
+  for (auto& q : inside_out.quads) std::reverse(q.begin(), q.end());
+  std::size_t splits = 0;
+  for (const QuadLayout& layout : {cube_layout(), moved, inside_out}) {
+    const PartitionResult plain = partition_mesh_layout(m, layout);
+    const PartitionResult cached = partition_mesh_layout(cache, layout);
+    EXPECT_EQ(cached.mesh.positions, plain.mesh.positions);
+    EXPECT_EQ(cached.mesh.triangles, plain.mesh.triangles);
+    EXPECT_EQ(cached.face_patch, plain.face_patch);
+    EXPECT_EQ(cached.split_vertices, plain.split_vertices);
+    ASSERT_EQ(cached.adjacency.size(), plain.adjacency.size());
+    for (std::size_t i = 0; i < plain.adjacency.size(); ++i) {
+      EXPECT_EQ(cached.adjacency[i].other_patch, plain.adjacency[i].other_patch);
+      EXPECT_EQ(cached.adjacency[i].other_side, plain.adjacency[i].other_side);
+      EXPECT_EQ(cached.adjacency[i].reversed, plain.adjacency[i].reversed);
+    }
+    EXPECT_EQ(test::check_partition(m, layout.corners, cached, &layout), "");
+    splits += cached.split_vertices;
+  }
+  EXPECT_GT(splits, 0u);  // the cached connectivity went through chord splits too
+  QuadLayout open = cube_layout();
+  open.quads.pop_back();
+  test::expect_invalid_input([&] { partition_mesh_layout(cache, open); }, "partition_mesh:", "not closed");
+  QuadLayout bad_vertex = cube_layout();
+  bad_vertex.corners[3] = static_cast<int>(m.positions.size());
+  test::expect_invalid_input([&] { partition_mesh_layout(cache, bad_vertex); },
+                             "partition_mesh:", "out of range");
+  // The cache checks the mesh as partition_mesh_layout() does.
+  TriMesh open_mesh = m;
+  open_mesh.triangles.pop_back();
+  test::expect_invalid_input([&] { PartitionMeshCache bad(open_mesh); }, "partition_mesh:", "not closed");
+}
+
 TEST(PartitionLayout, BadLayoutsAreRejectedWithOneLine) {
   const TriMesh m = sphere(3);
   QuadLayout open = cube_layout();

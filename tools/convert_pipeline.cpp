@@ -255,15 +255,6 @@ ConvertResult convert_relayout_when_stretched(
   std::vector<Built> built;
   std::vector<std::size_t> built_candidate;  // index into choice.candidates
   if (!tried.empty() && before_switch) before_switch(stretch, tried);
-  // The layouts prepared (patches, corners, quads, error weights): another set of weights that chooses the
-  // same layout is not converted again.
-  struct Prepared {
-    int patches;
-    std::vector<int> corners;
-    std::vector<std::array<int, 4>> quads;
-    std::vector<double> error_weights;
-  };
-  std::vector<Prepared> prepared;
   // Three phases. (1) On threads: each candidate's layout — its mesh read and prepared, its quads chosen
   // (most of the choice's time). (2) In candidate order: a layout that an earlier candidate chose already is
   // not converted again. (3) On threads: the other layouts converted. Every candidate is computed on its
@@ -279,33 +270,39 @@ ConvertResult convert_relayout_when_stretched(
                    static_cast<int>(candidates.size())}));
   std::vector<std::optional<PreparedModels>> layouts(candidates.size());
   std::mutex progress_mutex;
-  if (options.progress) options.progress("choose layouts", 0.0);
-  codec::parallel_for(static_cast<int>(candidates.size()), threads, [&](int i) {
-    RelayoutChoice::Candidate& c = candidates[static_cast<std::size_t>(i)];
-    if (c.level < 1) return;
+  // Runs one candidate's step; a layout that does not fit this mesh (too few vertices, paths that fail, a
+  // solver that gives up) is reported as not built.
+  const auto attempt = [](RelayoutChoice::Candidate& c, const auto& step) {
     try {
-      layouts[static_cast<std::size_t>(i)] = prepare(c.patches, c.error_weights);
-    } catch (const InvalidInput& e) {  // no such layout fits this mesh (too few vertices, paths that fail)
+      step();
+    } catch (const InvalidInput& e) {
       c.not_built = e.what();
     } catch (const SolverFailure& e) {
       c.not_built = e.what();
     }
+  };
+  if (options.progress) options.progress("choose layouts", 0.0);
+  codec::parallel_for(static_cast<int>(candidates.size()), threads, [&](int i) {
+    RelayoutChoice::Candidate& c = candidates[static_cast<std::size_t>(i)];
+    if (c.level < 1) return;
+    attempt(c, [&] { layouts[static_cast<std::size_t>(i)] = prepare(c.patches, c.error_weights); });
   });
   std::vector<std::size_t> to_build;  // candidate indices
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const RelayoutChoice::Candidate& c = candidates[i];
     if (!layouts[i]) continue;
     const ParameterizationInput& in = layouts[i]->inputs.front();
-    const auto same = std::find_if(prepared.begin(), prepared.end(), [&](const Prepared& p) {
-      return p.patches == c.patches && p.corners == in.partition_points && p.quads == in.layout_quads;
+    const auto same = std::find_if(to_build.begin(), to_build.end(), [&](std::size_t j) {
+      const ParameterizationInput& earlier = layouts[j]->inputs.front();
+      return candidates[j].patches == c.patches && earlier.partition_points == in.partition_points &&
+             earlier.layout_quads == in.layout_quads;
     });
-    if (same != prepared.end()) {
+    if (same != to_build.end()) {
       candidates[i].not_built =
-          "the same layout as with error weights " + error_weights_text(same->error_weights);
+          "the same layout as with error weights " + error_weights_text(candidates[*same].error_weights);
       layouts[i].reset();
       continue;
     }
-    prepared.push_back({c.patches, in.partition_points, in.layout_quads, c.error_weights});
     to_build.push_back(i);
   }
   std::vector<std::optional<Built>> builds(to_build.size());
@@ -313,7 +310,7 @@ ConvertResult convert_relayout_when_stretched(
   codec::parallel_for(static_cast<int>(to_build.size()), threads, [&](int t) {
     const std::size_t i = to_build[static_cast<std::size_t>(t)];
     RelayoutChoice::Candidate& c = candidates[i];
-    try {
+    attempt(c, [&] {
       Built b{std::move(*layouts[i]), options, {}, {}};
       layouts[i].reset();
       b.options.level = c.level;
@@ -345,11 +342,7 @@ ConvertResult convert_relayout_when_stretched(
       b.options.keep_inputs = options.keep_inputs;
       c.geometry_bytes = b.geometry_pack.size();
       builds[static_cast<std::size_t>(t)] = std::move(b);
-    } catch (const InvalidInput& e) {
-      c.not_built = e.what();
-    } catch (const SolverFailure& e) {
-      c.not_built = e.what();
-    }
+    });
   });
   for (std::size_t t = 0; t < to_build.size(); ++t) {
     if (!builds[t]) continue;

@@ -23,6 +23,8 @@
 #include <ostream>
 #include <sstream>
 #include <string_view>
+#include <unordered_set>
+#include <vector>
 
 namespace geomip {
 namespace {
@@ -715,7 +717,18 @@ std::string parse_obj_corner(const std::string& corner, long long& vertex) {
 }
 
 // `exact` (when not null) gets every vertex's coordinates as written: OpenMesh's reader rounds them to float.
-void validate_obj(const std::string& path, std::string_view bytes, std::vector<Eigen::Vector3d>* exact) {
+// An OBJ face whose corners repeat a vertex ("f 1 1 2"), which OpenMesh's reader drops without a word: its
+// 0-based corners and its place among the file's faces, so that read_mesh keeps it as PLY and OFF do (a
+// degenerate triangle that `info` counts and `repair` removes, instead of a face silently lost).
+struct RepeatedCornerFace {
+  std::size_t ordinal;  // faces of the file before it
+  std::vector<int> corners;
+};
+
+// Returns the number of faces ("f" lines).
+std::size_t validate_obj(const std::string& path, std::string_view bytes, std::vector<Eigen::Vector3d>* exact,
+                         std::vector<RepeatedCornerFace>* repeated = nullptr) {
+  std::size_t faces = 0;  // "f" lines so far
   MemoryStream in(bytes);
   LineScanner lines(in, 0);
   std::string line;
@@ -736,6 +749,7 @@ void validate_obj(const std::string& path, std::string_view bytes, std::vector<E
       std::istringstream corners(line.substr(end));
       std::string corner;
       int count = 0;
+      std::vector<int> resolved;  // 0-based
       while (corners >> corner) {
         long long index = 0;
         const std::string problem = parse_obj_corner(corner, index);
@@ -749,8 +763,17 @@ void validate_obj(const std::string& path, std::string_view bytes, std::vector<E
           max_index_line = lines.line_no();
         }
         ++count;
+        if (repeated && resolved.size() < (std::size_t{1} << 16))
+          resolved.push_back(static_cast<int>(index < 0 ? vertices + index : index - 1));
       }
       if (count < 3) fail(path, at_line(lines.line_no()) + "face with fewer than 3 corners");
+      if (repeated && resolved.size() == static_cast<std::size_t>(count)) {  // (longer faces: as read)
+        std::vector<int> sorted = resolved;
+        std::sort(sorted.begin(), sorted.end());
+        if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+          repeated->push_back({faces, std::move(resolved)});
+      }
+      ++faces;
       continue;
     }
     if (keyword != "v") continue;
@@ -766,6 +789,7 @@ void validate_obj(const std::string& path, std::string_view bytes, std::vector<E
     fail(path, at_line(max_index_line) + "face references vertex " + std::to_string(max_index) +
                    ", but the file has " + std::to_string(vertices) + " vertices (OBJ counts from 1)");
   }
+  return faces;
 }
 
 // Whitespace-separated tokens of a text, as `std::istream >> x` sees them, with the line of each.
@@ -1243,9 +1267,11 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
     bytes.remove_prefix(3);
   std::string_view data = bytes;
   std::vector<Eigen::Vector3d> exact;  // OBJ and PLY: the coordinates as written (the reader rounds to float)
+  std::vector<RepeatedCornerFace> repeated;  // OBJ: faces OpenMesh's reader may drop
+  std::size_t obj_faces = 0;
   switch (format) {
     case MeshFormat::kObj:
-      validate_obj(path, bytes, &exact);
+      obj_faces = validate_obj(path, bytes, &exact, &repeated);
       break;
     case MeshFormat::kOff:
       if (bytes.find('#') != std::string_view::npos) {
@@ -1283,6 +1309,45 @@ TriMesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const s
     fail(path, std::string("parse error: ") + e.what());
   }
   if (!ok) fail(path, std::string("cannot parse as a .") + extension_of(format) + " mesh");
+  // OBJ faces with a repeated corner as the file has them: OpenMesh's reader drops each later repeat of a
+  // corner and then the face if fewer than 3 corners are left ("f 1 1 2" lost, "f 1 2 1 3" read as the
+  // triangle 1 2 3, an area the file does not have). Left as the reader gave them if its faces are not
+  // exactly that.
+  if (!repeated.empty()) {
+    auto without_repeats = [](const std::vector<int>& corners) {
+      std::vector<int> kept;
+      std::unordered_set<int> seen;
+      for (int v : corners)
+        if (seen.insert(v).second) kept.push_back(v);
+      return kept;
+    };
+    // First check that the reader's faces are exactly that, then put the file's back in their places.
+    std::size_t next_kept = 0;
+    bool same = true;
+    for (std::size_t f = 0, r = 0; f < obj_faces && same; ++f) {
+      if (r < repeated.size() && repeated[r].ordinal == f) {
+        const std::vector<int> read = without_repeats(repeated[r++].corners);
+        if (read.size() >= 3)  // the reader kept it without its repeats
+          same = next_kept < importer.polygons.size() && importer.polygons[next_kept++] == read;
+      } else {
+        same = next_kept++ < importer.polygons.size();
+      }
+    }
+    if (same && next_kept == importer.polygons.size()) {
+      std::vector<std::vector<int>> merged;
+      merged.reserve(obj_faces);
+      next_kept = 0;
+      for (std::size_t f = 0, r = 0; f < obj_faces; ++f) {
+        if (r < repeated.size() && repeated[r].ordinal == f) {
+          if (without_repeats(repeated[r].corners).size() >= 3) ++next_kept;
+          merged.push_back(std::move(repeated[r++].corners));
+        } else {
+          merged.push_back(std::move(importer.polygons[next_kept++]));
+        }
+      }
+      importer.polygons = std::move(merged);
+    }
+  }
   if (importer.polygons.empty()) fail(path, std::string("no faces found (empty, or not a mesh in .") + extension_of(format) + " format)");
 
   TriMesh mesh;

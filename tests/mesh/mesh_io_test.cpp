@@ -102,6 +102,26 @@ TEST_F(MeshIo, KeepsNonManifoldFacesAsRead) {
   }
 }
 
+TEST_F(MeshIo, FacesWithARepeatedCornerAreReadAsWrittenInEveryFormat) {
+  // OpenMesh's OBJ reader drops "f 1 1 2" and reads "f 1 2 1 3" as the triangle 1 2 3; PLY and OFF keep both
+  // as written. Every format gives the file's faces, in order (fans of the polygons), so that `info` counts
+  // the degenerate ones and `repair` removes them, instead of one format losing a face without a word.
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+  const std::string obj = v + "f 1 2 3\nf 1 1 2\nf 1 2 1 3\nf -4 -2 -1\nf 2 2 2\nf 2 4 3\n";
+  const std::string off =
+      "OFF\n4 6 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 0 1\n4 0 1 0 2\n3 0 2 3\n3 1 1 1\n3 1 3 2\n";
+  const std::vector<std::array<int, 3>> expected = {{0, 1, 2}, {0, 0, 1}, {0, 1, 0}, {0, 0, 2},
+                                                    {0, 2, 3}, {1, 1, 1}, {1, 3, 2}};
+  const TriMesh from_obj = read_mesh(write_text(dir_, "repeat.obj", obj));
+  const TriMesh from_off = read_mesh(write_text(dir_, "repeat.off", off));
+  EXPECT_EQ(from_obj.triangles, expected);
+  EXPECT_EQ(from_off.triangles, expected);
+  EXPECT_EQ(read_mesh(write_mesh_file(dir_, "repeat.ply", from_off)).triangles, expected);
+  EXPECT_EQ(analyze_topology(from_obj).degenerate_faces, 4u);
+  // A file without repeats reads as before (the fan of a polygon, nothing added).
+  EXPECT_EQ(read_mesh(write_text(dir_, "plain.obj", v + "f 1 2 3 4\n")).triangles.size(), 2u);
+}
+
 TEST_F(MeshIo, TriangulatesPolygonsAndReadsStl) {
   const auto quad = write_text(dir_, "quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 1.5 0\nf 1 2 3 5 4\n");
   const TriMesh q = read_mesh(quad);

@@ -3,6 +3,7 @@
 #include "mesh/errors.h"
 #include "mesh/mesh_topology.h"
 #include "mesh/predicates.h"
+#include "param/half_edge_connectivity.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,126 +20,6 @@ namespace geomip {
 namespace {
 
 const char* const kFn = "partition_mesh: ";
-
-// Half-edge h = 3·f + k of triangle f runs from triangles[f][k] to triangles[f][(k+1)%3].
-int he_from(const TriMesh& m, int h) {
-  return m.triangles[h / 3][h % 3];
-}
-int he_to(const TriMesh& m, int h) {
-  return m.triangles[h / 3][(h + 1) % 3];
-}
-
-// Connectivity of a closed, consistently oriented triangle mesh: each half-edge's opposite, and each vertex's
-// outgoing half-edges (CSR). On such a mesh the outgoing half-edges of v reach every neighbour of v once.
-struct Connectivity {
-  std::vector<int> opposite;
-  std::vector<int> out_begin;  // #V + 1
-  std::vector<int> out;
-  std::vector<int> out_to;  // he_to of out[i], beside it: the scans below read contiguous memory
-
-  int find(const TriMesh&, int a, int b) const {  // half-edge a→b or -1
-    for (int i = out_begin[a]; i < out_begin[a + 1]; ++i) {
-      if (out_to[i] == b) return out[i];
-    }
-    return -1;
-  }
-};
-
-// \throw InvalidInput when an edge is not shared by exactly two oppositely oriented triangles.
-Connectivity build_connectivity(const TriMesh& m) {
-  const int nv = static_cast<int>(m.positions.size());
-  const int nh = static_cast<int>(3 * m.triangles.size());
-  Connectivity c;
-  c.out_begin.assign(nv + 1, 0);
-  for (int h = 0; h < nh; ++h) ++c.out_begin[he_from(m, h) + 1];
-  for (int v = 0; v < nv; ++v) c.out_begin[v + 1] += c.out_begin[v];
-  c.out.resize(nh);
-  c.out_to.resize(nh);
-  std::vector<int> fill(c.out_begin.begin(), c.out_begin.end() - 1);
-  for (int h = 0; h < nh; ++h) {
-    const int i = fill[he_from(m, h)]++;
-    c.out[i] = h;
-    c.out_to[i] = he_to(m, h);
-  }
-  c.opposite.assign(nh, -1);
-  // Vertex by vertex: the half-edges a→b out of a, each looked up among b's (contiguous lists).
-  for (int a = 0; a < nv; ++a) {
-    for (int i = c.out_begin[a]; i < c.out_begin[a + 1]; ++i) {
-      const int h = c.out[i], b = c.out_to[i];
-      int found = -1, same_direction = 0;
-      for (int k = c.out_begin[b]; k < c.out_begin[b + 1]; ++k) {
-        if (c.out_to[k] == a) {
-          if (found >= 0) same_direction = 1;
-          found = c.out[k];
-        }
-      }
-      for (int k = c.out_begin[a]; k < c.out_begin[a + 1]; ++k) {
-        if (k != i && c.out_to[k] == b) same_direction = 1;
-      }
-      if (found < 0 || same_direction) {
-        throw InvalidInput(
-            std::string(kFn) + "edge (" + std::to_string(a) + "," + std::to_string(b) +
-            ") is not shared by exactly two oppositely oriented triangles: the triangles must be "
-            "consistently oriented");
-      }
-      c.opposite[h] = found;
-    }
-  }
-  return c;
-}
-
-// Splits every listed edge (each an edge of `m`, whose connectivity is `conn`) at its midpoint; returns the
-// number of vertices appended (in list order). Triangles keep their id for their first piece (other pieces
-// appended, in triangle order) and their orientation; untouched triangles stay as they are. Cost: the split
-// edges' triangles.
-std::size_t split_edges(TriMesh& m, const Connectivity& conn, const std::vector<std::pair<int, int>>& edges) {
-  std::vector<int> he_mid(3 * m.triangles.size(), -1);  // per half-edge: the midpoint of its edge, or -1
-  std::vector<int> affected;
-  std::size_t added = 0;
-  for (const auto& [a, b] : edges) {
-    const int h = conn.find(m, a, b);
-    if (h < 0) throw std::logic_error("split_edges: not an edge of the mesh");
-    if (he_mid[h] >= 0) continue;
-    he_mid[h] = he_mid[conn.opposite[h]] = static_cast<int>(m.positions.size());
-    m.positions.push_back(0.5 * (m.positions[a] + m.positions[b]));
-    affected.push_back(h / 3);
-    affected.push_back(conn.opposite[h] / 3);
-    ++added;
-  }
-  std::sort(affected.begin(), affected.end());
-  affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
-  for (const int fi : affected) {
-    const auto f = static_cast<std::size_t>(fi);
-    const auto t = m.triangles[f];
-    std::array<int, 3> mids;  // mids[k]: midpoint of edge t[k]→t[k+1], or -1
-    int count = 0;
-    for (int k = 0; k < 3; ++k) {
-      mids[k] = he_mid[3 * f + static_cast<std::size_t>(k)];
-      count += mids[k] >= 0;
-    }
-    std::vector<std::array<int, 3>> pieces;
-    if (count == 3) {
-      pieces = {{t[0], mids[0], mids[2]},
-                {mids[0], t[1], mids[1]},
-                {mids[2], mids[1], t[2]},
-                {mids[0], mids[1], mids[2]}};
-    } else {
-      // Rotate so that: one split edge is edge 0 (a→b); two split edges leave edge 2 (c→a) whole.
-      int r = 0;
-      while (count == 1 ? mids[r] < 0 : mids[(r + 2) % 3] >= 0) ++r;
-      const int a = t[r], b = t[(r + 1) % 3], c = t[(r + 2) % 3];
-      const int m0 = mids[r], m1 = mids[(r + 1) % 3];
-      if (count == 1) {
-        pieces = {{a, m0, c}, {m0, b, c}};
-      } else {
-        pieces = {{a, m0, m1}, {m0, b, m1}, {a, m1, c}};
-      }
-    }
-    m.triangles[f] = pieces[0];
-    m.triangles.insert(m.triangles.end(), pieces.begin() + 1, pieces.end());
-  }
-  return added;
-}
 
 // Dijkstra on the edge graph with Euclidean lengths, reusing its arrays between queries.
 class PathTracer {
@@ -458,7 +339,6 @@ class Partitioner {
     const auto list = chords();
     if (list.empty()) return;
     result_.split_vertices += split_edges(result_.mesh, conn_, list);
-    conn_ = build_connectivity(result_.mesh);
     blocked_.resize(result_.mesh.positions.size(), 0);
     mark_cut();
   }

@@ -716,7 +716,6 @@ std::string parse_obj_corner(const std::string& corner, long long& vertex) {
   return "malformed face corner '" + corner.substr(0, 24) + "'";
 }
 
-// `exact` (when not null) gets every vertex's coordinates as written: OpenMesh's reader rounds them to float.
 // An OBJ face whose corners repeat a vertex ("f 1 1 2"), which OpenMesh's reader drops without a word: its
 // 0-based corners and its place among the file's faces, so that read_mesh keeps it as PLY and OFF do (a
 // degenerate triangle that `info` counts and `repair` removes, instead of a face silently lost).
@@ -725,10 +724,12 @@ struct RepeatedCornerFace {
   std::vector<int> corners;
 };
 
-// Returns the number of faces ("f" lines).
+// `exact` (when not null) gets every vertex's coordinates as written: OpenMesh's reader rounds them to float;
+// `repeated` (when not null) the faces with a repeated corner. Returns the number of faces ("f" lines).
 std::size_t validate_obj(const std::string& path, std::string_view bytes, std::vector<Eigen::Vector3d>* exact,
                          std::vector<RepeatedCornerFace>* repeated = nullptr) {
   std::size_t faces = 0;  // "f" lines so far
+  std::vector<int> resolved, sorted;  // one face's 0-based corners (reused from face to face)
   MemoryStream in(bytes);
   LineScanner lines(in, 0);
   std::string line;
@@ -749,7 +750,7 @@ std::size_t validate_obj(const std::string& path, std::string_view bytes, std::v
       std::istringstream corners(line.substr(end));
       std::string corner;
       int count = 0;
-      std::vector<int> resolved;  // 0-based
+      resolved.clear();
       while (corners >> corner) {
         long long index = 0;
         const std::string problem = parse_obj_corner(corner, index);
@@ -768,10 +769,9 @@ std::size_t validate_obj(const std::string& path, std::string_view bytes, std::v
       }
       if (count < 3) fail(path, at_line(lines.line_no()) + "face with fewer than 3 corners");
       if (repeated && resolved.size() == static_cast<std::size_t>(count)) {  // (longer faces: as read)
-        std::vector<int> sorted = resolved;
+        sorted.assign(resolved.begin(), resolved.end());
         std::sort(sorted.begin(), sorted.end());
-        if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
-          repeated->push_back({faces, std::move(resolved)});
+        if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) repeated->push_back({faces, resolved});
       }
       ++faces;
       continue;

@@ -74,10 +74,11 @@ void update_connectivity(const TriMesh& m, Connectivity& conn, const std::vector
   std::vector<char> vertex_changed(nv, 0);
   for (int v = old_nv; v < nv; ++v) vertex_changed[v] = 1;
   for (int v : old_corners) vertex_changed[v] = 1;
-  for (std::size_t f = 0; f < m.triangles.size(); ++f) {
-    if (face_changed[f])
-      for (int v : m.triangles[f]) vertex_changed[v] = 1;
-  }
+  // The changed triangles: the replaced ones, then the appended ones.
+  std::vector<int> changed_faces = affected;
+  for (int f = old_faces; f < static_cast<int>(m.triangles.size()); ++f) changed_faces.push_back(f);
+  for (int f : changed_faces)
+    for (int v : m.triangles[f]) vertex_changed[v] = 1;
   // The new lists of the changed vertices: their old unchanged half-edges and every changed half-edge out of
   // them, ascending.
   std::unordered_map<int, std::vector<int>> lists;
@@ -90,10 +91,9 @@ void update_connectivity(const TriMesh& m, Connectivity& conn, const std::vector
     }
   }
   std::vector<int> changed_half_edges;
-  for (std::size_t f = 0; f < m.triangles.size(); ++f) {
-    if (!face_changed[f]) continue;
+  for (int f : changed_faces) {
     for (int k = 0; k < 3; ++k) {
-      const int h = static_cast<int>(3 * f) + k;
+      const int h = 3 * f + k;
       changed_half_edges.push_back(h);
       lists[he_from(m, h)].push_back(h);
     }

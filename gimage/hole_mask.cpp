@@ -4,6 +4,9 @@
 #include "gimage/surface_distance.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
+#include <utility>
 
 namespace geomip {
 
@@ -39,6 +42,10 @@ HoleMaskResult hole_mask(const ModelParameterization& model, const TriMesh& orig
       const int t = location.triangle[static_cast<std::size_t>(j) * n + i];
       return t >= 0 && fill[first_triangle + static_cast<std::size_t>(t)];
     };
+    std::vector<std::uint8_t> samples(static_cast<std::size_t>(n) * n, 0);
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) samples[static_cast<std::size_t>(j) * n + i] = filled(i, j);
+    }
     std::vector<std::uint8_t> quads(static_cast<std::size_t>(intervals) * intervals, 0);
     for (int j = 0; j < intervals; ++j) {
       for (int i = 0; i < intervals; ++i) {
@@ -49,9 +56,47 @@ HoleMaskResult hole_mask(const ModelParameterization& model, const TriMesh& orig
       }
     }
     result.quads.push_back(std::move(quads));
+    result.fill_samples.push_back(std::move(samples));
     first_triangle += patch.triangles.size();
   }
   return result;
+}
+
+std::size_t snap_hole_borders(GeometryImages& images, const HoleMaskResult& mask, const TriMesh& original) {
+  if (mask.quads.empty() || mask.fill_samples.size() != images.geometry.size()) return 0;
+  using Key = std::array<float, 3>;
+  std::map<Key, Key> moved;  // a sample's position -> its closest point on the original, for every copy
+  for (std::size_t p = 0; p < images.geometry.size(); ++p) {
+    const GeometryImage& image = images.geometry[p];
+    const int n = image.size(), intervals = n - 1;
+    if (mask.fill_samples[p].size() != static_cast<std::size_t>(n) * n ||
+        mask.quads[p].size() != static_cast<std::size_t>(intervals) * intervals)
+      return 0;
+    for (int j = 0; j < intervals; ++j) {
+      for (int i = 0; i < intervals; ++i) {
+        if (mask.quads[p][static_cast<std::size_t>(j) * intervals + i]) continue;
+        for (const auto& [a, b] : {std::pair{i, j}, {i + 1, j}, {i, j + 1}, {i + 1, j + 1}}) {
+          if (!mask.fill_samples[p][static_cast<std::size_t>(b) * n + a]) continue;
+          const float* s = image.at(a, b);
+          moved.emplace(Key{s[0], s[1], s[2]}, Key{s[0], s[1], s[2]});
+        }
+      }
+    }
+  }
+  if (moved.empty()) return 0;
+  const SurfaceQuery query(original);
+  for (auto& [from, to] : moved) {
+    const Eigen::Vector3d point = query.closest(Eigen::Vector3d(from[0], from[1], from[2])).point;
+    to = Key{static_cast<float>(point[0]), static_cast<float>(point[1]), static_cast<float>(point[2])};
+  }
+  for (GeometryImage& image : images.geometry) {
+    for (std::size_t k = 0; k + 2 < image.values.size(); k += 3) {
+      const auto it = moved.find(Key{image.values[k], image.values[k + 1], image.values[k + 2]});
+      if (it == moved.end()) continue;
+      for (int c = 0; c < 3; ++c) image.values[k + c] = it->second[c];
+    }
+  }
+  return moved.size();
 }
 
 }  // namespace geomip

@@ -5,8 +5,9 @@
 // decoded meshes leave out the quads flagged here (the pack stores the mask; it costs a few bytes per hole).
 #pragma once
 
-#include "param/consistent_parameterization.h"
+#include "gimage/resample.h"
 #include "mesh/mesh.h"
+#include "param/consistent_parameterization.h"
 
 #include <cstdint>
 #include <vector>
@@ -27,6 +28,9 @@ struct HoleMaskResult {
   /// Per patch, per quad (i, j) of the level-`level` grid at index j·2^level + i: 1 = at least
   /// min_fill_corners of its corner samples lie in fill triangles. Empty when no triangle is a fill triangle.
   std::vector<std::vector<std::uint8_t>> quads;
+  /// Per patch, per sample (i, j) of the level-`level` grid at index j·(2^level + 1) + i: 1 = the sample lies
+  /// in a fill triangle. Empty when `quads` is.
+  std::vector<std::vector<std::uint8_t>> fill_samples;
   std::size_t fill_triangles = 0;  ///< parameterized triangles found off the original surface
   std::size_t masked_quads = 0;
 };
@@ -37,5 +41,14 @@ struct HoleMaskResult {
 /// \throw InvalidInput for a level outside [0, kMaxGeometryImageLevel] or an original without triangles.
 HoleMaskResult hole_mask(const ModelParameterization& model, const TriMesh& original, int level,
                          const HoleMaskOptions& options = {});
+
+/// Moves every fill sample that is a corner of a kept (unmasked) quad to its closest point on `original`, so
+/// that the faces along a hole's border end on the border instead of hanging over the fill by up to a quad
+/// (on the bunny those faces held a third of the decoded surface's squared distance to the original). Only
+/// samples of the fill move, and those only touch the border's kept quads and masked ones; a sample that
+/// several patches share (a seam) moves in all of them alike, so the seams stay bit-identical.
+/// \pre `mask` came from hole_mask() at the level of `images.geometry` (else nothing moves: returns 0).
+/// \return the number of distinct sample positions moved.
+std::size_t snap_hole_borders(GeometryImages& images, const HoleMaskResult& mask, const TriMesh& original);
 
 }  // namespace geomip

@@ -33,6 +33,7 @@ struct ConvertArgs {
   int quantization_bits = 14;
   int normal_bits = ConvertOptions{}.normal_bits;
   int hole_mask_level = -1;
+  bool no_hole_border_snap = false;
   bool no_normals = false;
   int normal_mesh_steps = ConvertOptions{}.normal_mesh_steps;
   double normal_mesh_reach = ConvertOptions{}.normal_mesh_max_shift;
@@ -165,6 +166,7 @@ int run_convert(const ConvertArgs& args) {
   options.quantization_bits = args.quantization_bits;
   options.normal_bits = args.normal_bits;
   options.hole_mask_level = args.hole_mask_level;
+  options.snap_hole_borders = !args.no_hole_border_snap;
   options.sampling_exponent = args.common.sampling_exponent;
   options.curvature_metric = args.common.curvature_metric;
   options.linf_sweeps = static_cast<std::size_t>(args.common.linf_sweeps);
@@ -310,6 +312,7 @@ int run_convert(const ConvertArgs& args) {
                                 {"layout_choice", relayout_json(relayout_choice)},
                                 {"normals", !args.no_normals},
                                 {"models", j_models},
+                                {"snapped_border_samples", converted.snapped_samples},
                                 {"normal_mesh",
                                  {{"steps", converted.normal_mesh_steps},
                                   {"samples", converted.normal_mesh_candidates},
@@ -402,6 +405,10 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "Grid level in [0, 10] of the mask of filled holes (default: N; coarser costs fewer bytes; "
                   "one above the grid level N is taken as N)")
       ->check(CLI::Range(0, 10));
+  cmd->add_flag(
+      "--no-hole-border-snap", args->no_hole_border_snap,
+      "Leave the fill samples at a hole's border where the fill put them instead of moving them onto "
+      "the original surface (ablations; decoded borders then hang over the hole by up to a quad)");
   cmd->add_flag("--no-normals", args->no_normals, "Geometry-only pack (for rate–distortion comparisons)");
   cmd->add_option(
          "--normal-mesh", args->normal_mesh_steps,

@@ -447,6 +447,8 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
     const bool repaired = m < models.originals.size() && !models.originals[m].triangles.empty();
     if (repaired) mask = hole_mask(params[m], models.originals[m], mask_level);
     if (options.fit) images = fit_images(images, repaired ? models.originals[m] : params[m].mesh, mask, mask_level);
+    if (repaired && options.snap_hole_borders)
+      result.snapped_samples += snap_hole_borders(images, mask, models.originals[m]);
     result.masked_quads.push_back(mask.masked_quads);
     inputs.push_back(pack_model_input(models.inputs[m].name, images, &mask, options.normals));
     inputs.back().hole_mask_level = mask_level;

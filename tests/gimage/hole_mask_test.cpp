@@ -8,6 +8,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <iostream>
+#include <map>
+
 namespace geomip {
 namespace {
 
@@ -65,6 +70,90 @@ TEST(HoleMask, MasksOnlyQuadsOverTheFill) {
   }
   EXPECT_EQ(kept_low, low);
   for (const Eigen::Vector3d& v : masked_corners) EXPECT_GT(v.z(), 0.7);
+}
+
+// The quads a decoder keeps, two triangles each (the mesh a pack decodes to, before quantization).
+TriMesh kept_quads(const GeometryImages& images, const HoleMaskResult& mask) {
+  TriMesh mesh;
+  for (std::size_t p = 0; p < images.geometry.size(); ++p) {
+    const GeometryImage& g = images.geometry[p];
+    const int n = g.size(), q = n - 1;
+    const int first = static_cast<int>(mesh.positions.size());
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) mesh.positions.push_back(g.sample(i, j).cast<double>());
+    }
+    for (int j = 0; j < q; ++j) {
+      for (int i = 0; i < q; ++i) {
+        if (mask.quads[p][static_cast<std::size_t>(j) * q + i]) continue;
+        const int a = first + j * n + i, b = a + 1, c = a + n + 1, d = a + n;
+        mesh.triangles.push_back({a, b, c});
+        mesh.triangles.push_back({a, c, d});
+      }
+    }
+  }
+  return mesh;
+}
+
+// snap_hole_borders(): the kept quads' corners all lie on the open surface afterwards (before, the fill's
+// corners stood off it, so the decoded border hung over the hole), nothing but fill samples moves, copies of
+// one sample (seams) move alike, and the kept surface's largest distance to the open mesh shrinks.
+TEST(HoleMask, SnappedBordersEndOnTheOriginalSurface) {
+  const HoledSphere h = holed_sphere();
+  const ModelParameterization model =
+      parameterize_consistently({test::automatic_input(h.repaired, "holed")}, test::quick_options())[0];
+  const int level = 6;
+  const HoleMaskResult mask = hole_mask(model, h.open, level);
+  ASSERT_EQ(mask.fill_samples.size(), model.patches.size());
+  ResampleOptions no_normals;
+  no_normals.normals = false;
+  const GeometryImages before = resample_geometry(model, level, no_normals);
+  GeometryImages after = before;
+  const std::size_t moved = snap_hole_borders(after, mask, h.open);
+  EXPECT_GT(moved, 0u);
+
+  const int n = (1 << level) + 1, q = n - 1;
+  std::vector<Eigen::Vector3d> corners_before, corners_after;
+  std::map<std::array<float, 3>, std::array<float, 3>> image_of;
+  for (std::size_t p = 0; p < before.geometry.size(); ++p) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3f b = before.geometry[p].sample(i, j), a = after.geometry[p].sample(i, j);
+        if (!mask.fill_samples[p][static_cast<std::size_t>(j) * n + i]) {
+          EXPECT_EQ(a, b) << "a surface sample moved";
+        }
+        const auto [it, fresh] =
+            image_of.emplace(std::array{b.x(), b.y(), b.z()}, std::array{a.x(), a.y(), a.z()});
+        EXPECT_TRUE(fresh || it->second == (std::array{a.x(), a.y(), a.z()}))
+            << "copies of a sample moved apart";
+        bool kept_corner = false;
+        for (int dj = -1; dj <= 0; ++dj) {
+          for (int di = -1; di <= 0; ++di) {
+            const int qi = i + di, qj = j + dj;
+            if (qi >= 0 && qj >= 0 && qi < q && qj < q &&
+                !mask.quads[p][static_cast<std::size_t>(qj) * q + qi])
+              kept_corner = true;
+          }
+        }
+        if (!kept_corner) continue;
+        corners_before.push_back(b.cast<double>());
+        corners_after.push_back(a.cast<double>());
+      }
+    }
+  }
+  const std::vector<double> off_before = distances_to_surface(h.open, corners_before);
+  const std::vector<double> off_after = distances_to_surface(h.open, corners_after);
+  EXPECT_GT(*std::max_element(off_before.begin(), off_before.end()), 1e-3);  // the fill stood off the surface
+  EXPECT_LT(*std::max_element(off_after.begin(), off_after.end()), 1e-6);    // float rounding only
+
+  SurfaceDistanceOptions options;
+  options.face_samples = 200000;
+  const double hanging_before =
+      measure_surface_distance(h.open, kept_quads(before, mask), options).approx_to_original.max;
+  const double hanging_after =
+      measure_surface_distance(h.open, kept_quads(after, mask), options).approx_to_original.max;
+  std::cout << "[ figures  ] kept surface's largest distance to the open sphere " << hanging_before << " -> "
+            << hanging_after << " (" << moved << " border samples moved)\n";
+  EXPECT_LT(hanging_after, 0.5 * hanging_before);
 }
 
 TEST(HoleMask, ClosedMeshHasNoMask) {

@@ -62,6 +62,21 @@ HoleMaskResult hole_mask(const ModelParameterization& model, const TriMesh& orig
   return result;
 }
 
+std::vector<std::vector<std::uint8_t>> refine_hole_quads(const std::vector<std::vector<std::uint8_t>>& quads,
+                                                         int from_level, int to_level) {
+  const int shift = to_level - from_level, n = 1 << to_level, coarse = 1 << from_level;
+  std::vector<std::vector<std::uint8_t>> fine(quads.size(),
+                                              std::vector<std::uint8_t>(static_cast<std::size_t>(n) * n, 0));
+  for (std::size_t p = 0; p < quads.size(); ++p) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i)
+        fine[p][static_cast<std::size_t>(j) * n + i] =
+            quads[p][static_cast<std::size_t>(j >> shift) * coarse + (i >> shift)];
+    }
+  }
+  return fine;
+}
+
 std::size_t snap_hole_borders(GeometryImages& images, const HoleMaskResult& mask, const TriMesh& original) {
   if (mask.quads.empty() || mask.fill_samples.size() != images.geometry.size()) return 0;
   using Key = std::array<float, 3>;

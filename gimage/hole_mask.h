@@ -42,13 +42,20 @@ struct HoleMaskResult {
 HoleMaskResult hole_mask(const ModelParameterization& model, const TriMesh& original, int level,
                          const HoleMaskOptions& options = {});
 
+/// `quads` (per patch, a level-`from_level` quad mask as HoleMaskResult::quads) on the finer level-`to_level`
+/// grid: each fine quad takes the flag of the coarse quad that holds it (what a decoder does with a coarse
+/// mask). \pre from_level ≤ to_level.
+std::vector<std::vector<std::uint8_t>> refine_hole_quads(const std::vector<std::vector<std::uint8_t>>& quads,
+                                                         int from_level, int to_level);
+
 /// Moves every fill sample that is a corner of a kept (unmasked) quad to its closest point on `original`, so
 /// that the faces along a hole's border end on the border instead of hanging over the fill by up to a quad
 /// (on the bunny those faces held a third of the decoded surface's squared distance to the original). Only
 /// samples of the fill move, and those only touch the border's kept quads and masked ones; a sample that
 /// several patches share (a seam) moves in all of them alike, so the seams stay bit-identical.
-/// \pre `mask` came from hole_mask() at the level of `images.geometry` (else nothing moves: returns 0).
-/// \return the number of distinct sample positions moved.
+/// \pre `mask`'s fill_samples and quads are on the grid of `images.geometry` (hole_mask() at that level; for
+/// a coarser mask, its quads through refine_hole_quads()); otherwise nothing moves and 0 is returned. \return
+/// the number of distinct sample positions moved.
 std::size_t snap_hole_borders(GeometryImages& images, const HoleMaskResult& mask, const TriMesh& original);
 
 }  // namespace geomip

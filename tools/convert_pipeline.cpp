@@ -90,17 +90,8 @@ GeometryImages fit_images(const GeometryImages& images, const TriMesh& surface, 
                           int mask_level) {
   FitOptions fit;
   fit.quad_split = QuadSplit::kShorter;  // what `geomip decode` does with a pack
-  if (!mask.quads.empty()) {
-    const int level = images.geometry.front().level, shift = level - mask_level;
-    const int n = 1 << level, coarse = 1 << mask_level;
-    fit.hole_quads.assign(mask.quads.size(), std::vector<std::uint8_t>(static_cast<std::size_t>(n) * n, 0));
-    for (std::size_t p = 0; p < mask.quads.size(); ++p) {
-      for (int j = 0; j < n; ++j) {
-        for (int i = 0; i < n; ++i)
-          fit.hole_quads[p][j * n + i] = mask.quads[p][(j >> shift) * coarse + (i >> shift)];
-      }
-    }
-  }
+  if (!mask.quads.empty())
+    fit.hole_quads = refine_hole_quads(mask.quads, mask_level, images.geometry.front().level);
   return fit_geometry_images(surface, images, fit).images;
 }
 
@@ -447,8 +438,16 @@ ConvertResult convert_models(const PreparedModels& models, const ConvertOptions&
     const bool repaired = m < models.originals.size() && !models.originals[m].triangles.empty();
     if (repaired) mask = hole_mask(params[m], models.originals[m], mask_level);
     if (options.fit) images = fit_images(images, repaired ? models.originals[m] : params[m].mesh, mask, mask_level);
-    if (repaired && options.snap_hole_borders)
-      result.snapped_samples += snap_hole_borders(images, mask, models.originals[m]);
+    if (repaired && options.snap_hole_borders) {
+      // The samples are the geometry's; the quads kept are the decoder's, at the mask's level.
+      if (mask_level == options.level) {
+        result.snapped_samples += snap_hole_borders(images, mask, models.originals[m]);
+      } else if (!mask.quads.empty()) {
+        HoleMaskResult fine = hole_mask(params[m], models.originals[m], options.level);
+        fine.quads = refine_hole_quads(mask.quads, mask_level, options.level);
+        result.snapped_samples += snap_hole_borders(images, fine, models.originals[m]);
+      }
+    }
     result.masked_quads.push_back(mask.masked_quads);
     inputs.push_back(pack_model_input(models.inputs[m].name, images, &mask, options.normals));
     inputs.back().hole_mask_level = mask_level;

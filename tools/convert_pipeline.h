@@ -59,9 +59,10 @@ struct ConvertOptions {
   int hole_mask_level = -1;
   /// Repaired meshes: the fill samples at a hole's border move onto the original surface
   /// (snap_hole_borders(), after the normal-mesh resampling and the fit), so the decoded border ends on the
-  /// hole's rim instead of hanging over the fill. Only with the hole mask at the geometry's level (the
-  /// default). On by default (bunny, means of three jittered copies: +1.61 dB at 32 KB, +0.75 at 16 KB, the
-  /// same below 8.8 KB; docs/codec-v3.md, "Hole borders on the original surface"); false for ablations.
+  /// hole's rim instead of hanging over the fill (with a coarser hole mask: the fill samples of the quads it
+  /// keeps, on the geometry's grid). On by default (bunny, means of three jittered copies: +1.61 dB at 32 KB,
+  /// +0.75 at 16 KB, the same below 8.8 KB; docs/codec-v3.md, "Hole borders on the original surface"); false
+  /// for ablations.
   bool snap_hole_borders = true;
   /// Curvature sampling exponent of the parameterization (SamplingWeightOptions::exponent; 0 = off, the
   /// default here because it costs the codec at low rates; the remeshing commands default to 1/3; README,

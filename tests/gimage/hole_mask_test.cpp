@@ -96,14 +96,31 @@ TriMesh kept_quads(const GeometryImages& images, const HoleMaskResult& mask) {
 
 // snap_hole_borders(): the kept quads' corners all lie on the open surface afterwards (before, the fill's
 // corners stood off it, so the decoded border hung over the hole), nothing but fill samples moves, copies of
-// one sample (seams) move alike, and the kept surface's largest distance to the open mesh shrinks.
-TEST(HoleMask, SnappedBordersEndOnTheOriginalSurface) {
+// one sample (seams) move alike, and the kept surface's largest distance to the open mesh shrinks. With the
+// mask at the grid's level, and with a mask one level coarser (what `convert --hole-mask-level` stores),
+// whose quads a decoder applies to the finer grid (refine_hole_quads()).
+class SnapHoleBorders : public ::testing::TestWithParam<int> {};
+
+TEST_P(SnapHoleBorders, KeptQuadsEndOnTheOriginalSurface) {
   const HoledSphere h = holed_sphere();
   const ModelParameterization model =
       parameterize_consistently({test::automatic_input(h.repaired, "holed")}, test::quick_options())[0];
-  const int level = 6;
-  const HoleMaskResult mask = hole_mask(model, h.open, level);
+  const int level = 6, mask_level = GetParam();
+  HoleMaskResult mask = hole_mask(model, h.open, level);
   ASSERT_EQ(mask.fill_samples.size(), model.patches.size());
+  if (mask_level < level) {
+    const HoleMaskResult coarse = hole_mask(model, h.open, mask_level);
+    mask.quads = refine_hole_quads(coarse.quads, mask_level, level);
+    for (std::size_t p = 0; p < mask.quads.size(); ++p) {  // each fine quad carries its coarse quad's flag
+      for (int j = 0; j < (1 << level); ++j) {
+        for (int i = 0; i < (1 << level); ++i) {
+          ASSERT_EQ(mask.quads[p][static_cast<std::size_t>(j) * (1 << level) + i],
+                    coarse.quads[p][static_cast<std::size_t>(j >> (level - mask_level)) * (1 << mask_level) +
+                                    (i >> (level - mask_level))]);
+        }
+      }
+    }
+  }
   ResampleOptions no_normals;
   no_normals.normals = false;
   const GeometryImages before = resample_geometry(model, level, no_normals);
@@ -155,6 +172,8 @@ TEST(HoleMask, SnappedBordersEndOnTheOriginalSurface) {
             << hanging_after << " (" << moved << " border samples moved)\n";
   EXPECT_LT(hanging_after, 0.5 * hanging_before);
 }
+
+INSTANTIATE_TEST_SUITE_P(MaskLevels, SnapHoleBorders, ::testing::Values(6, 5));
 
 TEST(HoleMask, ClosedMeshHasNoMask) {
   const ModelParameterization& model = test::parameterized("sphere");

@@ -1,8 +1,10 @@
-// hole_mask(): quads over a filled hole are found, and only those.
+// hole_mask(): quads over a filled hole are found, and only those; snap_hole_borders(): kept quads end on the
+// original surface.
 #include "gimage/hole_mask.h"
 
 #include "gimage/resample.h"
 #include "gimage/surface_distance.h"
+#include "gimage/uniform_remesh.h"
 #include "mesh/mesh_repair.h"
 #include "tests/gimage/gimage_fixtures.h"
 
@@ -72,23 +74,18 @@ TEST(HoleMask, MasksOnlyQuadsOverTheFill) {
   for (const Eigen::Vector3d& v : masked_corners) EXPECT_GT(v.z(), 0.7);
 }
 
-// The quads a decoder keeps, two triangles each (the mesh a pack decodes to, before quantization).
+// The quads a decoder keeps: the level-N uniform remesh (seams welded) without the masked quads' triangles.
 TriMesh kept_quads(const GeometryImages& images, const HoleMaskResult& mask) {
+  const int level = images.geometry.front().level, q = 1 << level;
+  const TriMesh remesh = uniform_remesh(images, level).mesh;
   TriMesh mesh;
-  for (std::size_t p = 0; p < images.geometry.size(); ++p) {
-    const GeometryImage& g = images.geometry[p];
-    const int n = g.size(), q = n - 1;
-    const int first = static_cast<int>(mesh.positions.size());
-    for (int j = 0; j < n; ++j) {
-      for (int i = 0; i < n; ++i) mesh.positions.push_back(g.sample(i, j).cast<double>());
-    }
-    for (int j = 0; j < q; ++j) {
-      for (int i = 0; i < q; ++i) {
-        if (mask.quads[p][static_cast<std::size_t>(j) * q + i]) continue;
-        const int a = first + j * n + i, b = a + 1, c = a + n + 1, d = a + n;
-        mesh.triangles.push_back({a, b, c});
-        mesh.triangles.push_back({a, c, d});
-      }
+  mesh.positions = remesh.positions;
+  for (std::size_t p = 0; p < mask.quads.size(); ++p) {
+    for (std::size_t k = 0; k < mask.quads[p].size(); ++k) {
+      if (mask.quads[p][k]) continue;
+      const std::size_t quad = p * static_cast<std::size_t>(q) * q + k;  // triangles 2·quad and 2·quad + 1
+      mesh.triangles.push_back(remesh.triangles[2 * quad]);
+      mesh.triangles.push_back(remesh.triangles[2 * quad + 1]);
     }
   }
   return mesh;

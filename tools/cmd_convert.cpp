@@ -4,6 +4,7 @@
 #include "codec/pack.h"
 #include "gimage/surface_distance.h"
 #include "mesh/errors.h"
+#include "mesh/mesh_io.h"
 #include "tools/atomic_file.h"
 #include "tools/commands.h"
 #include "tools/convert_pipeline.h"
@@ -48,6 +49,7 @@ struct ConvertArgs {
   bool short_filter = false;
   int threads = 0;  ///< --threads: the layout choice's (0 = one per hardware thread)
   bool fit = false;
+  bool fit_given = false;    ///< --fit or --no-fit on the command line (else fit_by_default())
   bool choose_loop = false;  ///< --choose-loop: the plain, tip or end loop, whichever prefixes are closest
   bool search =
       false;       ///< --search: the loops, the 8- to 64-patch layouts, the fit, ... (tools/convert_search.h)
@@ -125,10 +127,10 @@ int run_convert(const ConvertArgs& args) {
                        "without --points, --patches, --tip-loop or --end-loop");
   if (args.search && (args.choose_loop || args.common.meshes.size() != 1 || !args.common.points.empty() ||
                       args.common.patches != 2 || args.common.layout_error_weights_given ||
-                      loop_asked != LoopKind::kPlain || args.fit))
+                      loop_asked != LoopKind::kPlain || args.fit_given))
     throw InvalidInput(
         "--search chooses the layout and the fit of one mesh itself: give one MESH, without "
-        "--points, --patches, --layout-error-weights, --tip-loop, --end-loop, --fit or "
+        "--points, --patches, --layout-error-weights, --tip-loop, --end-loop, --fit, --no-fit or "
         "--choose-loop");
   const bool report = !args.common.quiet && !args.common.json;
   const auto t_start = std::chrono::steady_clock::now();
@@ -180,7 +182,15 @@ int run_convert(const ConvertArgs& args) {
   options.lifting_update = !args.no_lifting_update;
   options.cell_frames = !args.no_cell_frames;
   if (args.short_filter) options.filter = codec::WaveletFilter::kCubic;
-  options.fit = args.fit;
+  // The fit: as asked, else fit_by_default() (--search tries it itself; --choose-loop's loops are two
+  // squares of the mesh, so the mesh's faces decide).
+  if (args.fit_given)
+    options.fit = args.fit;
+  else if (args.choose_loop)
+    options.fit = read_mesh(args.common.meshes.front()).triangles.size() <= kDefaultFitMaxFaces;
+  else if (!args.search)
+    options.fit = fit_by_default(models);
+  if (!args.fit_given) options.fit_moved_layouts = false;
   options.up = up;
   options.front = front;
   options.progress = bar.callback();
@@ -286,6 +296,7 @@ int run_convert(const ConvertArgs& args) {
     if (searched->chosen.patches == 2)
       loop = searched->chosen.loop == LoopKind::kTips ? "tips" : searched->chosen.loop == LoopKind::kEnds ? "ends" : "plain";
   }
+  const bool fitted = searched ? searched->chosen.fit : options.fit;  // the pack's samples
   const std::vector<std::uint8_t>& pack = converted.pack;
   write_file_atomically(args.common.output, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(pack.data()), static_cast<std::streamsize>(pack.size()));
@@ -309,6 +320,7 @@ int run_convert(const ConvertArgs& args) {
                                 {"level", level},
                                 {"patches", info.models.front().geometry.num_patches},
                                 {"moved_to_patches", relayouted},
+                                {"fit", fitted},
                                 {"layout_choice", relayout_json(relayout_choice)},
                                 {"normals", !args.no_normals},
                                 {"models", j_models},
@@ -339,9 +351,10 @@ int run_convert(const ConvertArgs& args) {
                      .dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
   } else if (report) {
-    std::printf("convert %zu model(s) → %s: %zu bytes (header and manifest %zu, %zu chunks), level %d%s\n",
+    std::printf("convert %zu model(s) → %s: %zu bytes (header and manifest %zu, %zu chunks), level %d%s%s\n",
                 models.inputs.size(), args.common.output.c_str(), pack.size(), info.manifest_end,
-                info.chunks.size(), level, args.no_normals ? ", geometry only" : ", with normal maps");
+                info.chunks.size(), level, args.no_normals ? ", geometry only" : ", with normal maps",
+                fitted ? ", samples fitted (--no-fit: on the surface)" : "");
     std::printf("parameterization %.2f s, resampling %.2f s, encoding %.2f s\n", converted.param_seconds,
                 converted.resample_seconds, converted.encode_seconds);
     // The note points at more patches; not when convert tried them and none fits this mesh.
@@ -424,10 +437,13 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "Normal-mesh steps from STEP up (the coarser ones) refuse a move that would fold their grid "
                   "around the sample (default 3; 0 = none, 1 = every step)")
       ->check(CLI::Range(0, 10));
-  cmd->add_flag("--fit,!--no-fit", args->fit,
-                "Move every level-N sample along its normal so that the level-N remesh is a least-squares fit of "
-                "the surface, not its interpolant (gimage/fit.h, after the normal-mesh resampling; hole-mask "
-                "quads left out); --no-fit: samples on the surface (default)");
+  CLI::Option* fit = cmd->add_flag(
+      "--fit,!--no-fit", args->fit,
+      "Move every level-N sample along its normal so that the level-N remesh is a least-squares fit of the "
+      "surface, not its interpolant (gimage/fit.h, after the normal-mesh resampling; hole-mask quads left "
+      "out; about 6x the time); --no-fit: samples on the surface. Default: fitted for one mesh of up to "
+      "500,000 faces on two squares, not on K-patch layouts (a stretched shape moved to 16 or 64 patches "
+      "included) nor for consistent sets");
   // Codec tools, for ablations (docs/codec-v3.md); the defaults are the codec's best measured.
   CLI::Option* frame_steps =
       cmd->add_option("--frame-steps", args->frame_steps,
@@ -481,10 +497,11 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "camera): +x, -x, +y, -y, +z or -z, across the up axis. Default: from the first model's "
                   "shape (docs/streaming.md, \"Upright and front\")")
       ->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
-  return [args, level, frame_steps, normal_bits] {
+  return [args, level, frame_steps, normal_bits, fit] {
     args->level_given = level->count() > 0;
     args->frame_steps_given = frame_steps->count() > 0;
     args->normal_bits_given = normal_bits->count() > 0;
+    args->fit_given = fit->count() > 0;
     return run_convert(*args);
   };
 }

@@ -66,6 +66,7 @@ struct RdArgs {
   std::vector<double> layout_error_weights = {1.0};  // geomip: --layout-error-weights
   bool layout_error_weights_given = false;  // (else a stretched shape tries kStretchedLayoutErrorWeights)
   bool fit = false;         // geomip: least-squares fitted samples (--fit, as `geomip convert`)
+  bool fit_given = false;   // --fit or --no-fit given (else fit_by_default(), as `geomip convert`)
   bool tip_loop = false;    // geomip: the two-square loop through the tips (--tip-loop, as `geomip convert`)
   bool end_loop = false;    // geomip: the loop through the ends (--end-loop, as `geomip convert`)
   bool search = false;  // geomip: the best of the loops, the 8- to 64-patch layouts, the fit, ... (--search)
@@ -223,7 +224,8 @@ Series geomip_series(const RdArgs& args, LoopKind loop, bool relayout, std::vect
   options.level = level;
   options.normals = false;
   options.normal_mesh_steps = normal_mesh_steps;
-  options.fit = args.fit;
+  options.fit = args.fit;  // --search: the search tries the fit itself
+  if (!args.fit_given) options.fit_moved_layouts = false;
   options.threads = static_cast<int>(args.threads);
   options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
   std::shared_ptr<const std::vector<std::uint8_t>> pack;
@@ -233,6 +235,7 @@ Series geomip_series(const RdArgs& args, LoopKind loop, bool relayout, std::vect
   } else {
     PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, args.patches, loop,
                                            args.equal_area_layout, args.layout_error_weights);
+    if (!args.fit_given) options.fit = fit_by_default(models);  // as `geomip convert`
     ConvertResult converted = convert_relayout_when_stretched(
         models, options,
         [&](int k, std::string& why_not) {
@@ -333,10 +336,10 @@ int run_rd(const RdArgs& args) {
   check_loop_patches(loop, args.patches);
   check_output_directory(args.output);
   if (args.search &&
-      (args.patches != 2 || args.layout_error_weights_given || loop != LoopKind::kPlain || args.fit))
+      (args.patches != 2 || args.layout_error_weights_given || loop != LoopKind::kPlain || args.fit_given))
     throw InvalidInput(
         "--search chooses the layout and the fit itself: not with --patches, "
-        "--layout-error-weights, --tip-loop, --end-loop or --fit");
+        "--layout-error-weights, --tip-loop, --end-loop, --fit or --no-fit");
   const auto start = std::chrono::steady_clock::now();
   note_input_file(args.mesh);
   const auto original = std::make_shared<const TriMesh>(read_mesh(args.mesh));
@@ -575,9 +578,11 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_option("--normal-mesh", args->normal_mesh_steps,
                   "geomip: normal-mesh resampling of the finest STEPS wavelet steps (as `geomip convert`; 0 = off)")
       ->check(CLI::Range(0, 10));
-  cmd->add_flag("--fit,!--no-fit", args->fit,
-                "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip "
-                "convert --fit`; slower: about 30 s at level 8); --no-fit: samples on the surface (default)");
+  CLI::Option* fit = cmd->add_flag(
+      "--fit,!--no-fit", args->fit,
+      "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip convert "
+      "--fit`; about 6x the conversion time); --no-fit: samples on the surface. Default as `geomip "
+      "convert`: fitted for one mesh of up to 500,000 faces on two squares, not on K-patch layouts");
   add_patches_option(cmd, args->patches, args->patches_given, args->equal_area_layout,
                      args->layout_error_weights, args->layout_error_weights_given);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");
@@ -586,8 +591,9 @@ CommandRunner add_rd_command(CLI::App& app) {
                 "geomip: the pack `geomip convert --search` keeps (the loops, the 8- to 64-patch layouts at "
                 "about the same samples, then the best with --fit, the L-infinity pass and more framed "
                 "steps; scored on 1.5-32 KB prefixes)");
-  return [args, level] {
+  return [args, level, fit] {
     if (level->count() == 0) args->level = default_grid_level(static_cast<std::size_t>(args->patches));
+    args->fit_given = fit->count() > 0;
     return run_rd(*args);
   };
 }

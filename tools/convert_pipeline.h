@@ -87,10 +87,14 @@ struct ConvertOptions {
   /// Normal-mesh steps from this one up refuse moves that fold their grid
   /// (NormalMeshOptions::fold_guard_from_step; 0 = none).
   int normal_mesh_fold_guard = codec::NormalMeshOptions{}.fold_guard_from_step;
-  /// Least-squares fitted samples (gimage/fit.h), after the normal-mesh resampling: the level-N remesh fits the
-  /// surface (the mesh before repair, the hole mask's quads left out) instead of interpolating it. Any number of
-  /// models (offsets along the normals keep the correspondences).
+  /// Least-squares fitted samples (gimage/fit.h), after the normal-mesh resampling: the level-N remesh fits
+  /// the surface (the mesh before repair, the hole mask's quads left out) instead of interpolating it. Any
+  /// number of models (offsets along the normals keep the correspondences). `geomip convert` and `geomip rd`
+  /// turn it on by default where fit_by_default() says so.
   bool fit = false;
+  /// The fit of the layouts convert_relayout_when_stretched() moves a stretched shape to; nullopt: `fit`.
+  /// `geomip convert` and `geomip rd` leave them unfitted unless --fit is given (fit_by_default()).
+  std::optional<bool> fit_moved_layouts;
   /// The viewer's frame stored as each model's normalization (codec::PackModelInfo::normalization): the up
   /// axis (kAuto: from the first model's shape) and front of the first model (upright_rotation()), one
   /// rotation for every model of the pack alike (a consistent set keeps one pose), then each model's rotated
@@ -130,6 +134,20 @@ struct ConvertResult {
   /// ConvertOptions::stop_when_stretched applied: the parameterization only, `pack` empty.
   bool stopped_stretched = false;
 };
+
+/// Meshes of more faces than this are not fitted by default (fit_by_default()): the fit's closest-point
+/// queries grow with the mesh, and a million faces (`scripts/bench-scale`, issue #15's 60 s and 2 GB) would
+/// take about 40 s and 0.3–0.5 GB more (igea, 268,686 faces: 20.9 → 62.0 s, 404 → 666 MB on 2 busy cores).
+inline constexpr std::size_t kDefaultFitMaxFaces = 500'000;
+
+/// Whether `geomip convert` and `geomip rd` fit the samples (ConvertOptions::fit) when neither --fit nor
+/// --no-fit is given: for one mesh of at most kDefaultFitMaxFaces faces on the automatic two squares (or the
+/// genus-1 layout: no K-quad layout), not on K-quad layouts (--patches K, or the 16 or 64 patches a stretched
+/// shape moves to) nor for consistent sets. Measured (docs/codec-v3.md, "The fit by default on two squares"):
+/// since the hole borders are snapped onto the original surface, the fit raises the 16 and 32 KB prefixes of
+/// two-square packs (means of three jittered copies: bunny +0.15 / +0.45 dB, venus +0.50 / +1.06) and leaves
+/// the smaller ones within ±0.03 dB, for about 6× the conversion time (bunny 3.2 → 18.8 s, 87 → 533 MB).
+bool fit_by_default(const PreparedModels& models);
 
 /// From this L2 stretch of a model's two squares up, `geomip convert` and `geomip rd` move the mesh to
 /// more patches (kStretchedShapeLayouts) when --patches is not given (convert_relayout_when_stretched()). The

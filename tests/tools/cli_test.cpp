@@ -1492,14 +1492,17 @@ TEST_F(CliPack, NormalBitsQuantizeTheNormalMaps) {
 
 // convert --fit: the whole pack decodes closer to the mesh (symmetric RMS; the ratio measured:
 // docs/measurements.md, "Fitted geometry images"), and with `decode --quad-split fixed` to the same faces as
-// without it (the default split follows the decoded samples); --fit=x exits 2 with one line.
+// without it (the default split follows the decoded samples); --fit=x exits 2 with one line. The default
+// (fit_by_default()): one mesh on two squares is fitted, a K-patch layout is not.
 TEST_F(CliPack, FitDecodesCloserToTheMesh) {
   const TriMesh original = read_mesh(spot_);
   std::vector<TriMesh> decoded, fixed;
+  std::vector<std::string> bytes;
   for (const char* fit : {"--fit", "--no-fit"}) {
     const std::string pack = dir_ + "/fit.gip", obj = dir_ + "/fit.obj", fixed_obj = dir_ + "/fit-fixed.obj";
     const Outcome c = geomip("convert -q '" + spot_ + "' --level 5 --no-normals " + fit + " -o '" + pack + "'");
     ASSERT_EQ(c.exit_code, 0) << c.err;
+    bytes.push_back(slurp(pack));
     const Outcome d = geomip("decode -q '" + pack + "' -o '" + obj + "'");
     ASSERT_EQ(d.exit_code, 0) << d.err;
     decoded.push_back(read_mesh(obj));
@@ -1513,6 +1516,23 @@ TEST_F(CliPack, FitDecodesCloserToTheMesh) {
       measure_surface_distance(original, decoded[0]).rms / measure_surface_distance(original, decoded[1]).rms;
   RecordProperty("spot_rms_ratio", std::to_string(ratio));
   EXPECT_LT(ratio, 0.85);
+  ASSERT_NE(bytes[0], bytes[1]);
+  const Outcome d =
+      geomip("convert --json -q '" + spot_ + "' --level 5 --no-normals -o '" + dir_ + "/d.gip'");
+  ASSERT_EQ(d.exit_code, 0) << d.err;
+  EXPECT_TRUE(nlohmann::json::parse(d.out)["fit"].get<bool>());
+  EXPECT_EQ(slurp(dir_ + "/d.gip"), bytes[0]);  // two squares: fitted by default
+  std::vector<std::string> k_patches;
+  for (const char* fit : {"", "--no-fit", "--fit"}) {
+    const std::string pack = dir_ + "/k" + std::to_string(k_patches.size()) + ".gip";
+    const Outcome c = geomip("convert --json -q '" + spot_ + "' --patches 6 --level 4 --no-normals " + fit +
+                             " -o '" + pack + "'");
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    EXPECT_EQ(nlohmann::json::parse(c.out)["fit"].get<bool>(), std::string(fit) == "--fit") << fit;
+    k_patches.push_back(slurp(pack));
+  }
+  EXPECT_EQ(k_patches[0], k_patches[1]);  // K patches: not fitted by default
+  EXPECT_NE(k_patches[0], k_patches[2]);
   const Outcome bad = geomip("convert -q '" + spot_ + "' --level 3 --fit=x -o '" + dir_ + "/bad.gip'");
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;

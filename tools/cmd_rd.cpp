@@ -225,7 +225,6 @@ Series geomip_series(const RdArgs& args, LoopKind loop, bool relayout, std::vect
   options.normals = false;
   options.normal_mesh_steps = normal_mesh_steps;
   options.fit = args.fit;  // --search: the search tries the fit itself
-  if (!args.fit_given) options.fit_moved_layouts = false;
   options.threads = static_cast<int>(args.threads);
   options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
   std::shared_ptr<const std::vector<std::uint8_t>> pack;
@@ -581,8 +580,8 @@ CommandRunner add_rd_command(CLI::App& app) {
   CLI::Option* fit = cmd->add_flag(
       "--fit,!--no-fit", args->fit,
       "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip convert "
-      "--fit`; about 6x the conversion time); --no-fit: samples on the surface. Default as `geomip "
-      "convert`: fitted for one mesh of up to 500,000 faces on two squares, not on K-patch layouts");
+      "--fit`; several times the conversion time); --no-fit: samples on the surface. Default as `geomip "
+      "convert`: fitted for meshes of up to 500,000 faces");
   add_patches_option(cmd, args->patches, args->patches_given, args->equal_area_layout,
                      args->layout_error_weights, args->layout_error_weights_given);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");

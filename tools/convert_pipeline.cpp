@@ -305,7 +305,6 @@ ConvertResult convert_relayout_when_stretched(
       Built b{std::move(*layouts[i]), options, {}, {}};
       layouts[i].reset();
       b.options.level = c.level;
-      b.options.fit = options.fit_moved_layouts.value_or(options.fit);
       b.options.keep_inputs = true;  // the geometry-only pack is encoded again from them
       if (options.progress) {
         // One bar over all layouts: the conversions fill 0.9 of it, each named after its layout; the
@@ -390,8 +389,7 @@ ConvertResult convert_relayout_when_stretched(
 }
 
 bool fit_by_default(const PreparedModels& models) {
-  return models.inputs.size() == 1 && models.inputs.front().layout_quads.empty() &&
-         models.inputs.front().mesh.triangles.size() <= kDefaultFitMaxFaces;
+  return models.inputs.size() == 1 && models.inputs.front().mesh.triangles.size() <= kDefaultFitMaxFaces;
 }
 
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options) {

@@ -92,9 +92,6 @@ struct ConvertOptions {
   /// number of models (offsets along the normals keep the correspondences). `geomip convert` and `geomip rd`
   /// turn it on by default where fit_by_default() says so.
   bool fit = false;
-  /// The fit of the layouts convert_relayout_when_stretched() moves a stretched shape to; nullopt: `fit`.
-  /// `geomip convert` and `geomip rd` leave them unfitted unless --fit is given (fit_by_default()).
-  std::optional<bool> fit_moved_layouts;
   /// The viewer's frame stored as each model's normalization (codec::PackModelInfo::normalization): the up
   /// axis (kAuto: from the first model's shape) and front of the first model (upright_rotation()), one
   /// rotation for every model of the pack alike (a consistent set keeps one pose), then each model's rotated
@@ -141,12 +138,12 @@ struct ConvertResult {
 inline constexpr std::size_t kDefaultFitMaxFaces = 500'000;
 
 /// Whether `geomip convert` and `geomip rd` fit the samples (ConvertOptions::fit) when neither --fit nor
-/// --no-fit is given: for one mesh of at most kDefaultFitMaxFaces faces on the automatic two squares (or the
-/// genus-1 layout: no K-quad layout), not on K-quad layouts (--patches K, or the 16 or 64 patches a stretched
-/// shape moves to) nor for consistent sets. Measured (docs/codec-v3.md, "The fit by default on two squares"):
-/// since the hole borders are snapped onto the original surface, the fit raises the 16 and 32 KB prefixes of
-/// two-square packs (means of three jittered copies: bunny +0.15 / +0.45 dB, venus +0.50 / +1.06) and leaves
-/// the smaller ones within ±0.03 dB, for about 6× the conversion time (bunny 3.2 → 18.8 s, 87 → 533 MB).
+/// --no-fit is given: for one mesh of at most kDefaultFitMaxFaces faces, on any layout (a stretched shape's
+/// candidate layouts are fitted before they are measured); not for consistent sets (not measured). Measured
+/// (docs/codec-v3.md, "The fit by default"): since the hole borders are snapped onto the original surface,
+/// the fit raises the 16 and 32 KB prefixes (means of three jittered copies: bunny +0.15 / +0.45 dB, venus
+/// +0.50 / +1.06, horse +0.33 / +0.45) and moves the smaller ones by −0.02…+0.10 dB, for several times the
+/// conversion time (bunny 3.2 → 18.8 s, 87 → 533 MB).
 bool fit_by_default(const PreparedModels& models);
 
 /// From this L2 stretch of a model's two squares up, `geomip convert` and `geomip rd` move the mesh to

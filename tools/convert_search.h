@@ -58,8 +58,8 @@ struct SearchCandidate {
   /// " + fit" when fitted, then " + L∞ pass" with linf_sweeps, then " + frame steps N" when not the default.
   std::string name(int default_level) const;
   /// The switches of `geomip convert` that build this candidate ("--end-loop --fit", "--patches 8 --level
-  /// 7", "--tip-loop --fit --linf-sweeps 1000", "--patches 2 --fit", "--no-fit"): the fit named on two
-  /// squares (whose default depends on the mesh, fit_by_default()), and on K patches when fitted.
+  /// 7 --no-fit", "--tip-loop --fit --linf-sweeps 1000", "--patches 2 --fit", "--no-fit"): the fit always
+  /// named, since its default depends on the mesh (fit_by_default()).
   std::string switches(int default_level) const;
 };
 

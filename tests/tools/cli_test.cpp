@@ -1408,7 +1408,8 @@ TEST_F(CliPack, NormalMeshRefusedForSeveralMeshes) {
 // half a quantization step per coordinate of the level-N remesh's (same parameterization, same samples);
 // with the default frames the rotation rounds (about a step per coordinate), which this bound does not allow.
 // Both commands are given the same curvature metric (convert's default is not remesh's), so the same
-// parameterization. Out-of-range switches: exit 2, one line, no pack.
+// parameterization, and convert --no-fit (samples on the surface, as remesh's). Out-of-range switches: exit
+// 2, one line, no pack.
 TEST_F(CliPack, CodecSwitchesForAblations) {
   Outcome r = geomip("remesh --quiet '" + spot_ +
                      "' --level 4 --sampling-exponent 0 --curvature-metric 0.03 -o '" + dir_ + "/m'");
@@ -1418,9 +1419,9 @@ TEST_F(CliPack, CodecSwitchesForAblations) {
   const double step = (box.max - box.min).maxCoeff() / 16384.0;  // 14 bits over the largest extent
   const auto largest_offset_in_steps = [&](const std::string& switches) {
     const std::string pack = dir_ + "/ablation.gip";
-    const Outcome c =
-        geomip("convert -q '" + spot_ + "' --level 4 --no-normals --normal-mesh 0 --curvature-metric 0.03 " +
-               switches + " -o '" + pack + "'");
+    const Outcome c = geomip("convert -q '" + spot_ +
+                             "' --level 4 --no-normals --normal-mesh 0 --no-fit --curvature-metric 0.03 " +
+                             switches + " -o '" + pack + "'");
     EXPECT_EQ(c.exit_code, 0) << c.err;
     const Outcome d = geomip("decode -q --no-untangle '" + pack + "' -o '" + dir_ + "/ablation.obj'");
     EXPECT_EQ(d.exit_code, 0) << d.err;
@@ -1493,7 +1494,7 @@ TEST_F(CliPack, NormalBitsQuantizeTheNormalMaps) {
 // convert --fit: the whole pack decodes closer to the mesh (symmetric RMS; the ratio measured:
 // docs/measurements.md, "Fitted geometry images"), and with `decode --quad-split fixed` to the same faces as
 // without it (the default split follows the decoded samples); --fit=x exits 2 with one line. The default
-// (fit_by_default()): one mesh on two squares is fitted, a K-patch layout is not.
+// (fit_by_default()): one mesh is fitted, on two squares and on a K-patch layout; a consistent set is not.
 TEST_F(CliPack, FitDecodesCloserToTheMesh) {
   const TriMesh original = read_mesh(spot_);
   std::vector<TriMesh> decoded, fixed;
@@ -1528,11 +1529,15 @@ TEST_F(CliPack, FitDecodesCloserToTheMesh) {
     const Outcome c = geomip("convert --json -q '" + spot_ + "' --patches 6 --level 4 --no-normals " + fit +
                              " -o '" + pack + "'");
     ASSERT_EQ(c.exit_code, 0) << c.err;
-    EXPECT_EQ(nlohmann::json::parse(c.out)["fit"].get<bool>(), std::string(fit) == "--fit") << fit;
+    EXPECT_EQ(nlohmann::json::parse(c.out)["fit"].get<bool>(), std::string(fit) != "--no-fit") << fit;
     k_patches.push_back(slurp(pack));
   }
-  EXPECT_EQ(k_patches[0], k_patches[1]);  // K patches: not fitted by default
-  EXPECT_NE(k_patches[0], k_patches[2]);
+  EXPECT_EQ(k_patches[0], k_patches[2]);  // K patches: fitted by default too
+  EXPECT_NE(k_patches[0], k_patches[1]);
+  const Outcome set = geomip("convert --json -q --points '" + sphere_pair() +
+                             "' --level 3 --no-normals -o '" + dir_ + "/set.gip'");
+  ASSERT_EQ(set.exit_code, 0) << set.err;
+  EXPECT_FALSE(nlohmann::json::parse(set.out)["fit"].get<bool>());  // a consistent set: not by default
   const Outcome bad = geomip("convert -q '" + spot_ + "' --level 3 --fit=x -o '" + dir_ + "/bad.gip'");
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;

@@ -187,7 +187,7 @@ int run_convert(const ConvertArgs& args) {
   if (args.fit_given)
     options.fit = args.fit;
   else if (args.choose_loop)
-    options.fit = read_mesh(args.common.meshes.front()).triangles.size() <= kDefaultFitMaxFaces;
+    options.fit = fit_by_default(1, read_mesh(args.common.meshes.front()).triangles.size());
   else if (!args.search)
     options.fit = fit_by_default(models);
   options.up = up;
@@ -441,7 +441,8 @@ CommandRunner add_convert_command(CLI::App& app) {
       "Move every level-N sample along its normal so that the level-N remesh is a least-squares fit of the "
       "surface, not its interpolant (gimage/fit.h, after the normal-mesh resampling; hole-mask quads left "
       "out; several times the conversion time); --no-fit: samples on the surface. Default: fitted for one "
-      "mesh of up to 500,000 faces, not for consistent sets");
+      "mesh of up to " +
+          default_fit_max_faces_text() + " faces, not for consistent sets");
   // Codec tools, for ablations (docs/codec-v3.md); the defaults are the codec's best measured.
   CLI::Option* frame_steps =
       cmd->add_option("--frame-steps", args->frame_steps,

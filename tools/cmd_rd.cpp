@@ -581,7 +581,8 @@ CommandRunner add_rd_command(CLI::App& app) {
       "--fit,!--no-fit", args->fit,
       "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip convert "
       "--fit`; several times the conversion time); --no-fit: samples on the surface. Default as `geomip "
-      "convert`: fitted for meshes of up to 500,000 faces");
+      "convert`: fitted for meshes of up to " +
+          default_fit_max_faces_text() + " faces");
   add_patches_option(cmd, args->patches, args->patches_given, args->equal_area_layout,
                      args->layout_error_weights, args->layout_error_weights_given);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");

@@ -388,8 +388,22 @@ ConvertResult convert_relayout_when_stretched(
   return result;
 }
 
+bool fit_by_default(std::size_t model_count, std::size_t faces) {
+  return model_count == 1 && faces <= kDefaultFitMaxFaces;
+}
+
 bool fit_by_default(const PreparedModels& models) {
-  return models.inputs.size() == 1 && models.inputs.front().mesh.triangles.size() <= kDefaultFitMaxFaces;
+  return !models.inputs.empty() &&
+         fit_by_default(models.inputs.size(), models.inputs.front().mesh.triangles.size());
+}
+
+std::string default_fit_max_faces_text() {
+  std::string digits = std::to_string(kDefaultFitMaxFaces), text;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) text += ',';
+    text += digits[i];
+  }
+  return text;
 }
 
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options) {

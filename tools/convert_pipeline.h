@@ -146,6 +146,13 @@ inline constexpr std::size_t kDefaultFitMaxFaces = 500'000;
 /// conversion time (bunny 3.2 → 18.8 s, 87 → 533 MB).
 bool fit_by_default(const PreparedModels& models);
 
+/// fit_by_default() by counts, for callers that have not prepared the models (`convert --choose-loop`):
+/// `model_count` meshes, the first of `faces` faces.
+bool fit_by_default(std::size_t model_count, std::size_t faces);
+
+/// kDefaultFitMaxFaces as help texts write it ("500,000").
+std::string default_fit_max_faces_text();
+
 /// From this L2 stretch of a model's two squares up, `geomip convert` and `geomip rd` move the mesh to
 /// more patches (kStretchedShapeLayouts) when --patches is not given (convert_relayout_when_stretched()). The
 /// two squares' L2 stretch (as `convert` parameterizes) and which layout coded better (mean PSNR of the

@@ -1,6 +1,6 @@
 // Least-squares fitted geometry images: each sample moved a signed distance along its normal so that the
-// uniform remesh (gimage/uniform_remesh.h, same connectivity and triangle count) is a least-squares FIT of the
-// surface rather than its piecewise-linear interpolant.
+// uniform remesh (gimage/uniform_remesh.h, same connectivity and triangle count) is a least-squares FIT of
+// the surface rather than its piecewise-linear interpolant.
 //
 // A resampled geometry image (resample_geometry()) puts every sample exactly on the surface, so in curved
 // regions every remesh triangle lies on one side of the surface (its sag) and the symmetric RMS distance
@@ -13,33 +13,38 @@
 // equation in the offsets of the 3 vertices of the triangle it lands in (barycentric weights · normals, along
 // the hit triangle's normal). Points on the remesh (Dunavant's 6-point rule on every triangle, exact for the
 // square of a quadratic sag, weighted by area, plus its vertices with the weight Metro's sampling gives them)
-// are projected onto the original likewise (along the normal of the original triangle hit). Both directions are
-// averages over their samples and are added; a small Laplacian (offset differences across remesh edges) and
-// Tikhonov term keep the system positive definite. The normal equations are solved exactly (sparse LDLT),
-// the samples re-projected, and this repeated `iterations` times.
+// are projected onto the original likewise (along the normal of the original triangle hit). Both directions
+// are averages over their samples and are added; a small Laplacian (offset differences across remesh edges)
+// and Tikhonov term keep the system positive definite. The normal equations are solved by conjugate gradients
+// from the previous pass's offsets to a relative residual of 1e-10 (~20 iterations; a sparse LDLT where that
+// does not converge), the samples re-projected (each query started from its previous pass's answer), and this
+// repeated `iterations` times.
 //
 // Guarantees:
-// - One unknown per remesh vertex: a sample that seams share (SideLink) gets one offset, so shared samples stay
-//   bit-identical in every image that holds them, and the remesh of the fitted images stays watertight with the
-//   same face list.
+// - One unknown per remesh vertex: a sample that seams share (SideLink) gets one offset, so shared samples
+// stay
+//   bit-identical in every image that holds them, and the remesh of the fitted images stays watertight with
+//   the same face list.
 // - |offset| ≤ FitOptions::max_offset × the vertex's mean incident edge length in the level's remesh.
 // - No triangle of the fitted remesh has its normal turned by 90° or more from the same triangle of the
 //   unfitted remesh (offsets of the vertices of such triangles are halved up to 8 times, then reset to 0;
 //   checked in double before the positions are rounded to float).
 // - Deterministic: the same inputs and options give bit-identical results, whatever `threads` is.
-// - Correspondence: a sample moves only along the normal, by at most a fraction of an edge, so it stays over the
+// - Correspondence: a sample moves only along the normal, by at most a fraction of an edge, so it stays over
+// the
 //   same surface point; the (u,v) of every sample and the face list are unchanged, and a consistent set keeps
 //   its correspondences (each model is fitted to its own surface).
 // - Samples that only masked quads (FitOptions::hole_quads) touch keep their exact position; masked quads'
 //   triangles are neither sampled nor projected onto.
 //
-// Coarser remeshes of a fitted level-n image (every 2^(n−k)-th sample) are not refitted: the offsets are fitted
-// for the level-n triangles.
+// Coarser remeshes of a fitted level-n image (every 2^(n−k)-th sample) are not refitted: the offsets are
+// fitted for the level-n triangles.
 //
-// Cost: iterations + 1 passes, each an AABB tree of the remesh (SurfaceQuery) and one closest-point query per
-// point (original side: its vertices + samples_per_triangle × remesh triangles; remesh side: 6 per triangle +
-// its vertices), and per iteration a sparse LDLT of the vertices × vertices system (2D-grid-like fill). Memory:
-// O(points + vertices), all points' linearizations held at once (timings and peak memory: docs/measurements.md).
+// Cost: iterations passes (one more with FitOptions::measure_after), each an AABB tree of the remesh
+// (SurfaceQuery) and one closest-point query per point (original side: its vertices + samples_per_triangle ×
+// remesh triangles; remesh side: 6 per triangle + its vertices), and per iteration a conjugate-gradient solve
+// of the vertices × vertices system. Memory: O(points + vertices), all points' linearizations held at once
+// (timings and peak memory: docs/measurements.md).
 #pragma once
 
 #include "gimage/resample.h"
@@ -74,6 +79,9 @@ struct FitOptions {
   /// Optional hole mask, as HoleMaskResult::quads (per patch, per quad j·2^level + i, 1 = masked); empty =
   /// none.
   std::vector<std::vector<std::uint8_t>> hole_quads;
+  /// Whether a last pass measures FitResult::rms_to_remesh_after and rms_to_original_after (one more pass
+  /// of closest-point queries than the fit needs; false leaves them 0).
+  bool measure_after = true;
 };
 
 struct FitResult {
@@ -87,7 +95,7 @@ struct FitResult {
   /// RMS distance of the sampled points, original→remesh and remesh→original, before the fit and after it
   /// (the fit's own sample sets; `geomip eval` measures independently).
   double rms_to_remesh_before = 0, rms_to_original_before = 0;
-  double rms_to_remesh_after = 0, rms_to_original_after = 0;
+  double rms_to_remesh_after = 0, rms_to_original_after = 0;  ///< 0 without FitOptions::measure_after
   std::size_t clamped = 0;         ///< offsets cut to the max_offset bound (last iteration)
   std::size_t flip_guarded = 0;    ///< offsets reduced by the flip guard (last iteration)
 };

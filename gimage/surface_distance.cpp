@@ -73,11 +73,12 @@ void validate(const TriMesh& mesh, const char* which) {
 /// hints built. Not copyable: the tree refers into `triangles_`.
 class SearchSurface {
  public:
-  explicit SearchSurface(const TriMesh& mesh) {
+  explicit SearchSurface(const TriMesh& mesh) : primitive_of_(mesh.triangles.size(), -1) {
     triangles_.reserve(mesh.triangles.size());
     for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
       const auto& t = mesh.triangles[f];
       if (triangle_area(mesh, t) > 0) {
+        primitive_of_[f] = static_cast<std::ptrdiff_t>(triangles_.size());
         triangles_.emplace_back(to_point(mesh.positions[t[0]]), to_point(mesh.positions[t[1]]),
                                 to_point(mesh.positions[t[2]]));
         ids_.push_back(f);
@@ -95,8 +96,16 @@ class SearchSurface {
   std::size_t triangle_of(TriangleIterator primitive) const {
     return ids_[static_cast<std::size_t>(primitive - triangles_.cbegin())];
   }
+  /// The tree's primitive of the mesh's triangle `f`; triangles_.cend() for a zero-area triangle (not in the
+  /// tree) or an index out of range.
+  TriangleIterator end() const { return triangles_.cend(); }
+  TriangleIterator primitive_of(std::size_t f) const {
+    return f < primitive_of_.size() && primitive_of_[f] >= 0 ? triangles_.cbegin() + primitive_of_[f]
+                                                             : triangles_.cend();
+  }
 
  private:
+  std::vector<std::ptrdiff_t> primitive_of_;  ///< per mesh triangle, its entry in triangles_ or -1
   std::vector<Triangle> triangles_;
   std::vector<std::size_t> ids_;  ///< per entry of triangles_, its index in the mesh
   Tree tree_;
@@ -424,6 +433,17 @@ Eigen::Vector3d SurfaceQuery::normal_near(const Eigen::Vector3d& p) const {
 
 SurfaceQuery::Closest SurfaceQuery::closest(const Eigen::Vector3d& p) const {
   const auto [point, primitive] = impl_->surface.tree().closest_point_and_primitive(to_point(p));
+  return {Eigen::Vector3d(point.x(), point.y(), point.z()), impl_->surface.triangle_of(primitive)};
+}
+
+SurfaceQuery::Closest SurfaceQuery::closest(const Eigen::Vector3d& p, std::size_t hint_triangle) const {
+  const TriangleIterator hinted = impl_->surface.primitive_of(hint_triangle);
+  if (hinted == impl_->surface.end()) return closest(p);
+  // The hint is a point of the surface (p projected onto the hinted triangle), so the traversal only
+  // ever replaces it by a closer one: the distance found is exact, as without a hint.
+  const Point query = to_point(p);
+  const Point start = Kernel::Construct_projected_point_3()(*hinted, query);
+  const auto [point, primitive] = impl_->surface.tree().closest_point_and_primitive(query, {start, hinted});
   return {Eigen::Vector3d(point.x(), point.y(), point.z()), impl_->surface.triangle_of(primitive)};
 }
 

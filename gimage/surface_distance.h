@@ -134,6 +134,12 @@ class SurfaceQuery {
   };
   Closest closest(const Eigen::Vector3d& p) const;
 
+  /// closest() started from `p`'s projection onto the constructor's triangle `hint_triangle` (as unhinted
+  /// where that triangle has zero area or is out of range): the same distance, faster when the hint is near
+  /// the answer (a triangle the previous query of a nearby point returned). Where several triangles are
+  /// equally close (at a shared edge or vertex) the one returned may differ from the unhinted query's.
+  Closest closest(const Eigen::Vector3d& p, std::size_t hint_triangle) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

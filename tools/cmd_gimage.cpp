@@ -86,6 +86,7 @@ int run_gimage(const GimageArgs& args) {
       t0 = std::chrono::steady_clock::now();
       FitOptions fit;
       fit.quad_split = QuadSplit::kShorter;  // as `geomip remesh` and `geomip decode` split the quads by default
+      fit.measure_after = false;
       images = fit_geometry_images(result[i].mesh, images, fit).images;
       fit_seconds = seconds_since(t0);
     }

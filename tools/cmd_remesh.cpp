@@ -118,6 +118,7 @@ int run_remesh(const RemeshArgs& args) {
       t0 = std::chrono::steady_clock::now();
       FitOptions fit;
       fit.quad_split = split;
+      fit.measure_after = false;
       images = fit_geometry_images(result[i].mesh, images, fit).images;
       fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }

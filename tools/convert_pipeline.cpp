@@ -90,6 +90,7 @@ GeometryImages fit_images(const GeometryImages& images, const TriMesh& surface, 
                           int mask_level) {
   FitOptions fit;
   fit.quad_split = QuadSplit::kShorter;  // what `geomip decode` does with a pack
+  fit.measure_after = false;             // only the images are used
   if (!mask.quads.empty())
     fit.hole_quads = refine_hole_quads(mask.quads, mask_level, images.geometry.front().level);
   return fit_geometry_images(surface, images, fit).images;

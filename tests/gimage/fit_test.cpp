@@ -131,7 +131,7 @@ TEST(FitGeometryImages, ConsistentPairKeepsOneFaceListAndEachFitsBetter) {
   }
 }
 
-TEST(FitGeometryImages, DeterministicOverRunsAndThreads) {
+TEST(FitGeometryImages, DeterministicOverRunsAndThreadsAndWithoutTheMeasuringPass) {
   const ModelParameterization& m = test::parameterized("sphere");
   const GeometryImages g = resample_geometry(m, kLevel, {false, -1});
   FitOptions options;
@@ -143,6 +143,14 @@ TEST(FitGeometryImages, DeterministicOverRunsAndThreads) {
   EXPECT_TRUE(same_images(a.images, b.images));
   EXPECT_TRUE(same_images(a.images, c.images));
   EXPECT_FALSE(same_images(a.images, g));
+  // Without the measuring pass: the same images, the figures after left 0.
+  options.measure_after = false;
+  const FitResult d = fit_geometry_images(m.mesh, g, options);
+  EXPECT_TRUE(same_images(a.images, d.images));
+  EXPECT_GT(a.rms_to_original_after, 0);
+  EXPECT_EQ(d.rms_to_original_after, 0);
+  EXPECT_EQ(d.rms_to_remesh_after, 0);
+  EXPECT_EQ(d.rms_to_original_before, a.rms_to_original_before);
 }
 
 TEST(FitGeometryImages, NoIterationsLeavesTheImages) {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 
 namespace geomip {
@@ -340,6 +341,32 @@ TEST(SurfaceQuery, NormalNearIsTheInterpolatedVertexNormal) {
   const Eigen::Vector3d n = on_square.normal_near(some_rotation() * Eigen::Vector3d(0.3, 0.6, 0.5));
   EXPECT_NEAR(std::abs(n.dot(plane_normal)), 1.0, 1e-12);
   EXPECT_NEAR(n.norm(), 1.0, 1e-12);
+}
+
+// A hint never changes the distance: from any triangle, far or near, zero-area or out of range, the hinted
+// query finds a point as close as the unhinted one, on the surface (its triangle holds it).
+TEST(SurfaceQuery, HintedClosestIsAsCloseAsUnhinted) {
+  TriMesh mesh = test::sphere(3);
+  mesh.triangles.push_back({0, 0, 1});  // a zero-area triangle to hint at (not in the tree)
+  const SurfaceQuery query(mesh);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(-1.5, 1.5);
+  const std::size_t zero_area = mesh.triangles.size() - 1;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random));
+    const SurfaceQuery::Closest plain = query.closest(p);
+    const double d = (plain.point - p).norm();
+    for (std::size_t hint :
+         {plain.triangle, static_cast<std::size_t>(i) % zero_area, zero_area, mesh.triangles.size() + 5}) {
+      const SurfaceQuery::Closest hinted = query.closest(p, hint);
+      EXPECT_NEAR((hinted.point - p).norm(), d, 1e-12 * (1 + d)) << "point " << i << ", hint " << hint;
+      ASSERT_LT(hinted.triangle, zero_area);
+      const auto& t = mesh.triangles[hinted.triangle];
+      const Eigen::Vector3d a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+      EXPECT_NEAR((b - a).cross(c - a).normalized().dot(hinted.point - a), 0.0, 1e-12)
+          << "the point lies in its triangle's plane";
+    }
+  }
 }
 
 TEST(SurfaceQuery, LineInATrianglesPlaneTakesTheOverlapsEnds) {

@@ -182,14 +182,14 @@ int run_convert(const ConvertArgs& args) {
   options.lifting_update = !args.no_lifting_update;
   options.cell_frames = !args.no_cell_frames;
   if (args.short_filter) options.filter = codec::WaveletFilter::kCubic;
-  // The fit: as asked, else fit_by_default() (--search tries it itself; --choose-loop's loops are of one
-  // mesh, so its faces decide).
+  // The fit: as asked, else fit_by_default() (--search tries it itself; --choose-loop's loops are of its one
+  // mesh).
   if (args.fit_given)
     options.fit = args.fit;
   else if (args.choose_loop)
-    options.fit = fit_by_default(1, read_mesh(args.common.meshes.front()).triangles.size());
+    options.fit = fit_by_default(1);
   else if (!args.search)
-    options.fit = fit_by_default(models);
+    options.fit = fit_by_default(models.inputs.size());
   options.up = up;
   options.front = front;
   options.progress = bar.callback();
@@ -440,9 +440,8 @@ CommandRunner add_convert_command(CLI::App& app) {
       "--fit,!--no-fit", args->fit,
       "Move every level-N sample along its normal so that the level-N remesh is a least-squares fit of the "
       "surface, not its interpolant (gimage/fit.h, after the normal-mesh resampling; hole-mask quads left "
-      "out; several times the conversion time); --no-fit: samples on the surface. Default: fitted for one "
-      "mesh of up to " +
-          default_fit_max_faces_text() + " faces, not for consistent sets");
+      "out; up to about twice the conversion time); --no-fit: samples on the surface. Default: fitted for "
+      "one mesh, not for consistent sets");
   // Codec tools, for ablations (docs/codec-v3.md); the defaults are the codec's best measured.
   CLI::Option* frame_steps =
       cmd->add_option("--frame-steps", args->frame_steps,

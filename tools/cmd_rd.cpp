@@ -234,7 +234,7 @@ Series geomip_series(const RdArgs& args, LoopKind loop, bool relayout, std::vect
   } else {
     PreparedModels models = prepare_models({mesh_path}, "", "geomip rd", true, args.patches, loop,
                                            args.equal_area_layout, args.layout_error_weights);
-    if (!args.fit_given) options.fit = fit_by_default(models);  // as `geomip convert`
+    if (!args.fit_given) options.fit = fit_by_default(models.inputs.size());  // as `geomip convert`
     ConvertResult converted = convert_relayout_when_stretched(
         models, options,
         [&](int k, std::string& why_not) {
@@ -580,9 +580,8 @@ CommandRunner add_rd_command(CLI::App& app) {
   CLI::Option* fit = cmd->add_flag(
       "--fit,!--no-fit", args->fit,
       "geomip: fit the pack's samples to the surface by least squares before coding (as `geomip convert "
-      "--fit`; several times the conversion time); --no-fit: samples on the surface. Default as `geomip "
-      "convert`: fitted for meshes of up to " +
-          default_fit_max_faces_text() + " faces");
+      "--fit`; up to about twice the conversion time); --no-fit: samples on the surface. Default as `geomip "
+      "convert`: fitted");
   add_patches_option(cmd, args->patches, args->patches_given, args->equal_area_layout,
                      args->layout_error_weights, args->layout_error_weights_given);
   cmd->add_flag("--tip-loop", args->tip_loop, "geomip: the two-square loop through the tips (as `geomip convert --tip-loop`)");

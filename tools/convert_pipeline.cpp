@@ -85,12 +85,20 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
   }
 }
 
+/// Gauss–Newton passes of the fit for a pack. One: means of three jittered copies of the 1.5-32 KB prefixes
+/// with one, two and three passes agree within 0.03 dB on the bunny, the horse and venus, and the bunny's
+/// whole packs within 0.02 dB (docs/codec-v3.md, "A faster fit"); each pass is a full set of closest-point
+/// queries. `geomip remesh --fit` and `gimage --fit`, whose remeshes are not quantized, keep FitOptions'
+/// three.
+constexpr int kConvertFitIterations = 1;
+
 /// fit_geometry_images() against `surface`, the quads of `mask` (at `mask_level` ≤ the images' level) left out.
 GeometryImages fit_images(const GeometryImages& images, const TriMesh& surface, const HoleMaskResult& mask,
                           int mask_level) {
   FitOptions fit;
   fit.quad_split = QuadSplit::kShorter;  // what `geomip decode` does with a pack
   fit.measure_after = false;             // only the images are used
+  fit.iterations = kConvertFitIterations;
   if (!mask.quads.empty())
     fit.hole_quads = refine_hole_quads(mask.quads, mask_level, images.geometry.front().level);
   return fit_geometry_images(surface, images, fit).images;
@@ -389,22 +397,8 @@ ConvertResult convert_relayout_when_stretched(
   return result;
 }
 
-bool fit_by_default(std::size_t model_count, std::size_t faces) {
-  return model_count == 1 && faces <= kDefaultFitMaxFaces;
-}
-
-bool fit_by_default(const PreparedModels& models) {
-  return !models.inputs.empty() &&
-         fit_by_default(models.inputs.size(), models.inputs.front().mesh.triangles.size());
-}
-
-std::string default_fit_max_faces_text() {
-  std::string digits = std::to_string(kDefaultFitMaxFaces), text;
-  for (std::size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) text += ',';
-    text += digits[i];
-  }
-  return text;
+bool fit_by_default(std::size_t model_count) {
+  return model_count == 1;
 }
 
 ConvertResult convert_models(const PreparedModels& models, const ConvertOptions& options) {

@@ -132,26 +132,17 @@ struct ConvertResult {
   bool stopped_stretched = false;
 };
 
-/// Meshes of more faces than this are not fitted by default (fit_by_default()): the fit's closest-point
-/// queries grow with the mesh, and a million faces (`scripts/bench-scale`, issue #15's 60 s and 2 GB) would
-/// take about 40 s and 0.3–0.5 GB more (igea, 268,686 faces: 20.9 → 62.0 s, 404 → 666 MB on 2 busy cores).
-inline constexpr std::size_t kDefaultFitMaxFaces = 500'000;
-
 /// Whether `geomip convert` and `geomip rd` fit the samples (ConvertOptions::fit) when neither --fit nor
-/// --no-fit is given: for one mesh of at most kDefaultFitMaxFaces faces, on any layout (a stretched shape's
+/// --no-fit is given: for one mesh (`model_count` 1), of any size and on any layout (a stretched shape's
 /// candidate layouts are fitted before they are measured); not for consistent sets (not measured). Measured
 /// (docs/codec-v3.md, "The fit by default"): since the hole borders are snapped onto the original surface,
 /// the fit raises the 16 and 32 KB prefixes (means of three jittered copies: bunny +0.15 / +0.45 dB, venus
-/// +0.50 / +1.06, horse +0.33 / +0.45) and moves the smaller ones by −0.02…+0.10 dB, for several times the
-/// conversion time (bunny 3.2 → 18.8 s, 87 → 533 MB).
-bool fit_by_default(const PreparedModels& models);
-
-/// fit_by_default() by counts, for callers that have not prepared the models (`convert --choose-loop`):
-/// `model_count` meshes, the first of `faces` faces.
-bool fit_by_default(std::size_t model_count, std::size_t faces);
-
-/// kDefaultFitMaxFaces as help texts write it ("500,000").
-std::string default_fit_max_faces_text();
+/// +0.50 / +1.06, horse +0.33 / +0.45) and moves the smaller ones by −0.02…+0.10 dB. Its cost, one
+/// Gauss–Newton pass (docs/codec-v3.md, "A faster fit"): the bunny's `convert --no-normals` 2.7 → 6.1 s and
+/// 88 → 486 MB, a million faces (`scripts/bench-scale`'s mesh) 43.7 → 49.4 s and 1.40 → 1.47 GB (idle 2
+/// cores), so no size limit: until 2026-12-07 meshes above 500,000 faces were not fitted, when the fit took
+/// four passes and an LDLT per pass.
+bool fit_by_default(std::size_t model_count);
 
 /// From this L2 stretch of a model's two squares up, `geomip convert` and `geomip rd` move the mesh to
 /// more patches (kStretchedShapeLayouts) when --patches is not given (convert_relayout_when_stretched()). The

@@ -54,7 +54,8 @@ std::string SearchCandidate::switches(int default_level) const {
   if (patches != 2 || (loop == LoopKind::kPlain && two_squares_named))
     add("--patches " + std::to_string(patches));
   if (level != default_level) add("--level " + std::to_string(level));
-  // Named either way: the default depends on the mesh (fit_by_default()).
+  // Named either way, so that the switches keep building this candidate if the default (fit_by_default())
+  // moves.
   add(fit ? "--fit" : "--no-fit");
   if (linf_sweeps > 0) add("--linf-sweeps " + std::to_string(linf_sweeps));
   if (frame_steps >= 0 && frame_steps != ConvertOptions{}.frame_steps)

@@ -59,7 +59,7 @@ struct SearchCandidate {
   std::string name(int default_level) const;
   /// The switches of `geomip convert` that build this candidate ("--end-loop --fit", "--patches 8 --level
   /// 7 --no-fit", "--tip-loop --fit --linf-sweeps 1000", "--patches 2 --fit", "--no-fit"): the fit always
-  /// named, since its default depends on the mesh (fit_by_default()).
+  /// named, so that the switches do not depend on the default (fit_by_default()).
   std::string switches(int default_level) const;
 };
 

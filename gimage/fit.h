@@ -21,19 +21,17 @@
 // repeated `iterations` times.
 //
 // Guarantees:
-// - One unknown per remesh vertex: a sample that seams share (SideLink) gets one offset, so shared samples
-// stay
-//   bit-identical in every image that holds them, and the remesh of the fitted images stays watertight with
-//   the same face list.
+// - One unknown per remesh vertex: a sample that seams share (SideLink) gets one offset, so shared
+//   samples stay bit-identical in every image that holds them, and the remesh of the fitted images stays
+//   watertight with the same face list.
 // - |offset| ≤ FitOptions::max_offset × the vertex's mean incident edge length in the level's remesh.
 // - No triangle of the fitted remesh has its normal turned by 90° or more from the same triangle of the
 //   unfitted remesh (offsets of the vertices of such triangles are halved up to 8 times, then reset to 0;
 //   checked in double before the positions are rounded to float).
 // - Deterministic: the same inputs and options give bit-identical results, whatever `threads` is.
-// - Correspondence: a sample moves only along the normal, by at most a fraction of an edge, so it stays over
-// the
-//   same surface point; the (u,v) of every sample and the face list are unchanged, and a consistent set keeps
-//   its correspondences (each model is fitted to its own surface).
+// - Correspondence: a sample moves only along the normal, by at most a fraction of an edge, so it stays
+//   over the same surface point; the (u,v) of every sample and the face list are unchanged, and a
+//   consistent set keeps its correspondences (each model is fitted to its own surface).
 // - Samples that only masked quads (FitOptions::hole_quads) touch keep their exact position; masked quads'
 //   triangles are neither sampled nor projected onto.
 //

@@ -96,9 +96,10 @@ class SearchSurface {
   std::size_t triangle_of(TriangleIterator primitive) const {
     return ids_[static_cast<std::size_t>(primitive - triangles_.cbegin())];
   }
-  /// The tree's primitive of the mesh's triangle `f`; triangles_.cend() for a zero-area triangle (not in the
-  /// tree) or an index out of range.
+  /// Past the tree's last primitive: primitive_of()'s "none".
   TriangleIterator end() const { return triangles_.cend(); }
+  /// The tree's primitive of the mesh's triangle `f`; end() for a zero-area triangle (not in the tree) or an
+  /// index out of range.
   TriangleIterator primitive_of(std::size_t f) const {
     return f < primitive_of_.size() && primitive_of_[f] >= 0 ? triangles_.cbegin() + primitive_of_[f]
                                                              : triangles_.cend();

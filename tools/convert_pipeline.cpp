@@ -86,7 +86,7 @@ void normal_mesh(GeometryImages& images, const TriMesh& surface, int steps, cons
 }
 
 /// Gauss–Newton passes of the fit for a pack. One: means of three jittered copies of the 1.5-32 KB prefixes
-/// with one, two and three passes agree within 0.03 dB on the bunny, the horse and venus, and the bunny's
+/// with one, two and three passes agree within 0.07 dB on the bunny, the horse and venus, and the bunny's
 /// whole packs within 0.02 dB (docs/codec-v3.md, "A faster fit"); each pass is a full set of closest-point
 /// queries. `geomip remesh --fit` and `gimage --fit`, whose remeshes are not quantized, keep FitOptions'
 /// three.

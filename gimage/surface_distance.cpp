@@ -229,17 +229,29 @@ OneSidedDistance one_sided(const Samples& samples, const SearchSurface& target, 
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<Accumulator> partial(chunks);
   std::atomic<std::size_t> next_chunk{0};
+  const std::size_t face_begin = samples.vertices + samples.edges;
   auto work = [&] {
     for (std::size_t c = next_chunk++; c < chunks; c = next_chunk++) {
       Accumulator acc;
       acc.max_index = c * kChunk;
-      const std::size_t end = std::min(n, (c + 1) * kChunk);
-      for (std::size_t i = c * kChunk; i < end; ++i) {
+      const std::size_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
+      TriangleIterator previous = target.end();  // the previous sample's closest primitive
+      for (std::size_t i = begin; i < end; ++i) {
         const Point& p = samples.points[i];
-        // Hinted by the tree's kd-tree of vertices (accelerate_distance_queries()), not by the previous
-        // sample's closest point: face samples follow the file's face order, which jumps, and a far hint
-        // made the queries 2.3–4.6× slower (the distances are exact either way).
-        double d = std::sqrt(CGAL::squared_distance(p, target.tree().closest_point(p)));
+        // A face sample that follows one of the same face (they come face by face, ~10 per face by default)
+        // starts from p projected onto the previous sample's closest triangle; any other sample from the
+        // tree's kd-tree of vertices (accelerate_distance_queries()): across faces the previous answer is no
+        // good hint, as the file's face order jumps (it made the queries 2.3–4.6× slower). Measured: `geomip
+        // eval` of the bunny against its decoded pack 7 % faster, the same figures. The distance is exact
+        // either way (only which of equally close points is returned may differ), and a hint never crosses a
+        // chunk, so the result does not depend on the number of threads.
+        const bool same_face = i > begin && i > face_begin && samples.owner[i] == samples.owner[i - 1] &&
+                               previous != target.end();
+        const auto hit = same_face ? target.tree().closest_point_and_primitive(
+                                         p, {Kernel::Construct_projected_point_3()(*previous, p), previous})
+                                   : target.tree().closest_point_and_primitive(p);
+        previous = hit.second;
+        double d = std::sqrt(CGAL::squared_distance(p, hit.first));
         if (d <= noise_floor) d = 0;
         if (d > acc.max) {
           acc.max = d;

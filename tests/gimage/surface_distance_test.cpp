@@ -238,6 +238,28 @@ TEST(SurfaceDistance, DeterministicForASeedWhateverTheThreads) {
   EXPECT_NEAR(c.psnr_db, a.psnr_db, 0.2);
 }
 
+TEST(SurfaceDistance, FaceSamplesHintedByTheirNeighboursMeasureTheUnhintedDistances) {
+  // Consecutive face samples of one face start their query from the previous one's answer; the distances must
+  // be those of plain closest-point queries (distances_to_surface()), sample for sample, so the RMS agrees to
+  // rounding. A bumpy approximation, so that the closest triangle changes often between a face's samples.
+  const TriMesh original = test::sphere(3);
+  TriMesh bumpy = test::sphere(2);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> scale(0.97, 1.03);
+  for (auto& p : bumpy.positions) p *= scale(random);
+  SurfaceDistanceOptions options;
+  options.face_samples = 20000;  // about 16 per face, over several chunks
+  options.threads = 2;
+  const SurfaceDistance d = measure_surface_distance(original, bumpy, options);
+  const std::vector<Eigen::Vector3d> points =
+      sample_surface_points(original, options.face_samples, options.seed);
+  ASSERT_EQ(points.size(), d.original_to_approx.samples());
+  double sum = 0;
+  for (double x : distances_to_surface(bumpy, points)) sum += x * x;
+  EXPECT_NEAR(d.original_to_approx.rms, std::sqrt(sum / static_cast<double>(points.size())),
+              1e-12 * d.original_to_approx.rms);
+}
+
 TEST(SurfaceDistance, MoreSamplesConvergeOnTheSameRms) {
   const TriMesh fine = test::sphere(4);
   const TriMesh coarse = test::sphere(1);

@@ -98,6 +98,13 @@ class SearchSurface {
   }
   /// Past the tree's last primitive: primitive_of()'s "none".
   TriangleIterator end() const { return triangles_.cend(); }
+  /// The closest point of the surface to `p` and its primitive, the traversal started from `p` projected onto
+  /// `hint` (a primitive of the tree, not end()) instead of the kd-tree's start. The start is a point of the
+  /// surface, so the traversal only ever replaces it by a closer one: the distance is exact, as without a
+  /// hint; only which of equally close points is returned may differ.
+  std::pair<Point, TriangleIterator> closest_from(const Point& p, TriangleIterator hint) const {
+    return tree_.closest_point_and_primitive(p, {Kernel::Construct_projected_point_3()(*hint, p), hint});
+  }
   /// The tree's primitive of the mesh's triangle `f`; end() for a zero-area triangle (not in the tree) or an
   /// index out of range.
   TriangleIterator primitive_of(std::size_t f) const {
@@ -247,9 +254,8 @@ OneSidedDistance one_sided(const Samples& samples, const SearchSurface& target, 
         // chunk, so the result does not depend on the number of threads.
         const bool same_face = i > begin && i > face_begin && samples.owner[i] == samples.owner[i - 1] &&
                                previous != target.end();
-        const auto hit = same_face ? target.tree().closest_point_and_primitive(
-                                         p, {Kernel::Construct_projected_point_3()(*previous, p), previous})
-                                   : target.tree().closest_point_and_primitive(p);
+        const auto hit =
+            same_face ? target.closest_from(p, previous) : target.tree().closest_point_and_primitive(p);
         previous = hit.second;
         double d = std::sqrt(CGAL::squared_distance(p, hit.first));
         if (d <= noise_floor) d = 0;
@@ -452,11 +458,7 @@ SurfaceQuery::Closest SurfaceQuery::closest(const Eigen::Vector3d& p) const {
 SurfaceQuery::Closest SurfaceQuery::closest(const Eigen::Vector3d& p, std::size_t hint_triangle) const {
   const TriangleIterator hinted = impl_->surface.primitive_of(hint_triangle);
   if (hinted == impl_->surface.end()) return closest(p);
-  // The hint is a point of the surface (p projected onto the hinted triangle), so the traversal only
-  // ever replaces it by a closer one: the distance found is exact, as without a hint.
-  const Point query = to_point(p);
-  const Point start = Kernel::Construct_projected_point_3()(*hinted, query);
-  const auto [point, primitive] = impl_->surface.tree().closest_point_and_primitive(query, {start, hinted});
+  const auto [point, primitive] = impl_->surface.closest_from(to_point(p), hinted);
   return {Eigen::Vector3d(point.x(), point.y(), point.z()), impl_->surface.triangle_of(primitive)};
 }
 

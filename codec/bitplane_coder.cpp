@@ -109,7 +109,8 @@ bool layout_ok(const BitplaneLayout& layout) {
     if (v < -1 || v > 64) return false;
   }
   return layout.level >= 0 && layout.level <= 12 && layout.steps >= 0 && layout.steps <= layout.level &&
-         layout.num_patches >= 1 && layout.joint_segments >= 0;
+         layout.num_patches >= 1 && layout.joint_segments >= 0 && layout.bottom_bitplane >= 0 &&
+         layout.bottom_bitplane <= 64;
 }
 
 /// The bands of every patch (only_patch < 0) or of one patch, in coding order; Band::parent indexes the
@@ -839,12 +840,14 @@ void reconstruct_band(const Band& band, PatchCoefficients& patch) {
   }
 }
 
-/// The distinct start planes of deferred steps that are ≤ top, most significant first.
+/// The distinct start planes of deferred steps that are ≤ top and coded (≥ the bottom plane), most
+/// significant first.
 std::vector<int> hook_planes(const BitplaneLayout& layout, int top) {
   std::vector<int> planes;
   for (int k = 1; k <= layout.steps; ++k) {
     const int v = layout.start_plane[static_cast<std::size_t>(k)];
-    if (v >= 0 && v <= top && std::find(planes.begin(), planes.end(), v) == planes.end()) planes.push_back(v);
+    if (v >= layout.bottom_bitplane && v <= top && std::find(planes.begin(), planes.end(), v) == planes.end())
+      planes.push_back(v);
   }
   std::sort(planes.begin(), planes.end(), std::greater<int>());
   return planes;
@@ -884,6 +887,8 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
     compute_msb(b, coefs[b.patch], static_cast<int>(size));
     top = std::max(top, b.start >= 0 ? b.start : b.msb[b.node(b.levels - 1, 0, 0)] + b.offset);
   }
+  const int bottom = layout.bottom_bitplane;
+  top = std::max(top, bottom);  // at least one plane, even for a stream of zeros
   const std::vector<int> hooks = hook_planes(layout, top);
   // Before coding `plane`: the hook for the bands that start there, and their new magnitudes.
   const auto run_hook = [&](int plane) {
@@ -910,7 +915,7 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
     if (!layout.independent_patches) return true;
     return joint_bytes > 0 ? joint_total < joint_bytes : result.joint_segments < layout.joint_segments;
   };
-  for (; plane >= 0 && stay_joint(); --plane) {
+  for (; plane >= bottom && stay_joint(); --plane) {
     run_hook(plane);
     ArithmeticEncoder enc;
     joint.set_encoder(&enc);
@@ -919,7 +924,7 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
     joint_total += result.segments.back().size();
     if (layout.independent_patches) ++result.joint_segments;
   }
-  if (plane < 0) return result;
+  if (plane < bottom) return result;
   // A segment is the varint sizes of the P streams, then their bytes interleaved in proportion to their
   // sizes (see Interleaver).
   const int np = layout.num_patches;
@@ -929,7 +934,7 @@ BitplaneEncoding encode_bitplanes(const BitplaneLayout& layout,
     coders.emplace_back(layout, bands, p, &coefs);
     coders.back().copy_contexts(joint);
   }
-  for (; plane >= 0; --plane) {
+  for (; plane >= bottom; --plane) {
     run_hook(plane);
     std::vector<std::vector<std::uint8_t>> streams;
     for (auto& coder : coders) {
@@ -1118,7 +1123,7 @@ Status BitplaneDecoder::reset(const BitplaneLayout& layout, int top_bitplane,
                               DecodeHook before_plane) {
   s_.reset();
   if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) ||
-      top_bitplane < 0 || top_bitplane > 64) {
+      top_bitplane < layout.bottom_bitplane || top_bitplane > 64) {
     return Status::kInvalidArgument;
   }
   const std::size_t size = (std::size_t{1} << layout.level) + 1, samples = size * size;
@@ -1128,7 +1133,7 @@ Status BitplaneDecoder::reset(const BitplaneLayout& layout, int top_bitplane,
   auto st = std::make_unique<State>();
   st->layout = layout;
   st->top = top_bitplane;
-  st->planes = static_cast<std::size_t>(top_bitplane) + 1;
+  st->planes = static_cast<std::size_t>(top_bitplane - layout.bottom_bitplane) + 1;
   st->joint_planes = layout.independent_patches
                          ? std::min(st->planes, static_cast<std::size_t>(layout.joint_segments))
                          : st->planes;

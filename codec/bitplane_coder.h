@@ -102,6 +102,10 @@ struct BitplaneLayout {
   std::array<int, 13> start_plane = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
   /// Deferred bands use contexts of their own (classes 3 and 4 beside coarse, row/column and diagonal).
   bool own_deferred_contexts = false;
+  /// The lowest weighted plane coded (codec header version 7): the stream ends after it, so a band of
+  /// offset o keeps its plain planes ≥ bottom_bitplane − o and loses the ones below (reconstructed at the
+  /// middle of what is left, as in any prefix). 0: every plane, lossless on the integers.
+  int bottom_bitplane = 0;
 };
 
 /// Weighted offset of a band: its plain bit-plane p is coded in weighted plane p + offset. Coarse band
@@ -113,7 +117,9 @@ int band_offset(const BitplaneLayout& layout, int k, int orient);
 inline constexpr int kMaxCoefficientPlane = 29;
 
 struct BitplaneEncoding {
-  int top_bitplane = 0;  ///< most significant weighted plane; segments.size() == top_bitplane + 1
+  /// Most significant weighted plane (at least layout.bottom_bitplane); segments.size() == top_bitplane −
+  /// layout.bottom_bitplane + 1.
+  int top_bitplane = 0;
   std::vector<std::vector<std::uint8_t>> segments;  ///< one per weighted plane, most significant first
   int joint_segments = 0;  ///< leading segments coded jointly (the decoder's BitplaneLayout::joint_segments)
 };

@@ -24,7 +24,7 @@ namespace {
 // version 3: version 2 plus local frames and orientation weights; version 4: version 3 plus the lifting
 // update flag (bit 1 of the flags byte); version 5: version 4 plus the filter kCubicLong; version 6: version
 // 5 with cell frames (see "Local frames" below).
-constexpr std::uint8_t kHeaderVersion = 6;
+constexpr std::uint8_t kHeaderVersion = 7;
 constexpr int kMaxTangentialShift = 8;
 constexpr int kMaxLevel = 12;
 constexpr int kMaxTopBitplane = 48;
@@ -143,7 +143,10 @@ bool header_ok(const GeometryCodecHeader& h) {
   }
   if (!std::isfinite(h.step) || !(h.step > 0)) return false;
   if (h.top_bitplane < 0 || h.top_bitplane > kMaxTopBitplane) return false;
-  if (h.joint_segments < 0 || h.joint_segments > h.top_bitplane + 1 ||
+  if (h.bottom_bitplane < 0 || h.bottom_bitplane > h.top_bitplane ||
+      (h.version < 7 && h.bottom_bitplane != 0))
+    return false;
+  if (h.joint_segments < 0 || h.joint_segments > h.top_bitplane - h.bottom_bitplane + 1 ||
       (h.version < 2 && h.joint_segments != 0))
     return false;
   if (h.version < 3 && (h.orientation_weights || h.frame_steps != 0 || h.tangential_shift != 0)) return false;
@@ -675,6 +678,7 @@ BitplaneLayout make_layout(const GeometryCodecHeader& h) {
   BitplaneLayout layout{h.level, h.steps, h.num_patches, h.version >= 2, h.joint_segments};
   layout.orientation_weights = h.orientation_weights;
   layout.own_deferred_contexts = h.version >= 3;
+  layout.bottom_bitplane = h.bottom_bitplane;
   for (int k = 1; k <= h.frame_steps && k <= static_cast<int>(h.frame_start.size()); ++k)
     layout.start_plane[static_cast<std::size_t>(k)] = h.frame_start[static_cast<std::size_t>(k - 1)];
   return layout;
@@ -692,6 +696,7 @@ std::vector<std::uint8_t> GeometryCodecHeader::serialize() const {
   for (double o : origin) put_double(out, o);
   put_double(out, step);
   put_varint(out, static_cast<std::uint64_t>(top_bitplane));
+  if (version >= 7) put_varint(out, static_cast<std::uint64_t>(bottom_bitplane));
   if (version >= 2) put_varint(out, static_cast<std::uint64_t>(joint_segments));
   if (version >= 3) {
     out.push_back(static_cast<std::uint8_t>((orientation_weights ? 1 : 0) | (lifting_update ? 2 : 0)));
@@ -724,6 +729,7 @@ Status GeometryCodecHeader::parse(std::span<const std::uint8_t> bytes, GeometryC
   }
   int num_seams = 0;
   if (!r.f64(h.step) || !r.small_int(h.top_bitplane, kMaxTopBitplane) ||
+      (h.version >= 7 && !r.small_int(h.bottom_bitplane, kMaxTopBitplane)) ||
       (h.version >= 2 && !r.small_int(h.joint_segments, kMaxTopBitplane + 1))) {
     return Status::kCorrupt;
   }
@@ -775,6 +781,10 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   if (options.quantization_bits < 1 || options.quantization_bits > 24) {
     throw std::invalid_argument("encode_geometry: quantization_bits must be in [1, 24]");
   }
+  if (options.headroom_bits < 0) throw std::invalid_argument("encode_geometry: headroom_bits must be ≥ 0");
+  const int headroom = std::min(options.headroom_bits, 24 - options.quantization_bits);
+  if (headroom > 0 && !options.cell_frames)
+    throw std::invalid_argument("encode_geometry: headroom_bits needs cell_frames (codec header version 7)");
   if (options.steps < -1 || options.steps > level) {
     throw std::invalid_argument("encode_geometry: steps must be -1 or in [0, level]");
   }
@@ -812,7 +822,8 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   h.steps = options.steps < 0 ? level : options.steps;
   h.filter = options.filter;
   for (int c = 0; c < 3; ++c) h.origin[c] = lo[c];
-  h.step = extent > 0 ? extent / std::ldexp(1.0, options.quantization_bits) : 1.0;
+  h.step = extent > 0 ? extent / std::ldexp(1.0, options.quantization_bits + headroom) : 1.0;
+  h.bottom_bitplane = headroom;
   h.seams = seams;
 
   const Ownership own = seam_ownership(level, np, seams);
@@ -837,7 +848,7 @@ EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::ve
   }
   // Version 6 differs from 5 only in how frames are built: without cell frames the stream is version 5's (and
   // a stream without frames, such as a normal map's, is version 5's but for this byte).
-  h.version = options.cell_frames ? kHeaderVersion : 5;
+  h.version = !options.cell_frames ? 5 : headroom > 0 ? kHeaderVersion : 6;
   h.orientation_weights = options.orientation_weights;
   h.lifting_update = options.lifting_update;
   h.frame_steps = std::min(options.frame_steps, h.steps);

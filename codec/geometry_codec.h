@@ -3,16 +3,19 @@
 //
 // Pipeline (encoder): quantize each channel to integers on a fixed step (uniform over the model) → integer
 // lifting wavelet transform per patch (wavelet.h; border lines are never updated, so a seam's coefficients
-// depend only on the seam's samples) → embedded bit-plane coding of the coefficients (bitplane_coder.h) driven by the
-// context-adaptive binary arithmetic coder (arithmetic_coder.h). Every sample shared by several patches (seam
-// sides, corners) is coded once, by its owner (the lowest patch·grid index among the copies); the decoder
-// copies it to the other patches before the inverse transform, so every decoded prefix is watertight with
-// bit-identical seam samples.
+// depend only on the seam's samples) → embedded bit-plane coding of the coefficients (bitplane_coder.h)
+// driven by the context-adaptive binary arithmetic coder (arithmetic_coder.h). Every sample shared by several
+// patches (seam sides, corners) is coded once, by its owner (the lowest patch·grid index among the copies);
+// the decoder copies it to the other patches before the inverse transform, so every decoded prefix is
+// watertight with bit-identical seam samples.
 //
 // Version 3 (docs/codec-v3.md): the detail coefficients of the finest steps are coded in local frames
 // (normal, tangent, bitangent) that the decoder derives from its own coarser reconstruction, the tangential
 // components one bit-plane coarser; row and column details are weighted above diagonal ones. Version 4: the
-// wavelet may have an update step (wavelet.h), so the coarse levels are averages, not subsamples.
+// wavelet may have an update step (wavelet.h), so the coarse levels are averages, not subsamples. Version 7:
+// the samples are quantized GeometryCodecOptions::headroom_bits finer and the stream ends that many weighted
+// planes above plane 0 (GeometryCodecHeader::bottom_bitplane), so the coarse bands keep more precision for
+// the same bytes.
 //
 // The output is a list of segments, one per bit-plane pass, coarsest information first. Segments are
 // self-delimiting only through their sizes (stored by the container, pack.h); a decoder given the first k
@@ -50,12 +53,20 @@ struct Grid3 {
 };
 
 struct GeometryCodecOptions {
-  /// Quantization: the step is (largest bounding-box extent of all patches) / 2^quantization_bits, the origin
-  /// the bounding-box minimum; in [1, 24]. Full decoding is lossless up to this quantization (error ≤ step/2
-  /// per coordinate) when frame_steps is 0; near-lossless with frames (see frame_steps). More bits cost only
-  /// the bottom planes (prefixes of a given size hardly change); 14 is where a level-8 geometry image, not
-  /// the quantization, limits the accuracy (figures: docs/measurements.md).
+  /// Quantization: the finest details keep quantization_bits over the largest bounding-box extent of all
+  /// patches (in [1, 24]); the samples themselves are quantized headroom_bits finer (below), the origin is
+  /// the bounding-box minimum. With headroom_bits 0, full decoding is lossless up to this quantization (error
+  /// ≤ step/2 per coordinate) when frame_steps is 0; near-lossless with frames (see frame_steps).
   int quantization_bits = 14;
+  /// Headroom of the coarser bands (codec header version 7): the samples are quantized on (largest extent)
+  /// / 2^(quantization_bits + headroom_bits) and the stream ends at weighted bit-plane headroom_bits
+  /// (BitplaneLayout::bottom_bitplane), so the finest band keeps about quantization_bits of precision and
+  /// the coarser ones, weighted higher, keep up to headroom_bits more, which is where a prefix's error
+  /// sits: with 14 bits and no headroom the coarse bands reach their last plane before the fine ones, and
+  /// the bunny's and the horse's 32 KB prefixes were 1.3–2.1 dB below what finer coarse bands give
+  /// (docs/codec-v3.md, "Headroom for the coarse bands"). Capped at 24 − quantization_bits; 0 = the version-6
+  /// stream. Needs cell_frames.
+  int headroom_bits = 4;
   /// kCubicLong by default (codec header version 5): +0.16 … +0.29 dB over kCubic on the mean of the
   /// bunny's, horse's, venus's and armadillo's pack-prefix curves (docs/codec-v3.md, "Longer lifting
   /// filters"); kCubic: more grid and surface PSNR than kLinear at every byte count, and fewer bytes in all
@@ -101,8 +112,8 @@ struct GeometryCodecHeader {
   /// Stream layout: 1 = one joint stream for all patches (packs of format version 1), 2 = one stream per
   /// patch in every segment, decoded in parallel, 3 = version 2 plus local frames and orientation weights,
   /// 4 = version 3 plus the lifting update flag, 5 = version 4 plus the filter kCubicLong, 6 = version 5 with
-  /// cell frames (the frames from the coarse grid's normals and a table of octahedral cells; written by this
-  /// encoder).
+  /// cell frames (the frames from the coarse grid's normals and a table of octahedral cells), 7 = version 6
+  /// with a bottom bit-plane (written by this encoder when headroom_bits > 0; 6 otherwise).
   int version = 6;
   int level = 0;        ///< grid level n of every patch
   int num_patches = 0;  ///< patches per model
@@ -110,7 +121,10 @@ struct GeometryCodecHeader {
   WaveletFilter filter = WaveletFilter::kCubic;
   double origin[3] = {0, 0, 0};  ///< dequantized value = origin + step · integer
   double step = 1;
-  int top_bitplane = 0;  ///< most significant (weighted) bit-plane coded; one segment per plane down to 0
+  int top_bitplane = 0;  ///< most significant (weighted) bit-plane coded; one segment per plane down to
+                         ///< bottom_bitplane
+  /// Version 7: the lowest weighted bit-plane coded (GeometryCodecOptions::headroom_bits); 0 before.
+  int bottom_bitplane = 0;
   /// Version 2: the first joint_segments segments are one joint stream, the others per patch (≤ planes).
   int joint_segments = 0;
   /// Version 3: see GeometryCodecOptions. frame_start[k − 1] (k = 1..frame_steps) is the weighted bit-plane

@@ -511,7 +511,7 @@ std::vector<ChunkKey> chunk_order(const std::vector<int>& geometry_passes,
 }
 
 int passes_of(const GeometryCodecHeader& h) {
-  return h.top_bitplane + 1;
+  return h.top_bitplane - h.bottom_bitplane + 1;
 }
 
 std::uint64_t samples_of(const GeometryCodecHeader& h) {
@@ -566,10 +566,12 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     seams_before = &model.geometry.seams;
     // Pack version v ≤ 3 holds codec headers of version v (1: joint streams, 2: per-patch ones, 3: local
     // frames); version 4 (a container change) those of version 3; version 5 those of versions 3 and 4 (4:
-    // the lifting update); versions 6 and 7 those of versions 3 to 5 (5: the filter kCubicLong); version 8
-    // those of versions 3 to 6 (6: cell frames).
+    // the lifting update); versions 6 and 7 those of versions 3 to 5 (5: the filter kCubicLong); versions 8
+    // and 9 those of versions 3 to 6 (6: cell frames); version 10 those of versions 3 to 7 (7: a bottom
+    // bit-plane).
     const auto codec_version_ok = [&](int v) {
-      return out.version >= 8   ? v >= 3
+      return out.version >= 10  ? v >= 3
+             : out.version >= 8 ? v >= 3 && v <= 6
              : out.version >= 6 ? v >= 3 && v <= 5
              : out.version == 5 ? v == 3 || v == 4
              : out.version == 4 ? v == 3

@@ -47,25 +47,29 @@ namespace geomip::codec {
 /// this many bytes of a pack (or all of a shorter source) can always read the fixed header, and the
 /// manifest always ends at or after it.
 inline constexpr std::size_t kPackHeaderSize = 20;
-/// Format version written. Version 9 (this one): version 8 with a fourth form of seam table, the code of a
-/// closed genus-0 quad layout in canonical order (layout_code.h: about 4 bits per quad; the armadillo's
-/// 64-patch table 139 → 29 bytes; PackWriteOptions::canonical_layout puts a layout in that order). Version 8:
-/// version 7 with codec headers of version 6 too (cell frames: local frames from the coarse grid's normals
-/// and a table of octahedral cells; geometry_codec.cpp, docs/codec-v3.md "Cell frames"; the same container).
-/// Version 7: version 6 with compact seam tables — a codec header's seams follow it as "the same as the
-/// header before", one entry per side pair bit-packed (every layout's table), or the explicit list (pack.cpp,
-/// write_seams; docs/codec-v3.md "Seam tables"): the four animals with a 64-quad layout at level 8 show their
-/// first level of detail after 609 bytes instead of 3,554 (manifest 511 bytes instead of 3,456). Version 6:
-/// version 4's container, codec headers of versions 3 to 5 (the encoder writes 5: the geometry's wavelet
-/// filter kCubicLong, docs/codec-v3.md "Longer lifting filters"). Version 5: the same container, codec
-/// headers of versions 3 and 4 (4: the wavelet's lifting update, docs/codec-v3.md "Lifting update"); each
-/// bump lets an older reader say "unsupported version" instead of failing on the codec header. Version 4: the
-/// header diet — CRC32 trailers per chunk group instead of a CRC per chunk in the up-front table, a varint
-/// manifest size, compact doubles and codec headers (above); codec headers of version 3. Version 3: codec
-/// header version 3 (local frames, orientation weights; docs/codec-v3.md). Version 2: bit-plane segments hold
-/// one stream per patch (codec header version 2), decoded in parallel. Version 1: one joint stream per
-/// segment. Versions 1–8 are still read. "Version 4" in the layout notes means versions 4 and later.
-inline constexpr std::uint16_t kPackVersion = 9;
+/// Format version written. Version 10 (this one): version 9 with codec headers of version 7 too (a bottom
+/// bit-plane: the samples quantized GeometryCodecOptions::headroom_bits finer and the stream ending that many
+/// weighted planes above plane 0, so the coarse bands keep more precision for the same bytes;
+/// docs/codec-v3.md, "Headroom for the coarse bands"; the same container). Version 9: version 8 with a fourth
+/// form of seam table, the code of a closed genus-0 quad layout in canonical order (layout_code.h: about 4
+/// bits per quad; the armadillo's 64-patch table 139 → 29 bytes; PackWriteOptions::canonical_layout puts a
+/// layout in that order). Version 8: version 7 with codec headers of version 6 too (cell frames: local frames
+/// from the coarse grid's normals and a table of octahedral cells; geometry_codec.cpp, docs/codec-v3.md "Cell
+/// frames"; the same container). Version 7: version 6 with compact seam tables — a codec header's seams
+/// follow it as "the same as the header before", one entry per side pair bit-packed (every layout's table),
+/// or the explicit list (pack.cpp, write_seams; docs/codec-v3.md "Seam tables"): the four animals with a
+/// 64-quad layout at level 8 show their first level of detail after 609 bytes instead of 3,554 (manifest 511
+/// bytes instead of 3,456). Version 6: version 4's container, codec headers of versions 3 to 5 (the encoder
+/// writes 5: the geometry's wavelet filter kCubicLong, docs/codec-v3.md "Longer lifting filters"). Version 5:
+/// the same container, codec headers of versions 3 and 4 (4: the wavelet's lifting update, docs/codec-v3.md
+/// "Lifting update"); each bump lets an older reader say "unsupported version" instead of failing on the
+/// codec header. Version 4: the header diet — CRC32 trailers per chunk group instead of a CRC per chunk in
+/// the up-front table, a varint manifest size, compact doubles and codec headers (above); codec headers of
+/// version 3. Version 3: codec header version 3 (local frames, orientation weights; docs/codec-v3.md).
+/// Version 2: bit-plane segments hold one stream per patch (codec header version 2), decoded in parallel.
+/// Version 1: one joint stream per segment. Versions 1–9 are still read. "Version 4" in the layout notes
+/// means versions 4 and later.
+inline constexpr std::uint16_t kPackVersion = 10;
 inline constexpr std::uint16_t kOldestPackVersion = 1;
 
 enum class ChunkKind : std::uint8_t {
@@ -138,11 +142,13 @@ struct PackModelInput {
 };
 
 struct PackWriteOptions {
-  GeometryCodecOptions geometry;  ///< defaults: 14 bits, cubic interpolating wavelet
+  GeometryCodecOptions geometry;  ///< defaults: 14 bits with 4 of headroom, the kCubicLong wavelet
   /// Normal maps: no local frames (they are unit vectors, not displacements on a surface); the lifting update
   /// on (bunny: 20 % lower mean angular error at 10–80 KB of normal stream, the same at full decode in 0.98×
   /// the bytes; docs/codec-v3.md, "Lifting update").
+  /// No headroom: unmeasured on normal maps, whose passes interleave with the geometry's by index.
   GeometryCodecOptions normal_codec{.quantization_bits = 10,
+                                    .headroom_bits = 0,
                                     .filter = WaveletFilter::kCubic,
                                     .steps = -1,
                                     .frame_steps = 0,

@@ -46,6 +46,7 @@ struct ConvertArgs {
   bool no_orientation_weights = false;
   bool no_lifting_update = false;
   bool no_cell_frames = false;
+  int headroom_bits = ConvertOptions{}.headroom_bits;
   bool short_filter = false;
   int threads = 0;  ///< --threads: the layout choice's (0 = one per hardware thread)
   bool fit = false;
@@ -181,6 +182,7 @@ int run_convert(const ConvertArgs& args) {
   options.orientation_weights = !args.no_orientation_weights;
   options.lifting_update = !args.no_lifting_update;
   options.cell_frames = !args.no_cell_frames;
+  options.headroom_bits = args.headroom_bits;
   if (args.short_filter) options.filter = codec::WaveletFilter::kCubic;
   // The fit: as asked, else fit_by_default() (--search tries it itself; --choose-loop's loops are of its one
   // mesh).
@@ -462,6 +464,12 @@ CommandRunner add_convert_command(CLI::App& app) {
          "side by side; default: all cores, fewer for meshes of over a million faces); the pack does "
          "not depend on it")
       ->check(CLI::Range(1, 1024));
+  cmd->add_option("--headroom-bits", args->headroom_bits,
+                  "Extra quantization bits of the coarse wavelet bands (default 4; the stream ends where the "
+                  "finest details have --bits): a prefix's error sits in the coarse bands, so these lift the "
+                  "16-32 KB prefixes by 1-2 dB at about the same pack size; 0 = pack format 9's stream "
+                  "(ablations; also 0 with --no-cell-frames)")
+      ->check(CLI::Range(0, 10));
   cmd->add_flag("--no-cell-frames", args->no_cell_frames,
                 "Build the local frames as pack format 7 did (per sample, from the finest reconstruction) "
                 "instead of from the coarse grid and a table of direction cells (ablations; decodes slower; "

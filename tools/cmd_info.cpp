@@ -91,7 +91,7 @@ nlohmann::json pack_info(const std::string& path) {
     mj["name"] = m.name;
     mj["level"] = m.geometry.level;
     mj["patches"] = m.geometry.num_patches;
-    mj["geometry_passes"] = m.geometry.top_bitplane + 1;
+    mj["geometry_passes"] = m.geometry.top_bitplane - m.geometry.bottom_bitplane + 1;
     mj["normals"] = m.has_normals;
     if (m.has_normals) mj["normal_level"] = m.normals.level;
     mj["hole_mask"] = !m.hole_mask.empty();

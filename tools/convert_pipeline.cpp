@@ -127,6 +127,7 @@ codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::s
   write.geometry.orientation_weights = options.orientation_weights;
   write.geometry.lifting_update = options.lifting_update;
   write.geometry.cell_frames = options.cell_frames;
+  write.geometry.headroom_bits = options.cell_frames ? options.headroom_bits : 0;  // version 7 builds on 6
   write.geometry.filter = options.filter;
   return write;
 }

@@ -38,6 +38,9 @@ struct ConvertOptions {
   int normal_level = -1;      ///< normal map level (-1: N+1, at most 10)
   bool normals = true;        ///< false: geometry-only pack
   int quantization_bits = 14; ///< position quantization over the largest bounding-box extent
+  /// The coarse bands' extra bits (codec::GeometryCodecOptions::headroom_bits; 4 by default, 0 without cell
+  /// frames).
+  int headroom_bits = codec::GeometryCodecOptions{}.headroom_bits;
   /// Normal-map quantization bits over the largest extent of the normals' components
   /// (codec::PackWriteOptions:: normal_codec; 10 by default). Each bit fewer costs about 0.8× the normal
   /// bytes of a whole pack and raises its shading error (docs/codec-v3.md, "Shading error" and "Normal maps

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -77,6 +78,7 @@ TEST(GeometryCodec, AllSegmentsReconstructWithinHalfAStep) {
         options.filter = filter;
         options.steps = steps;
         options.frame_steps = 0;  // lossless up to the quantization only in xyz (frames round)
+        options.headroom_bits = 0;  // and with every plane coded
         const auto enc = encode_geometry(patches, seams, options);
         DecodedGeometry dec;
         const auto segs = first_segments(enc, enc.segments.size());
@@ -128,7 +130,7 @@ TEST(GeometryCodec, EveryBytePrefixDecodesWatertight) {
   for (int frames : {0, 3}) {
     std::vector<PatchSeam> seams;
     const auto patches = two_patch_surface(4, seams);
-    GeometryCodecOptions options{12, WaveletFilter::kCubic, -1};
+    GeometryCodecOptions options{.quantization_bits = 12, .filter = WaveletFilter::kCubic, .steps = -1};
     options.frame_steps = frames;
     options.tangential_shift = frames > 0 ? 2 : 0;
     const auto enc = encode_geometry(patches, seams, options);
@@ -150,6 +152,72 @@ TEST(GeometryCodec, EveryBytePrefixDecodesWatertight) {
   }
 }
 
+/// The decode of the first `bytes` bytes of the stream (whole segments, then a prefix of the next).
+DecodedGeometry decode_prefix(const EncodedGeometry& enc, std::size_t bytes) {
+  std::size_t k = 0;
+  while (k < enc.segments.size() && enc.segments[k].size() <= bytes) bytes -= enc.segments[k++].size();
+  const std::span<const std::uint8_t> tail =
+      k < enc.segments.size() ? std::span<const std::uint8_t>(enc.segments[k].data(), bytes)
+                              : std::span<const std::uint8_t>();
+  DecodedGeometry dec;
+  EXPECT_EQ(decode_geometry(enc.header, first_segments(enc, k), tail, dec), Status::kOk);
+  return dec;
+}
+
+std::size_t total_bytes(const EncodedGeometry& enc) {
+  std::size_t t = 0;
+  for (const auto& s : enc.segments) t += s.size();
+  return t;
+}
+
+// Headroom (codec header version 7): the samples are quantized headroom_bits finer and the stream stops that
+// many weighted planes above 0. The finest band then keeps about quantization_bits of precision, the coarser
+// bands (weighted higher) more, which is what a prefix needs: at every byte count from a tenth of the
+// no-headroom stream up to its whole length, the headroom stream's prefix is at least as close to the
+// surface, and at the no-headroom stream's whole length clearly closer, at about the same total bytes.
+TEST(GeometryCodec, HeadroomKeepsTheCoarseBandsFinerForTheSameBytes) {
+  std::vector<PatchSeam> seams;
+  const auto patches = two_patch_surface(6, seams);
+  GeometryCodecOptions plain;
+  plain.quantization_bits = 12;
+  plain.headroom_bits = 0;
+  GeometryCodecOptions room = plain;
+  room.headroom_bits = 4;
+  const EncodedGeometry a = encode_geometry(patches, seams, plain), b = encode_geometry(patches, seams, room);
+  EXPECT_EQ(a.header.version, 6);
+  EXPECT_EQ(a.header.bottom_bitplane, 0);
+  ASSERT_EQ(b.header.version, 7);
+  EXPECT_EQ(b.header.bottom_bitplane, 4);
+  EXPECT_DOUBLE_EQ(b.header.step * 16, a.header.step);
+  EXPECT_EQ(b.segments.size(),
+            static_cast<std::size_t>(b.header.top_bitplane - b.header.bottom_bitplane + 1));
+  GeometryCodecHeader parsed;
+  ASSERT_EQ(GeometryCodecHeader::parse(b.header.serialize(), parsed), Status::kOk);
+  EXPECT_EQ(parsed.bottom_bitplane, 4);
+  const std::size_t total_a = total_bytes(a), total_b = total_bytes(b);
+  EXPECT_LT(static_cast<double>(total_b), 1.25 * static_cast<double>(total_a));
+  // Whole streams: the plain one lossless up to its (frame-rounded) quantization, the headroom one within a
+  // few of the plain steps, both complete and watertight.
+  const DecodedGeometry whole_b = decode_prefix(b, total_b);
+  EXPECT_EQ(whole_b.segments_complete, b.segments.size());
+  EXPECT_FALSE(whole_b.partial);
+  expect_watertight(whole_b.patches, seams);
+  EXPECT_LE(max_error(whole_b.patches, patches), 8 * a.header.step);
+  double worst_ratio = 0;
+  for (int tenth = 1; tenth <= 10; ++tenth) {
+    const std::size_t bytes = total_a * static_cast<std::size_t>(tenth) / 10;
+    const double ea = rms_error(decode_prefix(a, bytes).patches, patches);
+    const DecodedGeometry pb = decode_prefix(b, bytes);
+    expect_watertight(pb.patches, seams);
+    const double eb = rms_error(pb.patches, patches);
+    worst_ratio = std::max(worst_ratio, eb / ea);
+    if (tenth == 10) EXPECT_LT(eb, 0.8 * ea) << "at the plain stream's whole length";
+  }
+  EXPECT_LE(worst_ratio, 1.02);
+  std::printf("[ figures  ] headroom 4: %zu vs %zu bytes in all; prefix RMS at most %.3fx the plain's\n",
+              total_b, total_a, worst_ratio);
+}
+
 TEST(GeometryCodec, DroppingFinestStepsStaysWatertightAndLowersDetailLevel) {
   std::vector<PatchSeam> seams;
   const auto patches = two_patch_surface(5, seams);
@@ -157,6 +225,7 @@ TEST(GeometryCodec, DroppingFinestStepsStaysWatertightAndLowersDetailLevel) {
   for (bool update : {false, true}) {
     GeometryCodecOptions o;
     o.frame_steps = 0;  // exact coarse samples need exact (xyz) coefficients
+    o.headroom_bits = 0;
     o.lifting_update = update;
     const auto enc = encode_geometry(patches, seams, o);
     const auto segs = first_segments(enc, enc.segments.size());
@@ -414,6 +483,7 @@ TEST(GeometryCodec, GoldenStreamIsStable) {
       for (bool v3_tools : {false, true}) {
         GeometryCodecOptions o;
         o.quantization_bits = 6;  // extent 64: step 1
+        o.headroom_bits = 0;      // the stream of codec header version 6
         o.filter = filter;
         o.frame_steps = v3_tools ? 3 : 0;
         o.tangential_shift = v3_tools ? 1 : 0;
@@ -535,15 +605,10 @@ std::vector<Grid3> noisy_plane(double a, bool normal_detail) {
   return g;
 }
 
-std::size_t total_bytes(const EncodedGeometry& enc) {
-  std::size_t t = 0;
-  for (const auto& s : enc.segments) t += s.size();
-  return t;
-}
-
 GeometryCodecOptions framed(int frame_steps, int shift) {
   GeometryCodecOptions o;
   o.quantization_bits = 12;
+  o.headroom_bits = 0;  // every plane: near-lossless bounds in the header's step
   o.frame_steps = frame_steps;
   o.tangential_shift = shift;
   return o;
@@ -638,6 +703,7 @@ TEST(GeometryCodec, OrientationWeightsStayLossless) {
   const auto patches = two_patch_surface(5, seams);
   GeometryCodecOptions o;
   o.frame_steps = 0;
+  o.headroom_bits = 0;
   o.orientation_weights = true;
   const auto enc = encode_geometry(patches, seams, o);
   EXPECT_TRUE(enc.header.orientation_weights);

@@ -206,9 +206,13 @@ PackModelInput turned_pillow_model(int level, const std::string& name) {
 }
 
 TEST(Pack, LayoutCodesNeedFormat9) {
-  // The pillow's table is a layout code in canonical order already: format 9 stores it as one.
-  std::vector<std::uint8_t> pack = write_pack({pillow_model(4, "a")}, geometry_only());
-  ASSERT_EQ(kPackVersion, 9);
+  // The pillow's table is a layout code in canonical order already: format 9 stores it as one. Without
+  // headroom (codec header 6) a format-10 writer's pack is format 9's but for the version byte.
+  PackWriteOptions no_headroom = geometry_only();
+  no_headroom.geometry.headroom_bits = 0;
+  std::vector<std::uint8_t> pack = write_pack({pillow_model(4, "a")}, no_headroom);
+  ASSERT_EQ(kPackVersion, 10);
+  pack[8] = 9;
   ASSERT_EQ(decode_pack(pack).status, Status::kOk);
   std::vector<std::uint8_t> as8 = pack;
   as8[8] = 8;  // the manifest's CRC does not cover the version
@@ -216,7 +220,8 @@ TEST(Pack, LayoutCodesNeedFormat9) {
   // The turned pillow's table is not: stored as format 7 did, it reads as format 8 too.
   const PackModelInput turned = turned_pillow_model(4, "a");
   ASSERT_EQ(test::seam_mismatches(turned.geometry, turned.seams), 0u);
-  std::vector<std::uint8_t> other = write_pack({turned}, geometry_only());
+  std::vector<std::uint8_t> other = write_pack({turned}, no_headroom);
+  other[8] = 9;
   const PackDecodeResult as9 = decode_pack(other);
   ASSERT_EQ(as9.status, Status::kOk);
   other[8] = 8;
@@ -224,15 +229,39 @@ TEST(Pack, LayoutCodesNeedFormat9) {
   ASSERT_EQ(relabelled.status, Status::kOk);
   EXPECT_EQ(relabelled.models.at(0).geometry[1].values, as9.models.at(0).geometry[1].values);
   // With canonical_layout the writer turns it back: the code again, and the pillow's own grids.
-  PackWriteOptions o = geometry_only();
+  PackWriteOptions o = no_headroom;
   o.canonical_layout = true;
-  EXPECT_EQ(write_pack({turned}, o), pack);
+  std::vector<std::uint8_t> canonical = write_pack({turned}, o);
+  canonical[8] = 9;
+  EXPECT_EQ(canonical, pack);
+}
+
+TEST(Pack, HeadroomNeedsFormat10) {
+  // The default writer's geometry has headroom (codec header 7, a bottom bit-plane): format 10 only.
+  std::vector<std::uint8_t> pack = write_pack({pillow_model(5, "a")}, geometry_only());
+  PackInfo info;
+  ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
+  EXPECT_EQ(info.version, 10);
+  const GeometryCodecHeader& h = info.models.at(0).geometry;
+  EXPECT_EQ(h.version, 7);
+  EXPECT_EQ(h.bottom_bitplane, GeometryCodecOptions{}.headroom_bits);
+  EXPECT_GT(h.bottom_bitplane, 0);
+  // The whole pack decodes complete (not "truncated" for the planes below the bottom one), near-losslessly.
+  const PackDecodeResult whole = decode_pack(pack);
+  ASSERT_EQ(whole.status, Status::kOk);
+  EXPECT_EQ(whole.models.at(0).geometry_passes,
+            static_cast<std::size_t>(h.top_bitplane - h.bottom_bitplane + 1));
+  EXPECT_LE(max_error(whole.models.at(0).geometry, pillow_model(5, "a").geometry), 8.0 * 2.0 / 16384.0);
+  std::vector<std::uint8_t> as9 = pack;
+  as9[8] = 9;  // the manifest's CRC does not cover the version
+  EXPECT_EQ(decode_pack(as9).status, Status::kCorrupt);
 }
 
 TEST(Pack, CellFramesNeedFormat8) {
   for (const bool cells : {true, false}) {
     PackWriteOptions o = geometry_only();
     o.geometry.cell_frames = cells;
+    o.geometry.headroom_bits = 0;  // codec header 6 (7 builds on it)
     std::vector<std::uint8_t> pack = write_pack({turned_pillow_model(4, "a")}, o);
     PackInfo info;
     ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
@@ -710,7 +739,8 @@ TEST(Pack, ManifestByteChangesAreRefusedOrReadAsValid) {
 // version 5: codec header version 4, the lifting update; golden-pillow-v6.gip by version 6: codec header
 // version 5, the filter kCubicLong; golden-pillow-v7.gip by version 7: compact seam tables;
 // golden-pillow-v8.gip by version 8: codec header version 6, cell frames; golden-pillow-v9.gip by version 9:
-// the two squares' seam table as a layout code) must keep decoding to
+// the two squares' seam table as a layout code; golden-pillow-v10.gip by version 10: codec header version 7,
+// a bottom bit-plane 4 planes up) must keep decoding to
 // the pillow they were made from: decoders of old streams do not silently change.
 class GoldenPack : public ::testing::TestWithParam<std::pair<const char*, int>> {};
 
@@ -723,12 +753,14 @@ TEST_P(GoldenPack, Decodes) {
   PackInfo info;
   ASSERT_EQ(read_pack_info(pack, info), Status::kOk);
   EXPECT_EQ(info.version, version);
-  EXPECT_EQ(info.models.at(0).geometry.version, version >= 8   ? 6
+  EXPECT_EQ(info.models.at(0).geometry.version, version >= 10  ? 7
+                                                : version >= 8 ? 6
                                                 : version >= 6 ? 5
                                                 : version >= 5 ? 4
                                                                : std::min(version, 3));
   EXPECT_EQ(info.models.at(0).geometry.filter, version >= 6 ? WaveletFilter::kCubicLong : WaveletFilter::kCubic);
   EXPECT_EQ(info.models.at(0).geometry.lifting_update, version >= 5);
+  EXPECT_EQ(info.models.at(0).geometry.bottom_bitplane, version >= 10 ? 4 : 0);
   const PackDecodeResult r = decode_pack(pack);
   ASSERT_EQ(r.status, Status::kOk);
   ASSERT_EQ(r.models.size(), 2u);
@@ -760,7 +792,8 @@ INSTANTIATE_TEST_SUITE_P(Versions, GoldenPack,
                                            std::pair<const char*, int>{"golden-pillow-v6.gip", 6},
                                            std::pair<const char*, int>{"golden-pillow-v7.gip", 7},
                                            std::pair<const char*, int>{"golden-pillow-v8.gip", 8},
-                                           std::pair<const char*, int>{"golden-pillow-v9.gip", 9}));
+                                           std::pair<const char*, int>{"golden-pillow-v9.gip", 9},
+                                           std::pair<const char*, int>{"golden-pillow-v10.gip", 10}));
 
 }  // namespace
 }  // namespace geomip::codec

@@ -1435,13 +1435,21 @@ TEST_F(CliPack, CodecSwitchesForAblations) {
     }
     return largest / step;
   };
-  EXPECT_LE(largest_offset_in_steps("--frame-steps 0 --no-orientation-weights"), 0.5 + 1e-6);
-  EXPECT_LE(largest_offset_in_steps("--frame-steps 0"), 0.5 + 1e-6);
-  EXPECT_GT(largest_offset_in_steps("--frame-steps 3 --tangential-shift 2"), 0.5);
+  EXPECT_LE(largest_offset_in_steps("--frame-steps 0 --no-orientation-weights --headroom-bits 0"),
+            0.5 + 1e-6);
+  EXPECT_LE(largest_offset_in_steps("--frame-steps 0 --headroom-bits 0"), 0.5 + 1e-6);
+  EXPECT_GT(largest_offset_in_steps("--frame-steps 3 --tangential-shift 2 --headroom-bits 0"), 0.5);
+  // With the default headroom the finest band loses its last 4 of 18 bits (reconstructed at the middle):
+  // no longer within half a 14-bit step, but within two.
+  const double headroom = largest_offset_in_steps("--frame-steps 0");
+  EXPECT_GT(headroom, 0.5);
+  EXPECT_LE(headroom, 2.0);
   const std::string pack = dir_ + "/bad.gip";
   expect_bad_input("convert -q '" + spot_ + "' --level 4 --frame-steps 5 -o '" + pack + "'", "--frame-steps");
   expect_bad_input("convert -q '" + spot_ + "' --level 4 --tangential-shift 9 -o '" + pack + "'",
                    "--tangential-shift");
+  expect_bad_input("convert -q '" + spot_ + "' --level 4 --headroom-bits 11 -o '" + pack + "'",
+                   "--headroom-bits");
 }
 
 // convert --normal-bits B: the normal maps are quantized with B bits instead of 10 — a smaller pack whose
@@ -2088,11 +2096,15 @@ TEST_F(CliPack, InfoDescribesAPack) {
   EXPECT_EQ(j["models"][0]["patches"], 2);
   EXPECT_EQ(j["models"][0]["normals"], true);
   std::uint64_t previous = j["manifest_bytes"];
+  int geometry_chunks = 0;
   for (const auto& c : j["chunks"]) {
     EXPECT_EQ(c["cumulative"].get<std::uint64_t>(), previous + c["bytes"].get<std::uint64_t>());
     previous = c["cumulative"];
+    geometry_chunks += c["kind"] == "geometry";
   }
   EXPECT_EQ(previous, fs::file_size(pack));
+  // One chunk per geometry pass (with headroom the passes end above weighted plane 0).
+  EXPECT_EQ(j["models"][0]["geometry_passes"].get<int>(), geometry_chunks);
   const std::uint64_t first = j["first_level_bytes"];
   EXPECT_LT(first, fs::file_size(pack));
   EXPECT_EQ(geomip("decode -q '" + pack + "' --bytes " + std::to_string(first) + " -o '" + dir_ + "/first.obj'").exit_code, 0);

@@ -23,7 +23,8 @@ namespace {
 // Version 1: one joint bit-plane stream for all patches; version 2: a stream per patch (parallel decoding);
 // version 3: version 2 plus local frames and orientation weights; version 4: version 3 plus the lifting
 // update flag (bit 1 of the flags byte); version 5: version 4 plus the filter kCubicLong; version 6: version
-// 5 with cell frames (see "Local frames" below).
+// 5 with cell frames (see "Local frames" below); version 7: version 6 with a bottom bit-plane (a varint after
+// the top one; GeometryCodecOptions::headroom_bits), written only when it is above 0.
 constexpr std::uint8_t kHeaderVersion = 7;
 constexpr int kMaxTangentialShift = 8;
 constexpr int kMaxLevel = 12;

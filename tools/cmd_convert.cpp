@@ -47,6 +47,8 @@ struct ConvertArgs {
   bool no_lifting_update = false;
   bool no_cell_frames = false;
   int headroom_bits = ConvertOptions{}.headroom_bits;
+  int normal_headroom_bits = ConvertOptions{}.normal_headroom_bits;
+  bool normal_headroom_given = false;  ///< --normal-headroom-bits on the command line
   bool short_filter = false;
   int threads = 0;  ///< --threads: the layout choice's (0 = one per hardware thread)
   bool fit = false;
@@ -114,6 +116,9 @@ int run_convert(const ConvertArgs& args) {
   check_level_options(args, level);
   check_quantization_switches(args.quantization_bits, args.normal_bits, args.normal_bits_given,
                               args.no_normals);
+  if (args.no_normals && args.normal_headroom_given)
+    throw InvalidInput(
+        "--normal-headroom-bits sets the normal maps' headroom, and --no-normals writes none: drop one");
   if (args.no_normals && args.normal_level >= 0)
     throw InvalidInput("--normal-level sets the normal maps' level, and --no-normals writes none: drop one");
   if (args.tangential_shift < 0 || args.tangential_shift > 8)
@@ -168,6 +173,7 @@ int run_convert(const ConvertArgs& args) {
   options.normals = !args.no_normals;
   options.quantization_bits = args.quantization_bits;
   options.normal_bits = args.normal_bits;
+  options.normal_headroom_bits = args.normal_headroom_bits;
   options.hole_mask_level = args.hole_mask_level;
   options.snap_hole_borders = !args.no_hole_border_snap;
   options.sampling_exponent = args.common.sampling_exponent;
@@ -470,6 +476,16 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "16-32 KB prefixes by up to 2.3 dB at about the same pack size; 0 = pack format 9's stream "
                   "(ablations; also 0 with --no-cell-frames)")
       ->check(CLI::Range(0, 10));
+  CLI::Option* normal_headroom =
+      cmd->add_option(
+             "--normal-headroom-bits", args->normal_headroom_bits,
+             "Extra quantization bits of the normal maps' coarse bands, as --headroom-bits for the geometry "
+             "(default 4: streamed prefixes of the normal maps up to 38 % closer in angle, the whole normal "
+             "stream "
+             "0.90-0.99x the bytes at a mean error of about 0.05 degrees instead of 0.042; 0 = 10 bits "
+             "lossless, "
+             "the normal maps of packs before 2026-12-07)")
+          ->check(CLI::Range(0, 8));
   cmd->add_flag("--no-cell-frames", args->no_cell_frames,
                 "Build the local frames as pack format 7 did (per sample, from the finest reconstruction) "
                 "instead of from the coarse grid and a table of direction cells (ablations; decodes slower; "
@@ -503,8 +519,9 @@ CommandRunner add_convert_command(CLI::App& app) {
                   "camera): +x, -x, +y, -y, +z or -z, across the up axis. Default: from the first model's "
                   "shape (docs/streaming.md, \"Upright and front\")")
       ->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
-  return [args, level, frame_steps, normal_bits, fit] {
+  return [args, level, frame_steps, normal_bits, normal_headroom, fit] {
     args->level_given = level->count() > 0;
+    args->normal_headroom_given = normal_headroom->count() > 0;
     args->frame_steps_given = frame_steps->count() > 0;
     args->normal_bits_given = normal_bits->count() > 0;
     args->fit_given = fit->count() > 0;

@@ -122,6 +122,7 @@ codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::s
   write.normals = options.normals;
   write.geometry.quantization_bits = options.quantization_bits;
   write.normal_codec.quantization_bits = options.normal_bits;
+  write.normal_codec.headroom_bits = options.normal_headroom_bits;
   write.geometry.frame_steps = options.frame_steps;
   write.geometry.tangential_shift = options.tangential_shift;
   write.geometry.orientation_weights = options.orientation_weights;

@@ -46,6 +46,10 @@ struct ConvertOptions {
   /// bytes of a whole pack and raises its shading error (docs/codec-v3.md, "Shading error" and "Normal maps
   /// of a shape moved to 16 patches"); a streamed prefix is hardly affected (the bottom planes come last).
   int normal_bits = codec::PackWriteOptions{}.normal_codec.quantization_bits;
+  /// The normal maps' headroom (codec::PackWriteOptions::normal_codec; 4 by default, as the geometry's):
+  /// every streamed prefix of the normal maps closer, the whole stream a little smaller and a little less
+  /// exact than 0's (10 bits lossless).
+  int normal_headroom_bits = codec::PackWriteOptions{}.normal_codec.headroom_bits;
   /// Codec tools of the geometry stream (codec::GeometryCodecOptions: local frames of the finest
   /// frame_steps wavelet steps, their tangential components 2^tangential_shift coarser, orientation
   /// weights, the wavelet's lifting update). The defaults are the codec's; the switches exist for ablations

@@ -14,7 +14,7 @@
 //
 // Angular error of decoded normal maps: the packs' xyz coding against two-channel codings (normal-byte
 // budgets), and today's pack at file prefixes (normals_report.cpp):
-//   codec_bench --normals MESH.obj [--bits B,...] [--normal-mesh K] [--base BYTES]
+//   codec_bench --normals MESH.obj [--bits B,...] [--headroom H] [--normal-mesh K] [--base BYTES]
 //
 // For instruction counts (valgrind --tool=callgrind, repeatable on a shared machine), one decode on one
 // thread:
@@ -22,7 +22,8 @@
 // (full: decode_pack; increments: 64 PackDecoder updates, models at the end; shown: models after each).
 // Draco's side of the same count: the mesh encoded as in --stream (14 bits, level 10), then decoded once by
 // geomip::draco_decode (bitstream → geomip mesh); count only that call:
-//   valgrind --tool=callgrind --toggle-collect='geomip::draco_decode*' codec_bench --draco-decode-once MESH.obj
+//   valgrind --tool=callgrind --toggle-collect='geomip::draco_decode*' codec_bench --draco-decode-once
+//   MESH.obj
 //
 // Rate–distortion report instead of benchmarks:
 //   codec_bench --rd FILE.geometry.exr|synthetic [--filter linear|cubic|both] [--steps N] [--bits B] [--mesh

@@ -1,13 +1,14 @@
-// codec_bench --normals MESH.obj [--bits B,...] [--normal-mesh K] [--base BYTES]: the angular error of decoded normal maps
-// (docs/codec-v3.md, "Normal maps: two-channel codings"). MESH goes through `geomip convert`'s pipeline once
-// (default options: level 8, normal maps at level 9, hole masks; --normal-mesh as convert's); its
-// uncompressed normal maps are the reference. Errors are the mean /
-// 95th percentile / max angle in degrees between decoded and reference normals over all texels not in a
-// filled hole (a texel counts as the quad it is the lower-left corner of; the last row and column use the
-// quad before). Printed:
+// codec_bench --normals MESH.obj [--bits B,...] [--headroom H] [--normal-mesh K] [--base BYTES]: the angular
+// error of decoded normal maps (docs/codec-v3.md, "Normal maps: two-channel codings"). MESH goes through
+// `geomip convert`'s pipeline once (default options: level 8, normal maps at level 9, hole masks;
+// --normal-mesh as convert's); its uncompressed normal maps are the reference. Errors are the mean / 95th
+// percentile / max angle in degrees between decoded and reference normals over all texels not in a filled
+// hole (a texel counts as the quad it is the lower-left corner of; the last row and column use the quad
+// before). Printed:
 //   - the error of the fully decoded geometry's own normals (no normal map at all);
 //   - the normal stream alone (model 0), per quantization (--bits, default 10), at normal-byte budgets
-//     (complete segments plus a prefix of the next): xyz (the packs' coding), octahedral in one global frame,
+//     (complete segments plus a prefix of the next): xyz (the packs' coding, headroom included), xyz without
+//     headroom and with headroom H (--headroom, default 2), octahedral in one global frame,
 //     the residual against the fully decoded geometry, and two layers: the first BYTES of the xyz stream
 //     (--base, default 20000) as the frames' normal, then the residual in those frames (normal_codings.h);
 //   - today's pack (write_pack() defaults): the full pack and file prefixes of it, with the normal-chunk
@@ -121,7 +122,7 @@ void normalize_grid(Grid3& g) {
 /// channels, seams shared), xyz with the geometry's longer filter kCubicLong, octahedral in one global frame (2 channels; a flat grid's frames are the xyz
 /// axes), the residual against the fully decoded geometry, and two layers — the first `base_bytes` of the
 /// xyz stream, then the residual against their normals (bytes: both layers; normal_codings.h).
-void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes) {
+void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes, int headroom) {
   const GeometryCodecOptions codec = PackWriteOptions{}.normal_codec;
   GeometryCodecOptions options = codec;
   options.quantization_bits = bits;
@@ -150,9 +151,16 @@ void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes) {
   for (Grid3& g : axes) normalize_grid(g);
   GeometryCodecOptions long_filter = options;  // the geometry's 6-point / 4-tap filter (pack format 6)
   long_filter.filter = WaveletFilter::kCubicLong;
+  GeometryCodecOptions headroom0 = options, other = options;  // other headrooms (pack format 10)
+  headroom0.headroom_bits = 0;
+  other.headroom_bits = headroom;
+  char other_name[32];
+  std::snprintf(other_name, sizeof other_name, "xyz head %d", headroom);
   const Variant variants[] = {
       {"xyz", encode_geometry(in.normals, in.seams, options), nullptr, {}},
       {"xyz+long", encode_geometry(in.normals, in.seams, long_filter), nullptr, {}},
+      {"xyz head 0", encode_geometry(in.normals, in.seams, headroom0), nullptr, {}},
+      {other_name, encode_geometry(in.normals, in.seams, other), nullptr, {}},
       {"octahedral", encode_geometry(normal_residual(in.normals, flat, {}), {}, options), &flat, {}},
       {"residual", encode_geometry(normal_residual(in.normals, decoded_geometry, along), {}, options),
        &decoded_geometry, along},
@@ -163,7 +171,8 @@ void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes) {
               "coding", "bytes", "mean°", "p95°", "max°");
   for (const Variant& v : variants) {
     const std::size_t total = v.base_bytes + stream_bytes(v.encoded);
-    for (std::size_t budget : {10000, 20000, 40000, 80000, 160000, 320000, 400000, 450000, 500000, 0}) {
+    for (std::size_t budget :
+         {10000, 20000, 40000, 80000, 160000, 320000, 400000, 450000, 500000, 550000, 575000, 600000, 0}) {
       if (budget >= total || (budget != 0 && budget <= v.base_bytes)) continue;
       const std::size_t b = budget == 0 ? total : budget;
       std::vector<Grid3> normals = decode_budget(v.encoded, b - v.base_bytes);
@@ -186,9 +195,11 @@ int normals_report(int argc, char** argv) {
   std::vector<int> bits_list = {10};
   int normal_mesh_steps = geomip::tools::ConvertOptions{}.normal_mesh_steps;
   std::size_t base_bytes = 20000;
+  int headroom = 2;
   for (int i = 3; i + 1 < argc; ++i) {
     if (std::strcmp(argv[i], "--normal-mesh") == 0) normal_mesh_steps = std::atoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--base") == 0) base_bytes = static_cast<std::size_t>(std::atol(argv[i + 1]));
+    if (std::strcmp(argv[i], "--headroom") == 0) headroom = std::atoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--bits") == 0) {
       bits_list.clear();
       for (const char* p = argv[i + 1]; *p;) {
@@ -213,7 +224,7 @@ int normals_report(int argc, char** argv) {
     std::printf("the fully decoded geometry's own normals: mean %.3f°, p95 %.3f°, max %.2f°\n", st.mean, st.p95,
                 st.max);
   }
-  for (int bits : bits_list) stream_report(in[0], bits, base_bytes);
+  for (int bits : bits_list) stream_report(in[0], bits, base_bytes, headroom);
   std::printf("today's pack (xyz normal maps, %d bits), all models\n  %-14s %9s %9s   %7s %7s %7s\n",
               PackWriteOptions{}.normal_codec.quantization_bits, "decode", "bytes", "normal B", "mean°", "p95°",
               "max°");

@@ -13,8 +13,11 @@
 // the lifting update), pillow-l4-per-patch-v6.gip (format 6, the filter kCubicLong),
 // pillow-l4-per-patch-v7.gip (format 7, compact seam tables), pillow-l4-per-patch-v8.gip (format 8, cell
 // frames), pillow-l4-per-patch-v9.gip (format 9, the seam table as a layout code),
-// pillow-l4-per-patch-v10.gip (format 10, a bottom bit-plane: the geometry's last 4 planes not coded):
-//   ./build/tests/make_golden_pack --per-patch tests/fuzz/seeds/pack/pillow-l4-per-patch-v10.gip
+// pillow-l4-per-patch-v10.gip (format 10, a bottom bit-plane: the geometry's last 4 planes not coded),
+// pillow-l4-per-patch-v10-normal-headroom.gip (format 10 as written since 2026-12-07: the normal maps' last
+// 4 planes not coded either):
+//   ./build/tests/make_golden_pack --per-patch
+//   tests/fuzz/seeds/pack/pillow-l4-per-patch-v10-normal-headroom.gip
 // With --layout, a fuzzer seed whose seam tables are long: two models of 24 level-2 patches glued in random
 // side pairs (a quad layout's mirrored table, then a reference to it), normal maps on the first —
 // tests/fuzz/seeds/pack/layout-24-v7.gip (format 7), layout-24-v8.gip (format 8):

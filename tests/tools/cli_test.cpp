@@ -1453,10 +1453,12 @@ TEST_F(CliPack, CodecSwitchesForAblations) {
 }
 
 // convert --normal-bits B: the normal maps are quantized with B bits instead of 10 — a smaller pack whose
-// decoded normals lie within the coarser quantization of the 10-bit pack's (a full decode is lossless up to
-// the quantization, each component within half a step of the unit input, step = extent / 2^B ≤ 2 / 2^B, and
-// is then renormalized: a unit vector off by e ends at most |e| ≤ √3·step/2 (to first order) from the input);
-// the geometry is untouched; out-of-range values and --no-normals exit 2 with one line and nothing written.
+// decoded normals lie within the coarser quantization of the 10-bit pack's (without headroom a full decode
+// is lossless up to the quantization, each component within half a step of the unit input, step = extent /
+// 2^B ≤ 2 / 2^B, and is then renormalized: a unit vector off by e ends at most |e| ≤ √3·step/2 (to first
+// order) from the input); the geometry is untouched; out-of-range values and --no-normals exit 2 with one
+// line and nothing written. --normal-headroom-bits H reaches the normal maps' codec header (the bottom
+// bit-plane; 4 by default), with the same refusals.
 TEST_F(CliPack, NormalBitsQuantizeTheNormalMaps) {
   const auto convert = [&](const std::string& switches, const std::string& name) {
     const std::string pack = dir_ + "/" + name;
@@ -1465,7 +1467,19 @@ TEST_F(CliPack, NormalBitsQuantizeTheNormalMaps) {
     const std::string bytes = slurp(pack);
     return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
   };
-  const std::vector<std::uint8_t> ten = convert("", "n10.gip"), seven = convert("--normal-bits 7", "n7.gip");
+  const std::vector<std::uint8_t> ten = convert("--normal-headroom-bits 0", "n10.gip"),
+                                  seven = convert("--normal-bits 7 --normal-headroom-bits 0", "n7.gip"),
+                                  room = convert("", "n10h.gip"),
+                                  room2 = convert("--normal-headroom-bits 2", "n10h2.gip");
+  const auto bottom_plane = [](const std::vector<std::uint8_t>& pack) {
+    codec::PackInfo info;
+    EXPECT_EQ(codec::read_pack_info(pack, info), codec::Status::kOk);
+    return info.models.at(0).normals.bottom_bitplane;
+  };
+  EXPECT_EQ(bottom_plane(ten), 0);
+  EXPECT_EQ(bottom_plane(seven), 0);
+  EXPECT_EQ(bottom_plane(room), codec::PackWriteOptions{}.normal_codec.headroom_bits);
+  EXPECT_EQ(bottom_plane(room2), 2);
   EXPECT_LT(seven.size(), ten.size() * 9 / 10);
   const codec::PackDecodeResult a = codec::decode_pack(ten), b = codec::decode_pack(seven);
   ASSERT_EQ(a.status, codec::Status::kOk);
@@ -1496,6 +1510,11 @@ TEST_F(CliPack, NormalBitsQuantizeTheNormalMaps) {
                    "--normal-bits");
   expect_bad_input("convert -q '" + spot_ + "' --level 4 --normal-bits 8 --no-normals -o '" + pack + "'",
                    "--normal-bits");
+  expect_bad_input("convert -q '" + spot_ + "' --level 4 --normal-headroom-bits 9 -o '" + pack + "'",
+                   "--normal-headroom-bits");
+  expect_bad_input(
+      "convert -q '" + spot_ + "' --level 4 --normal-headroom-bits 2 --no-normals -o '" + pack + "'",
+      "--normal-headroom-bits");
   EXPECT_FALSE(fs::exists(pack));
 }
 

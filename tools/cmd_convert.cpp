@@ -480,11 +480,9 @@ CommandRunner add_convert_command(CLI::App& app) {
       cmd->add_option(
              "--normal-headroom-bits", args->normal_headroom_bits,
              "Extra quantization bits of the normal maps' coarse bands, as --headroom-bits for the geometry "
-             "(default 4: streamed prefixes of the normal maps up to 38 % closer in angle, the whole normal "
-             "stream "
-             "0.90-0.99x the bytes at a mean error of about 0.05 degrees instead of 0.042; 0 = 10 bits "
-             "lossless, "
-             "the normal maps of packs before 2026-12-07)")
+             "(default 4: streamed prefixes of the normal maps up to 38 % closer in angle, the whole "
+             "normal stream 0.90-0.99x the bytes at a mean error of about 0.05 degrees instead of 0.042; "
+             "0 = 10 bits lossless, the normal maps of packs before 2026-12-07)")
           ->check(CLI::Range(0, 8));
   cmd->add_flag("--no-cell-frames", args->no_cell_frames,
                 "Build the local frames as pack format 7 did (per sample, from the finest reconstruction) "

@@ -22,8 +22,8 @@
 // (full: decode_pack; increments: 64 PackDecoder updates, models at the end; shown: models after each).
 // Draco's side of the same count: the mesh encoded as in --stream (14 bits, level 10), then decoded once by
 // geomip::draco_decode (bitstream → geomip mesh); count only that call:
-//   valgrind --tool=callgrind --toggle-collect='geomip::draco_decode*' codec_bench --draco-decode-once
-//   MESH.obj
+//   valgrind --tool=callgrind --toggle-collect='geomip::draco_decode*'  (one command, continued:)
+//     codec_bench --draco-decode-once MESH.obj
 //
 // Rate–distortion report instead of benchmarks:
 //   codec_bench --rd FILE.geometry.exr|synthetic [--filter linear|cubic|both] [--steps N] [--bits B] [--mesh

@@ -205,22 +205,22 @@ TEST(GeometryCodec, HeadroomKeepsTheCoarseBandsFinerForTheSameBytes) {
   EXPECT_FALSE(whole_b.partial);
   expect_watertight(whole_b.patches, seams);
   EXPECT_LE(max_error(whole_b.patches, patches), 8 * a.header.step);
-  double worst_ratio = 0;
+  double worst_rms_ratio = 0;
   for (int tenth = 1; tenth <= 10; ++tenth) {
     const std::size_t bytes = total_a * static_cast<std::size_t>(tenth) / 10;
     const double ea = rms_error(decode_prefix(a, bytes).patches, patches);
     const DecodedGeometry pb = decode_prefix(b, bytes);
     expect_watertight(pb.patches, seams);
     const double eb = rms_error(pb.patches, patches);
-    worst_ratio = std::max(worst_ratio, eb / ea);
+    worst_rms_ratio = std::max(worst_rms_ratio, eb / ea);
     if (tenth == 10) {
       EXPECT_LT(eb, 0.8 * ea) << "at the plain stream's whole length";
     }
   }
   // A ratio of RMS errors (deterministic for this fixture), not a time.
-  EXPECT_LE(worst_ratio, 1.02);
+  EXPECT_LE(worst_rms_ratio, 1.02);
   std::printf("[ figures  ] headroom 4: %zu vs %zu bytes in all; prefix RMS at most %.3fx the plain's\n",
-              total_b, total_a, worst_ratio);
+              total_b, total_a, worst_rms_ratio);
 }
 
 /// A unit vector field with detail at several scales, a function of the position (so seam samples, which
@@ -275,21 +275,21 @@ TEST(GeometryCodec, NormalMapHeadroomMakesEveryPrefixCloser) {
   const double whole_a = mean_angle(decode_prefix(a, total_a).patches, normals),
                whole_b = mean_angle(decode_prefix(b, total_b).patches, normals);
   EXPECT_LE(whole_b, 1.5 * whole_a);
-  double worst_ratio = 0, ratio_at_90 = 0;
+  double worst_angle_ratio = 0, angle_ratio_at_90 = 0;
   for (int tenth = 1; tenth <= 9; ++tenth) {
     const std::size_t bytes = std::min(total_a * static_cast<std::size_t>(tenth) / 10, total_b);
     const double ea = mean_angle(decode_prefix(a, bytes).patches, normals),
                  eb = mean_angle(decode_prefix(b, bytes).patches, normals);
-    worst_ratio = std::max(worst_ratio, eb / ea);
-    if (tenth == 9) ratio_at_90 = eb / ea;
+    worst_angle_ratio = std::max(worst_angle_ratio, eb / ea);
+    if (tenth == 9) angle_ratio_at_90 = eb / ea;
   }
   // Ratios of mean angles (deterministic for this fixture), not times.
-  EXPECT_LE(worst_ratio, 1.02);
-  EXPECT_LT(ratio_at_90, 0.8);
+  EXPECT_LE(worst_angle_ratio, 1.02);
+  EXPECT_LT(angle_ratio_at_90, 0.8);
   std::printf(
       "[ figures  ] normal headroom %d: %zu vs %zu bytes, whole %.4f vs %.4f deg; prefixes at most "
       "%.3fx the lossless stream's angle, %.3fx at 90 %% of its length\n",
-      room.headroom_bits, total_b, total_a, whole_b, whole_a, worst_ratio, ratio_at_90);
+      room.headroom_bits, total_b, total_a, whole_b, whole_a, worst_angle_ratio, angle_ratio_at_90);
 }
 
 TEST(GeometryCodec, DroppingFinestStepsStaysWatertightAndLowersDetailLevel) {

@@ -16,8 +16,8 @@
 // pillow-l4-per-patch-v10.gip (format 10, a bottom bit-plane: the geometry's last 4 planes not coded),
 // pillow-l4-per-patch-v10-normal-headroom.gip (format 10 as written since 2026-12-07: the normal maps' last
 // 4 planes not coded either):
-//   ./build/tests/make_golden_pack --per-patch
-//   tests/fuzz/seeds/pack/pillow-l4-per-patch-v10-normal-headroom.gip
+//   ./build/tests/make_golden_pack --per-patch  (one command, continued:)
+//     tests/fuzz/seeds/pack/pillow-l4-per-patch-v10-normal-headroom.gip
 // With --layout, a fuzzer seed whose seam tables are long: two models of 24 level-2 patches glued in random
 // side pairs (a quad layout's mirrored table, then a reference to it), normal maps on the first —
 // tests/fuzz/seeds/pack/layout-24-v7.gip (format 7), layout-24-v8.gip (format 8):

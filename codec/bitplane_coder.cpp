@@ -195,6 +195,10 @@ std::vector<Band> make_bands(const BitplaneLayout& layout,
         }
       }
     }
+    // The significant list holds distinct samples: room for all of them up front, so the sorting passes never
+    // grow (copy) it (about as much memory as its growth by doubling would take at the end; where the
+    // allocator maps fresh pages, those never written are never touched).
+    b.lsp.reserve(static_cast<std::size_t>(b.w) * static_cast<std::size_t>(b.h));
     const int top = b.levels - 1;
     if (b.state[b.node(top, 0, 0)] & kActive) b.lis.push_back(pack(top, 0, 0));
   };
@@ -1096,6 +1100,7 @@ struct BitplaneDecoder::State {
   std::size_t planes = 0, joint_planes = 0;  // joint_planes: segments of the joint coder
   int max_threads = 0;
   DecodeHook before_plane;
+  HookViewShift view_shift;
   std::vector<PatchCoefficients> hook_view;  // the hooks' reconstruction: one buffer for all of them
   std::vector<std::vector<std::uint8_t>> coded;
   std::vector<Band> bands;  // never resized after the coders point into it
@@ -1120,7 +1125,7 @@ BitplaneDecoder& BitplaneDecoder::operator=(BitplaneDecoder&&) noexcept = defaul
 
 Status BitplaneDecoder::reset(const BitplaneLayout& layout, int top_bitplane,
                               std::vector<std::vector<std::uint8_t>> coded, int max_threads,
-                              DecodeHook before_plane) {
+                              DecodeHook before_plane, HookViewShift view_shift) {
   s_.reset();
   if (!layout_ok(layout) || coded.size() != static_cast<std::size_t>(layout.num_patches) ||
       top_bitplane < layout.bottom_bitplane || top_bitplane > 64) {
@@ -1139,6 +1144,7 @@ Status BitplaneDecoder::reset(const BitplaneLayout& layout, int top_bitplane,
                          : st->planes;
   st->max_threads = max_threads;
   st->before_plane = std::move(before_plane);
+  st->view_shift = std::move(view_shift);
   st->coded = std::move(coded);
   st->bands = make_bands(layout, st->coded, -1, max_threads);
   st->joint = std::make_unique<PlaneCoder<true>>(layout, st->bands, -1, nullptr);
@@ -1199,7 +1205,7 @@ Status BitplaneDecoder::update(std::span<const std::span<const std::uint8_t>> se
       st.hooks_run = true;
       for (int h : st.hooks) {
         if (static_cast<std::size_t>(st.top - h) == a && st.before_plane) {
-          reconstruct(st.hook_view);
+          reconstruct_view(st.hook_view, st.view_shift ? st.view_shift(h) : 0);
           st.before_plane(h, st.hook_view);
           ++st.hook_version;
         }
@@ -1264,15 +1270,31 @@ void BitplaneDecoder::reconstruct(std::vector<PatchCoefficients>& out) const {
     out.clear();
     return;
   }
+  reconstruct_view(out, 0);
+}
+
+void BitplaneDecoder::reconstruct_view(std::vector<PatchCoefficients>& out, int shift) const {
   const State& st = *s_;
   const std::size_t size = (std::size_t{1} << st.layout.level) + 1, samples = size * size;
   const int np = st.layout.num_patches;
+  shift = std::clamp(shift, 0, st.layout.steps);
   out.resize(static_cast<std::size_t>(np));
   parallel_for(np, st.max_threads, [&](int c) {
     auto& patch = out[static_cast<std::size_t>(c)];
-    for (auto& ch : patch) ch.assign(samples, 0);
+    if (shift == 0) {
+      for (auto& ch : patch) ch.assign(samples, 0);
+    } else {  // zero the positions at multiples of 2^shift only
+      const std::size_t s = std::size_t{1} << shift;
+      for (auto& ch : patch) {
+        ch.resize(samples);
+        for (std::size_t j = 0; j < size; j += s) {
+          for (std::size_t i = 0; i < size; i += s) ch[j * size + i] = 0;
+        }
+      }
+    }
     for (const auto& band : st.bands) {
-      if (band.patch == c) reconstruct_band(band, patch);
+      // Step k's details lie at odd multiples of 2^(k−1): none at multiples of 2^shift when k ≤ shift.
+      if (band.patch == c && (band.orient == 0 || band.k > shift)) reconstruct_band(band, patch);
     }
   });
 }

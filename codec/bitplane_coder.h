@@ -159,6 +159,11 @@ struct BitplaneDecodeResult {
 /// before decoding each plane that is some step's start plane, with the same `view` as the encoder's hook got
 /// (scratch for the hook).
 using DecodeHook = std::function<void(int plane, std::vector<PatchCoefficients>& view)>;
+/// What a decode hook reads of its view (optional): the hook at `plane` reads only the positions (i, j) with
+/// i and j multiples of 2^view_shift(plane) (0: the whole grid). The decoder then reconstructs the view
+/// only there (the detail bands of steps ≤ the shift have no position there); the view's other values are
+/// unspecified (left from earlier hooks). Saves the hooks of the coarse steps most of a full reconstruction.
+using HookViewShift = std::function<int(int plane)>;
 
 /// Incremental decoding (a class because its state is reused): the decoder keeps its significance lists,
 /// contexts, range-decoder states and its place inside the plane it stopped in, and each update() continues
@@ -175,7 +180,7 @@ class BitplaneDecoder {
 
   /// Starts over. kInvalidArgument (and nothing to decode) on the errors of decode_bitplanes().
   Status reset(const BitplaneLayout& layout, int top_bitplane, std::vector<std::vector<std::uint8_t>> coded,
-               int max_threads = 0, DecodeHook before_plane = {});
+               int max_threads = 0, DecodeHook before_plane = {}, HookViewShift view_shift = {});
   /// Continues with a longer prefix of the stream: `segments` start with the complete segments of the
   /// previous call (same contents; the memory may have moved), `partial_tail` is a prefix of the next one
   /// and extends the previous call's tail when that segment is still the one in progress. Returns as
@@ -191,6 +196,8 @@ class BitplaneDecoder {
 
  private:
   struct State;
+  /// reconstruct() at the positions whose coordinates are multiples of 2^shift only (see HookViewShift).
+  void reconstruct_view(std::vector<PatchCoefficients>& out, int shift) const;
   std::unique_ptr<State> s_;
 };
 

@@ -362,7 +362,7 @@ struct FrameField {
     int sh = 0;                     // grid position (i, j) is (i >> sh, j >> sh) here
     std::size_t sub = 0;            // samples per row
     bool bounded = false;           // every sample below 2^27 in magnitude: the differences' bound never acts
-    std::vector<std::int32_t> xyz;  // the samples, three values each
+    std::unique_ptr<std::int32_t[]> xyz;  // the samples, three values each (sub² of them)
   };
   std::vector<std::vector<std::shared_ptr<const CellGrid>>> step_grid;  // [patch][k − 1]
   mutable std::vector<std::unique_ptr<std::uint16_t[]>> cell;           // [patch][grid index]
@@ -433,6 +433,18 @@ struct FrameField {
         }
       }
     });
+  }
+
+  /// The grid positions compute(plane, view) reads: multiples of 2^view_shift(plane) (HookViewShift).
+  int view_shift(int plane) const {
+    int min_k = 0;
+    for (int k = frame_steps; k >= 1; --k) {
+      if (start[static_cast<std::size_t>(k - 1)] == plane) min_k = k;
+    }
+    // Cell frames read the coarse grid of step min_k (spacing 2^min_k; the framed steps above min_k lie on
+    // it, and the seam copies map it to itself), the normals of versions 3–5 the grid at spacing 2^(min_k−1).
+    if (min_k == 0) return 0;
+    return cells ? min_k : min_k - 1;
   }
 
   /// The frames of the steps that start at `plane`, from `view` (the decoder's coefficients before that
@@ -529,8 +541,11 @@ struct FrameField {
       grid->sh = min_k;
       grid->sub = sub;
       std::int32_t low = 0, high = 0;
-      grid->xyz.resize(3 * sub * sub);
-      std::vector<std::int32_t> g(sub * sub);
+      // Both written in full before they are read: no zero-fill.
+      grid->xyz = uninitialized_array<std::int32_t>(3 * sub * sub);
+      const std::size_t count = sub * sub;
+      const std::unique_ptr<std::int32_t[]> gathered = uninitialized_array<std::int32_t>(count);
+      const std::span<std::int32_t> g(gathered.get(), count);
       for (int c = 0; c < 3; ++c) {
         for (std::size_t y = 0; y < sub; ++y) {
           const std::int32_t* src = w[p][c].data() + y * static_cast<std::size_t>(s2) * size;
@@ -566,7 +581,7 @@ struct FrameField {
     const int sh = grid.sh, d = 1 << (k - 1), m = 1 << level;
     const auto sub = static_cast<std::ptrdiff_t>(grid.sub);
     const std::size_t size = static_cast<std::size_t>(m) + 1;
-    const std::int32_t* const g = grid.xyz.data();
+    const std::int32_t* const g = grid.xyz.get();
     // The samples of the grid's row y (a multiple of 2^sh) and the offset of its column x in such a row.
     const auto row_at = [&](int y) { return g + 3 * static_cast<std::ptrdiff_t>(y >> sh) * sub; };
     const auto col = [&](int x) { return 3 * static_cast<std::ptrdiff_t>(x >> sh); };
@@ -927,8 +942,9 @@ Status GeometryDecoder::reset(const GeometryCodecHeader& header, const GeometryD
   const DecodeHook hook = [raw](int plane, std::vector<PatchCoefficients>& view) {
     raw->ff.compute(plane, view);
   };
-  const Status s =
-      st->bits.reset(make_layout(header), header.top_bitplane, st->own.coded, options.max_threads, hook);
+  const HookViewShift shift = [raw](int plane) { return raw->ff.view_shift(plane); };
+  const Status s = st->bits.reset(make_layout(header), header.top_bitplane, st->own.coded,
+                                  options.max_threads, hook, shift);
   if (s != Status::kOk) return s;
   s_ = std::move(st);
   return Status::kOk;

@@ -465,10 +465,14 @@ void decode_fine_masks(std::span<const std::uint8_t> bytes,
         const int same = decoder.decode(uniform_ctx[uniform_context(uniform, coarse_side, ci, cj, c)]);
         uniform[static_cast<std::size_t>(cj) * coarse_side + ci] = static_cast<std::uint8_t>(same);
         for (int j = cj * block; j < (cj + 1) * block; ++j) {
-          for (int i = ci * block; i < (ci + 1) * block; ++i) {
-            mask[static_cast<std::size_t>(j) * side + i] = static_cast<std::uint8_t>(
-                same ? c : decoder.decode(fine_ctx[mask_context(mask, side, i, j) | c << 4]));
+          std::uint8_t* const row = mask.data() + static_cast<std::size_t>(j) * side;
+          if (same) {  // the block is its coarse quad's value (most blocks): whole rows at a time
+            std::fill_n(row + ci * block, block, static_cast<std::uint8_t>(c));
+            continue;
           }
+          for (int i = ci * block; i < (ci + 1) * block; ++i)
+            row[i] =
+                static_cast<std::uint8_t>(decoder.decode(fine_ctx[mask_context(mask, side, i, j) | c << 4]));
         }
       }
     }

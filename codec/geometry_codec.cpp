@@ -435,12 +435,17 @@ struct FrameField {
     });
   }
 
+  /// The finest framed step that starts at `plane` (0: none).
+  int finest_step_starting_at(int plane) const {
+    for (int k = 1; k <= frame_steps; ++k) {
+      if (start[static_cast<std::size_t>(k - 1)] == plane) return k;
+    }
+    return 0;
+  }
+
   /// The grid positions compute(plane, view) reads: multiples of 2^view_shift(plane) (HookViewShift).
   int view_shift(int plane) const {
-    int min_k = 0;
-    for (int k = frame_steps; k >= 1; --k) {
-      if (start[static_cast<std::size_t>(k - 1)] == plane) min_k = k;
-    }
+    const int min_k = finest_step_starting_at(plane);
     // Cell frames read the coarse grid of step min_k (spacing 2^min_k; the framed steps above min_k lie on
     // it, and the seam copies map it to itself), the normals of versions 3–5 the grid at spacing 2^(min_k−1).
     if (min_k == 0) return 0;
@@ -453,10 +458,7 @@ struct FrameField {
   /// cross product of the central differences (i ± s, j) and (i, j ± s) of that reconstruction (one-sided on
   /// the border).
   void compute(int plane, std::vector<PatchCoefficients>& view) {
-    int min_k = 0;
-    for (int k = frame_steps; k >= 1; --k) {
-      if (start[static_cast<std::size_t>(k - 1)] == plane) min_k = k;
-    }
+    const int min_k = finest_step_starting_at(plane);
     if (min_k == 0) return;
     std::vector<PatchCoefficients>& w = view;  // scratch: changed in place
     to_xyz(w, min_k);

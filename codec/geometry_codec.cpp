@@ -1069,6 +1069,27 @@ void GeometryDecoder::build_result(int drop_finest_steps) {
   st.cached_drop = drop;
 }
 
+void copy_seam_samples(std::vector<Grid3>& patches, const std::vector<PatchSeam>& seams) {
+  if (patches.empty() || seams.empty()) return;
+  const int level = patches[0].level;
+  const std::size_t samples = static_cast<std::size_t>(grid_size(level)) * grid_size(level);
+  for (const Grid3& g : patches) {
+    if (g.level != level || g.values.size() != 3 * samples) return;
+  }
+  for (const PatchSeam& seam : seams) {
+    const int np = static_cast<int>(patches.size());
+    if (seam.patch < 0 || seam.patch >= np || seam.other_patch < 0 || seam.other_patch >= np ||
+        seam.side < 0 || seam.side > 3 || seam.other_side < 0 || seam.other_side > 3)
+      return;
+  }
+  const Ownership own = seam_ownership(level, static_cast<int>(patches.size()), seams);
+  for (const auto& [copy, owner] : own.copies) {
+    const float* from = patches[owner / samples].values.data() + 3 * (owner % samples);
+    float* to = patches[copy / samples].values.data() + 3 * (copy % samples);
+    to[0] = from[0], to[1] = from[1], to[2] = from[2];
+  }
+}
+
 Status decode_geometry(const GeometryCodecHeader& header,
                        std::span<const std::span<const std::uint8_t>> segments,
                        std::span<const std::uint8_t> partial_tail, DecodedGeometry& out,

@@ -154,6 +154,12 @@ struct EncodedGeometry {
 EncodedGeometry encode_geometry(const std::vector<Grid3>& patches, const std::vector<PatchSeam>& seams,
                                 const GeometryCodecOptions& options = {});
 
+/// Gives every seam copy (a sample that seams glue to a sample of a lower patch·grid index) its owner's
+/// values, as decoding a stream with these seams does: afterwards the glued samples are bit-identical. For
+/// grids decoded from a stream without seams (two-layer normal maps, normal_layers.h). Grids of another
+/// level or count than the seams describe are left as they are. Cost: one pass over the patches' borders.
+void copy_seam_samples(std::vector<Grid3>& patches, const std::vector<PatchSeam>& seams);
+
 struct GeometryDecodeOptions {
   /// Zero the details of the finest `drop_finest_steps` wavelet steps (0 = keep all). The result stays on the
   /// full grid: the coarser level interpolated by the wavelet's own subdivision (for band-wise morphing).

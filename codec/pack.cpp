@@ -345,6 +345,35 @@ bool read_codec_header(ByteReader& r, GeometryCodecHeader& h, std::uint16_t vers
 // Hole mask of one patch, `side` × `side` quads: a flag byte (0 = no masked quad), then the bits in raster
 // order through the arithmetic coder, each in a context of its already coded neighbours (left, up, up-left,
 // up-right): a hole costs about its perimeter, an empty patch one byte.
+// Two-layer normal maps (version 11): one bit per patch, packed little-endian into ⌈patches / 8⌉ bytes.
+void write_orientation(ByteWriter& w, const NormalOrientation& orientation, int num_patches) {
+  for (int p = 0; p < num_patches; p += 8) {
+    std::uint8_t byte = 0;
+    for (int k = 0; k < 8 && p + k < num_patches; ++k) {
+      const std::size_t i = static_cast<std::size_t>(p + k);
+      if (i >= orientation.size() || orientation[i]) byte |= static_cast<std::uint8_t>(1u << k);
+    }
+    w.u8(byte);
+  }
+}
+
+bool read_orientation(ByteReader& r, NormalOrientation& orientation, int num_patches) {
+  orientation.assign(static_cast<std::size_t>(std::max(num_patches, 0)), true);
+  for (int p = 0; p < num_patches; p += 8) {
+    std::uint8_t byte;
+    if (!r.u8(byte)) return false;
+    for (int k = 0; k < 8; ++k) {
+      const bool bit = (byte >> k) & 1;
+      if (p + k < num_patches) {
+        orientation[static_cast<std::size_t>(p + k)] = bit;
+      } else if (bit) {
+        return false;  // padding bits are 0
+      }
+    }
+  }
+  return true;
+}
+
 int mask_context(const std::vector<std::uint8_t>& mask, int side, int i, int j) {
   auto at = [&](int x, int y) {
     return x >= 0 && y >= 0 && x < side ? mask[static_cast<std::size_t>(y) * side + x] : std::uint8_t{0};
@@ -495,17 +524,29 @@ std::vector<std::uint8_t> coarsen_mask(const std::vector<std::uint8_t>& mask, in
 }
 
 // The canonical chunk order: by stage (geometry pass p → p, normal pass p → p + delay, a fine hole mask → the
-// manifest's mask stage), then geometry, normals, hole mask, then model.
+// manifest's mask stage), then geometry, normals, hole mask, then model. Two-layer normal maps (version 11):
+// layer 2's pass q (normal pass base + q) → q + its own delay, so its larger passes land beside the
+// geometry passes of the same size as the xyz passes they replace would have; each stream's passes stay in
+// order, and at one stage layer 1's pass comes before layer 2's.
 struct ChunkKey {
   int stage, kind, model, pass;
 };
+struct NormalLayers {
+  int base_passes = 0;     // layer 1's passes; 0: one layer
+  int residual_delay = 0;  // layer 2's stage offset
+};
 std::vector<ChunkKey> chunk_order(const std::vector<int>& geometry_passes,
                                   const std::vector<int>& normal_passes, const std::vector<bool>& fine_mask,
-                                  int normals_delay, int mask_stage) {
+                                  int normals_delay, int mask_stage,
+                                  const std::vector<NormalLayers>& layers) {
   std::vector<ChunkKey> keys;
   for (std::size_t m = 0; m < geometry_passes.size(); ++m) {
     for (int p = 0; p < geometry_passes[m]; ++p) keys.push_back({p, 0, static_cast<int>(m), p});
-    for (int p = 0; p < normal_passes[m]; ++p) keys.push_back({p + normals_delay, 1, static_cast<int>(m), p});
+    const NormalLayers& l = layers[m];
+    for (int p = 0; p < normal_passes[m]; ++p)
+      keys.push_back(
+          {l.base_passes > 0 && p >= l.base_passes ? p - l.base_passes + l.residual_delay : p + normals_delay,
+           1, static_cast<int>(m), p});
     if (fine_mask[m]) keys.push_back({mask_stage, 2, static_cast<int>(m), 0});
   }
   std::stable_sort(keys.begin(), keys.end(), [](const ChunkKey& a, const ChunkKey& b) {
@@ -558,6 +599,7 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     return Status::kCorrupt;
   out.models.assign(static_cast<std::size_t>(model_count), {});
   std::vector<int> geometry_passes, normal_passes;
+  std::vector<NormalLayers> layers;
   std::vector<bool> fine_mask;
   std::uint64_t samples = 0;
   const std::vector<PatchSeam>* seams_before = nullptr;  // version 7: the seam table read last
@@ -565,7 +607,7 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
     std::uint8_t has_normals;
     if (!r.string(model.name, kMaxNameSize) || !read_normalization(r, model.normalization, out.version) ||
         !read_codec_header(r, model.geometry, out.version, seams_before) || !r.u8(has_normals) ||
-        has_normals > 1)
+        has_normals > (out.version >= 11 ? 2 : 1))
       return Status::kCorrupt;
     seams_before = &model.geometry.seams;
     // Pack version v ≤ 3 holds codec headers of version v (1: joint streams, 2: per-patch ones, 3: local
@@ -586,7 +628,8 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
         passes_of(model.geometry) > static_cast<int>(kMaxPasses))
       return Status::kCorrupt;
     samples += samples_of(model.geometry);
-    model.has_normals = has_normals == 1;
+    model.has_normals = has_normals >= 1;
+    model.normal_layers = has_normals == 2 ? 2 : 1;
     if (model.has_normals) {
       if (!read_codec_header(r, model.normals, out.version, seams_before) ||
           !codec_version_ok(model.normals.version) || model.normals.level > kMaxPackLevel ||
@@ -596,6 +639,28 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
       samples += samples_of(model.normals);
       seams_before = &model.normals.seams;
     }
+    if (model.normal_layers == 2) {
+      // Version 11: layer 1's pass count, the orientation bits, layer 2's header (same level and patches,
+      // no seams).
+      std::uint64_t base_passes;
+      if (!r.bounded(base_passes, static_cast<std::uint64_t>(passes_of(model.normals))) || base_passes == 0 ||
+          !read_orientation(r, model.normal_orientation, model.normals.num_patches) ||
+          !read_codec_header(r, model.normal_residual, out.version, nullptr) ||
+          !codec_version_ok(model.normal_residual.version) ||
+          model.normal_residual.level != model.normals.level ||
+          model.normal_residual.num_patches != model.normals.num_patches ||
+          !model.normal_residual.seams.empty() || passes_of(model.normal_residual) < 1 ||
+          passes_of(model.normal_residual) > static_cast<int>(kMaxPasses))
+        return Status::kCorrupt;
+      model.normal_base_passes = static_cast<int>(base_passes);
+      samples += samples_of(model.normal_residual);
+    }
+    if (model.normal_layers == 2) {
+      std::uint64_t delay;
+      if (!r.bounded(delay, 2 * kMaxPasses)) return Status::kCorrupt;
+      model.normal_residual_delay = static_cast<int>(delay);
+    }
+    layers.push_back({model.normal_layers == 2 ? model.normal_base_passes : 0, model.normal_residual_delay});
     if (samples > kMaxSamplesPerPack) return Status::kCorrupt;
     std::uint64_t mask_patches;
     if (!r.bounded(mask_patches, static_cast<std::uint64_t>(model.geometry.num_patches)))
@@ -615,11 +680,11 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
       if (!read_mask(r, 1 << model.hole_mask_level, mask)) return Status::kCorrupt;
     fine_mask.push_back(mask_patches > 0 && model.fine_hole_mask_level > model.hole_mask_level);
     geometry_passes.push_back(passes_of(model.geometry));
-    normal_passes.push_back(model.has_normals ? passes_of(model.normals) : 0);
+    normal_passes.push_back(model.normal_passes());
   }
   const std::vector<ChunkKey> order =
       chunk_order(geometry_passes, normal_passes, fine_mask, static_cast<int>(normals_delay),
-                  static_cast<int>(mask_stage));
+                  static_cast<int>(mask_stage), layers);
   std::uint64_t group_bytes = 0, chunk_count;
   if (out.version >= 4 && (!r.bounded(group_bytes, kMaxChunkSize) || group_bytes == 0))
     return Status::kCorrupt;
@@ -653,6 +718,20 @@ Status parse_manifest(std::span<const std::uint8_t> bytes, std::size_t manifest_
 }
 
 }  // namespace
+
+int PackModelInfo::normal_passes() const {
+  if (!has_normals) return 0;
+  return normal_layers == 2 ? normal_base_passes + passes_of(normal_residual) : passes_of(normals);
+}
+
+std::uint32_t manifest_crc(std::uint16_t version, std::span<const std::uint8_t> manifest) {
+  if (version < 11) return crc32(manifest);
+  const std::uint8_t v[2] = {static_cast<std::uint8_t>(version & 0xff),
+                             static_cast<std::uint8_t>(version >> 8)};
+  std::vector<std::uint8_t> both(v, v + 2);
+  both.insert(both.end(), manifest.begin(), manifest.end());
+  return crc32(both);
+}
 
 std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
   uLong crc = ::crc32(0L, Z_NULL, 0);
@@ -724,7 +803,7 @@ Status read_pack_info(std::span<const std::uint8_t> bytes, PackInfo& out) {
   const std::size_t manifest_end = h.size + h.manifest_size;
   if (bytes.size() < manifest_end) return Status::kTruncated;
   const auto manifest = bytes.subspan(h.size, h.manifest_size);
-  if (kCheckCrc && crc32(manifest) != h.manifest_crc) return Status::kCorrupt;
+  if (kCheckCrc && manifest_crc(h.version, manifest) != h.manifest_crc) return Status::kCorrupt;
   out.manifest_end = manifest_end;
   out.version = h.version;
   const Status s = parse_manifest(manifest, manifest_end, out);
@@ -789,14 +868,23 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
     std::uint64_t samples = 0;
     for (const PackModelInput& model : models) {
       for (const Grid3& g : model.geometry) samples += static_cast<std::uint64_t>(g.size()) * g.size();
-      if (options.normals)
-        for (const Grid3& g : model.normals) samples += static_cast<std::uint64_t>(g.size()) * g.size();
+      if (options.normals)  // two layers: the residual grids count as well
+        for (const Grid3& g : model.normals)
+          samples += static_cast<std::uint64_t>(options.normal_layers) * g.size() * g.size();
     }
     if (samples > kMaxSamplesPerPack)
       throw std::invalid_argument("write_pack: " + std::to_string(samples) +
                                   " samples (geometry and normal maps), more than a pack holds (2^25)");
   }
-  std::vector<EncodedGeometry> geometry(models.size()), normals(models.size());
+  if (options.normal_layers != 1 && options.normal_layers != 2)
+    throw std::invalid_argument("write_pack: normal_layers must be 1 or 2");
+  if (!(options.normal_base_bytes_per_texel > 0) || !std::isfinite(options.normal_base_bytes_per_texel) ||
+      !(options.normal_residual_step > 0) || !std::isfinite(options.normal_residual_step))
+    throw std::invalid_argument(
+        "write_pack: normal_base_bytes_per_texel and normal_residual_step must be positive");
+  std::vector<EncodedGeometry> geometry(models.size()), normals(models.size()), residual(models.size());
+  std::vector<int> base_passes(models.size(), 0);  // layer 1's passes; 0 = one layer
+  std::vector<NormalOrientation> orientation(models.size());
   std::vector<int> geometry_passes, normal_passes, mask_level;
   for (std::size_t m = 0; m < models.size(); ++m) {
     const PackModelInput& model = models[m];
@@ -812,8 +900,50 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
       if (model.normals.size() != model.geometry.size())
         throw std::invalid_argument("write_pack: model '" + model.name + "': normal maps and patches differ");
       normals[m] = encode_geometry(model.normals, model.seams, options.normal_codec);
+      if (options.normal_layers == 2) {
+        // Layer 1: the xyz stream's first passes that hold the base bytes; layer 2 only when passes remain.
+        std::uint64_t texels = 0;
+        for (const Grid3& g : model.normals) texels += static_cast<std::uint64_t>(g.size()) * g.size();
+        const double base = options.normal_base_bytes_per_texel * static_cast<double>(texels);
+        std::size_t bytes = 0, passes = 0;
+        while (passes < normals[m].segments.size() && static_cast<double>(bytes) < base)
+          bytes += normals[m].segments[passes++].size();
+        if (passes >= 1 && passes < normals[m].segments.size()) {
+          base_passes[m] = static_cast<int>(passes);
+          std::vector<std::span<const std::uint8_t>> first;
+          for (std::size_t k = 0; k < passes; ++k) first.emplace_back(normals[m].segments[k]);
+          DecodedGeometry axes, decoded;
+          if (decode_geometry(normals[m].header, first, {}, axes) != Status::kOk)
+            throw std::logic_error("write_pack: layer 1 of the normal maps does not decode");
+          normalize_normal_maps(axes.patches);
+          std::vector<std::span<const std::uint8_t>> all;
+          for (const auto& seg : geometry[m].segments) all.emplace_back(seg);
+          if (decode_geometry(geometry[m].header, all, {}, decoded) != Status::kOk)
+            throw std::logic_error("write_pack: the geometry does not decode");
+          orientation[m] = normal_orientation(axes.patches, decoded.patches);
+          const std::vector<Grid3> grids =
+              normal_residual(model.normals, decoded.patches, orientation[m], &axes.patches);
+          // The residual's step: normal_residual_step times the xyz stream's nominal one (its extent 2 over
+          // 2^bits), so layer 2 ends at about the angular precision of the xyz stream it replaces.
+          float lo = 0, hi = 0;
+          for (const Grid3& g : grids)
+            for (std::size_t k = 0; k + 2 < g.values.size(); k += 3)
+              for (int c = 0; c < 2; ++c)
+                lo = std::min(lo, g.values[k + c]), hi = std::max(hi, g.values[k + c]);
+          const double target =
+              options.normal_residual_step * 2.0 / std::ldexp(1.0, options.normal_codec.quantization_bits);
+          GeometryCodecOptions codec = options.normal_codec;
+          codec.quantization_bits =
+              std::clamp(static_cast<int>(std::ceil(std::log2(std::max(double(hi - lo), target) / target))),
+                         1, options.normal_codec.quantization_bits);
+          residual[m] = encode_geometry(grids, {}, codec);
+        }
+      }
     }
-    normal_passes.push_back(with_normals ? static_cast<int>(normals[m].segments.size()) : 0);
+    normal_passes.push_back(!with_normals ? 0
+                            : base_passes[m] > 0
+                                ? base_passes[m] + static_cast<int>(residual[m].segments.size())
+                                : static_cast<int>(normals[m].segments.size()));
     const int level = model.geometry.front().level;
     mask_level.push_back(model.hole_mask_level < 0 ? level : model.hole_mask_level);
     if (mask_level.back() > level)
@@ -856,6 +986,20 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
     }
   }
 
+  // Layer 2's stage offset: its first passes that hold fewer bytes than layer 1's last (the residual's top
+  // planes, nearly empty) go before that pass's stage, the next one right after it.
+  std::vector<NormalLayers> layers(models.size());
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    if (base_passes[m] == 0) continue;
+    const std::size_t last = normals[m].segments[static_cast<std::size_t>(base_passes[m] - 1)].size();
+    std::size_t bytes = 0;
+    int lead = 0;
+    while (lead < static_cast<int>(residual[m].segments.size()) &&
+           bytes + residual[m].segments[static_cast<std::size_t>(lead)].size() < last)
+      bytes += residual[m].segments[static_cast<std::size_t>(lead++)].size();
+    layers[m] = {base_passes[m], std::max(0, base_passes[m] + options.normals_delay - lead)};
+  }
+
   ByteWriter manifest;
   const std::vector<PatchSeam>* seams_before = nullptr;  // the seam table written last
   manifest.varint(models.size());
@@ -866,10 +1010,16 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
     write_normalization(manifest, models[m].normalization, kPackVersion);
     write_codec_header(manifest, geometry[m].header, kPackVersion, seams_before);
     seams_before = &geometry[m].header.seams;
-    manifest.u8(normal_passes[m] > 0 ? 1 : 0);
+    manifest.u8(normal_passes[m] == 0 ? 0 : base_passes[m] > 0 ? 2 : 1);
     if (normal_passes[m] > 0) {
       write_codec_header(manifest, normals[m].header, kPackVersion, seams_before);
       seams_before = &normals[m].header.seams;
+    }
+    if (base_passes[m] > 0) {
+      manifest.varint(static_cast<std::uint64_t>(base_passes[m]));
+      write_orientation(manifest, orientation[m], normals[m].header.num_patches);
+      write_codec_header(manifest, residual[m].header, kPackVersion, nullptr);
+      manifest.varint(static_cast<std::uint64_t>(layers[m].residual_delay));
     }
     manifest.varint(models[m].hole_mask.size());
     if (!models[m].hole_mask.empty()) {
@@ -879,11 +1029,13 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
     for (const auto& mask : coarse_masks[m]) write_mask(manifest, mask, 1 << coarse_level[m]);
   }
   const std::vector<ChunkKey> order =
-      chunk_order(geometry_passes, normal_passes, fine_mask, options.normals_delay, mask_stage);
+      chunk_order(geometry_passes, normal_passes, fine_mask, options.normals_delay, mask_stage, layers);
   auto segment = [&](const ChunkKey& key) -> const std::vector<std::uint8_t>& {
     if (key.kind == 2) return fine_mask_bytes[static_cast<std::size_t>(key.model)];
-    const auto& encoded = key.kind == 0 ? geometry[static_cast<std::size_t>(key.model)]
-                                        : normals[static_cast<std::size_t>(key.model)];
+    const std::size_t m = static_cast<std::size_t>(key.model);
+    if (key.kind == 1 && base_passes[m] > 0 && key.pass >= base_passes[m])
+      return residual[m].segments[static_cast<std::size_t>(key.pass - base_passes[m])];
+    const auto& encoded = key.kind == 0 ? geometry[m] : normals[m];
     return encoded.segments[static_cast<std::size_t>(key.pass)];
   };
   std::vector<std::uint64_t> sizes;
@@ -901,7 +1053,7 @@ std::vector<std::uint8_t> write_pack(const std::vector<PackModelInput>& models,
   for (std::uint8_t b : kMagic) file.u8(b);
   file.u16(kPackVersion);
   file.varint(manifest.data().size());
-  file.u32(crc32(manifest.data()));
+  file.u32(manifest_crc(kPackVersion, manifest.data()));
   std::vector<std::uint8_t>& out = file.data();
   out.insert(out.end(), manifest.data().begin(), manifest.data().end());
   std::size_t group_begin = out.size();
@@ -926,14 +1078,15 @@ struct PackDecoder::State {
   std::size_t next_chunk = 0;  // first chunk not yet complete and verified
   std::size_t chunks_decoded = 0, bytes_used = 0;
   struct Model {
-    GeometryDecoder geometry, normals;
-    bool with_normals = false;
-    std::vector<std::size_t> geometry_chunks, normal_chunks;
+    // Streams: 0 geometry, 1 normal maps (layer 1 of two), 2 layer 2 of two-layer normal maps.
+    std::array<GeometryDecoder, 3> decoder;
+    std::array<std::vector<std::size_t>, 3> chunks;  // verified chunks of each stream
+    std::array<Status, 3> status{Status::kOk, Status::kOk, Status::kOk};
+    // The last update fed the stream bytes not yet verified (the open CRC group, see update()).
+    std::array<bool, 3> tentative{false, false, false};
+    bool with_normals = false, two_layers = false;
     bool has_fine_mask = false;
     std::vector<std::vector<std::uint8_t>> fine_mask;
-    Status geometry_status = Status::kOk, normals_status = Status::kOk;
-    // The last update fed the stream bytes not yet verified (the open CRC group, see update()).
-    bool tentative_geometry = false, tentative_normals = false;
     std::size_t tentative_geometry_passes = 0;  // complete geometry chunks among them
   };
   std::vector<Model> models;
@@ -941,25 +1094,31 @@ struct PackDecoder::State {
   std::span<const std::uint8_t> payload(std::span<const std::uint8_t> data, std::size_t c) const {
     return data.subspan(static_cast<std::size_t>(info.chunks[c].offset), info.chunks[c].payload_size());
   }
-  /// Feeds one model's stream (geometry or normals) its verified chunks, then the complete chunks `extra`
-  /// and `tail` (a byte prefix of the chunk after them).
-  void feed(std::span<const std::uint8_t> data, Model& m, bool geometry, std::span<const std::size_t> extra,
-            std::span<const std::uint8_t> tail) {
-    const auto& list = geometry ? m.geometry_chunks : m.normal_chunks;
+  /// The stream a geometry or normal chunk belongs to.
+  std::size_t stream_of(const ChunkInfo& chunk) const {
+    if (chunk.kind == ChunkKind::kGeometry) return 0;
+    const PackModelInfo& mi = info.models[static_cast<std::size_t>(chunk.model)];
+    return mi.normal_layers == 2 && chunk.pass >= mi.normal_base_passes ? 2 : 1;
+  }
+  /// Feeds one model's stream its verified chunks, then the complete chunks `extra` and `tail` (a byte
+  /// prefix of the chunk after them).
+  void feed(std::span<const std::uint8_t> data, Model& m, std::size_t stream,
+            std::span<const std::size_t> extra, std::span<const std::uint8_t> tail) {
+    const auto& list = m.chunks[stream];
     std::vector<std::span<const std::uint8_t>> segments;
     segments.reserve(list.size() + extra.size());
     for (std::size_t c : list) segments.push_back(payload(data, c));
     for (std::size_t c : extra) segments.push_back(payload(data, c));
-    (geometry ? m.geometry_status : m.normals_status) =
-        (geometry ? m.geometry : m.normals).update(segments, tail);
+    m.status[stream] = m.decoder[stream].update(segments, tail);
   }
-  void reset_stream(Model& m, std::size_t index, bool geometry) {
+  void reset_stream(Model& m, std::size_t index, std::size_t stream) {
     const PackModelInfo& mi = info.models[index];
-    if (geometry)
-      m.geometry.reset(mi.geometry,
-                       {.drop_finest_steps = options.drop_finest_steps, .max_threads = options.max_threads});
+    if (stream == 0)
+      m.decoder[0].reset(
+          mi.geometry, {.drop_finest_steps = options.drop_finest_steps, .max_threads = options.max_threads});
     else
-      m.normals.reset(mi.normals, {.max_threads = options.max_threads});
+      m.decoder[stream].reset(stream == 1 ? mi.normals : mi.normal_residual,
+                              {.max_threads = options.max_threads});
   }
 };
 
@@ -982,9 +1141,12 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
       st.have_info = true;
       st.models.resize(st.info.models.size());
       for (std::size_t m = 0; m < st.models.size(); ++m) {
-        st.models[m].with_normals = options.normals && st.info.models[m].has_normals;
-        st.reset_stream(st.models[m], m, true);
-        if (st.models[m].with_normals) st.reset_stream(st.models[m], m, false);
+        State::Model& model = st.models[m];
+        model.with_normals = options.normals && st.info.models[m].has_normals;
+        model.two_layers = model.with_normals && st.info.models[m].normal_layers == 2;
+        st.reset_stream(model, m, 0);
+        if (model.with_normals) st.reset_stream(model, m, 1);
+        if (model.two_layers) st.reset_stream(model, m, 2);
       }
     }
     const PackInfo& info = st.info;
@@ -1022,7 +1184,7 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
               st.payload(data, c), mi.hole_mask, 1 << mi.fine_hole_mask_level, shift, m.fine_mask);
           m.has_fine_mask = true;
         } else {
-          (chunk.kind == ChunkKind::kGeometry ? m.geometry_chunks : m.normal_chunks).push_back(c);
+          m.chunks[st.stream_of(chunk)].push_back(c);
         }
         ++st.chunks_decoded;
       }
@@ -1040,7 +1202,7 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
       std::vector<std::size_t> complete;
       std::span<const std::uint8_t> tail;
     };
-    std::vector<Open> open_geometry(st.models.size()), open_normals(st.models.size());
+    std::vector<std::array<Open, 3>> open(st.models.size());
     if (!st.crc_failed && st.next_chunk < info.chunks.size()) {
       st.status = Status::kTruncated;
       for (std::size_t c = st.next_chunk; options.partial_chunks && c < info.chunks.size(); ++c) {
@@ -1048,13 +1210,11 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
         if (chunk.offset >= data.size()) break;
         const bool complete = chunk.offset + chunk.payload_size() <= data.size();
         if (chunk.kind != ChunkKind::kHoleMask && (chunk.kind == ChunkKind::kGeometry || options.normals)) {
-          Open& open =
-              (chunk.kind == ChunkKind::kGeometry ? open_geometry
-                                                  : open_normals)[static_cast<std::size_t>(chunk.model)];
+          Open& o = open[static_cast<std::size_t>(chunk.model)][st.stream_of(chunk)];
           if (complete)
-            open.complete.push_back(c);
+            o.complete.push_back(c);
           else
-            open.tail = data.subspan(static_cast<std::size_t>(chunk.offset));
+            o.tail = data.subspan(static_cast<std::size_t>(chunk.offset));
           st.bytes_used = static_cast<std::size_t>(
               std::min<std::uint64_t>(data.size(), chunk.offset + chunk.payload_size()));
         }
@@ -1063,14 +1223,16 @@ void PackDecoder::update(std::span<const std::uint8_t> bytes) {
     }
     for (std::size_t m = 0; m < st.models.size(); ++m) {
       State::Model& model = st.models[m];
-      const auto stream = [&](bool geometry, const Open& open, bool& tentative) {
-        if (st.crc_failed && tentative) st.reset_stream(model, m, geometry);
-        st.feed(data, model, geometry, open.complete, open.tail);
-        tentative = !open.complete.empty() || !open.tail.empty();
+      const auto stream = [&](std::size_t k) {
+        const Open& o = open[m][k];
+        if (st.crc_failed && model.tentative[k]) st.reset_stream(model, m, k);
+        st.feed(data, model, k, o.complete, o.tail);
+        model.tentative[k] = !o.complete.empty() || !o.tail.empty();
       };
-      stream(true, open_geometry[m], model.tentative_geometry);
-      model.tentative_geometry_passes = open_geometry[m].complete.size();
-      if (model.with_normals) stream(false, open_normals[m], model.tentative_normals);
+      stream(0);
+      model.tentative_geometry_passes = open[m][0].complete.size();
+      if (model.with_normals) stream(1);
+      if (model.two_layers) stream(2);
     }
   } catch (const std::exception&) {
     // The decoders do not throw on bytes; a failed allocation on a hostile manifest lands here.
@@ -1111,33 +1273,35 @@ PackDecodeResult PackDecoder::make_result(int drop_finest_steps, bool normals, b
         model.hole_mask = sm.fine_mask;
         model.hole_mask_level = model_info.fine_hole_mask_level;
       }
-      model.geometry_passes = sm.geometry_chunks.size() + sm.tentative_geometry_passes;
-      DecodedGeometry decoded;
-      if (take) {
-        sm.geometry.take_result(decoded, drop_finest_steps);
-      } else {
-        sm.geometry.result(decoded, drop_finest_steps);
-      }
-      if (sm.geometry_status != Status::kOk) result.status = Status::kCorrupt;
+      model.geometry_passes = sm.chunks[0].size() + sm.tentative_geometry_passes;
+      const auto decode = [&](std::size_t k, int drop) {
+        DecodedGeometry decoded;
+        if (take) {
+          sm.decoder[k].take_result(decoded, drop);
+        } else {
+          sm.decoder[k].result(decoded, drop);
+        }
+        return decoded;
+      };
+      DecodedGeometry decoded = decode(0, drop_finest_steps);
+      if (sm.status[0] != Status::kOk) result.status = Status::kCorrupt;
       model.geometry = std::move(decoded.patches);
       model.detail_level = decoded.detail_level;
-      const bool any_normals = !sm.normal_chunks.empty() || sm.tentative_normals;
-      if (sm.with_normals && any_normals) {
-        if (sm.normals_status != Status::kOk) result.status = Status::kCorrupt;
+      const auto any = [&](std::size_t k) { return !sm.chunks[k].empty() || sm.tentative[k]; };
+      if (sm.with_normals && any(1)) {
+        if (sm.status[1] != Status::kOk || (sm.two_layers && sm.status[2] != Status::kOk))
+          result.status = Status::kCorrupt;
         if (normals) {
-          DecodedGeometry decoded_normals;
-          if (take) {
-            sm.normals.take_result(decoded_normals);
-          } else {
-            sm.normals.result(decoded_normals);
-          }
-          model.normals = std::move(decoded_normals.patches);
-          for (Grid3& grid : model.normals) {
-            for (std::size_t k = 0; k + 2 < grid.values.size(); k += 3) {
-              float* n = grid.values.data() + k;
-              const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-              if (len > 0) n[0] /= len, n[1] /= len, n[2] /= len;
-            }
+          model.normals = decode(1, -1).patches;
+          normalize_normal_maps(model.normals);
+          if (sm.two_layers && any(2)) {
+            // Layer 2: the residual in frames around layer 1's normals and the geometry decoded so far;
+            // the seams glue the result as layer 1's stream glued its samples.
+            std::vector<Grid3> maps = decode(2, -1).patches;
+            apply_normal_residual(maps, model.geometry, model_info.normal_orientation, &model.normals,
+                                  st.options.max_threads);
+            copy_seam_samples(maps, model_info.normals.seams);
+            model.normals = std::move(maps);
           }
         }
       }

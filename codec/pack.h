@@ -3,8 +3,9 @@
 //
 // Layout (all integers little-endian; varint = unsigned LEB128):
 //   [fixed header]
-//     versions 4–5: magic "GEOMIPK\x1a" (8) | format version u16 | manifest size varint (1–4 bytes) |
-//                manifest CRC32 u32   (15–18 bytes)
+//     versions 4 on: magic "GEOMIPK\x1a" (8) | format version u16 | manifest size varint (1–4 bytes) |
+//                manifest CRC32 u32   (15–18 bytes; from version 11 on the CRC covers the version too:
+//                manifest_crc())
 //     versions 1–3: magic (8) | format version u16 | flags u16 (0) | manifest size u32 | manifest CRC32 u32
 //                (kPackHeaderSize = 20 bytes)
 //   [manifest, manifest-size bytes]
@@ -39,6 +40,7 @@
 #include <vector>
 
 #include "codec/geometry_codec.h"
+#include "codec/normal_layers.h"
 #include "codec/status.h"
 
 namespace geomip::codec {
@@ -47,29 +49,33 @@ namespace geomip::codec {
 /// this many bytes of a pack (or all of a shorter source) can always read the fixed header, and the
 /// manifest always ends at or after it.
 inline constexpr std::size_t kPackHeaderSize = 20;
-/// Format version written. Version 10 (this one): version 9 with codec headers of version 7 too (a bottom
-/// bit-plane: the samples quantized GeometryCodecOptions::headroom_bits finer and the stream ending that many
-/// weighted planes above plane 0, so the coarse bands keep more precision for the same bytes;
-/// docs/codec-v3.md, "Headroom for the coarse bands"; the same container). Version 9: version 8 with a fourth
-/// form of seam table, the code of a closed genus-0 quad layout in canonical order (layout_code.h: about 4
-/// bits per quad; the armadillo's 64-patch table 139 → 29 bytes; PackWriteOptions::canonical_layout puts a
-/// layout in that order). Version 8: version 7 with codec headers of version 6 too (cell frames: local frames
-/// from the coarse grid's normals and a table of octahedral cells; geometry_codec.cpp, docs/codec-v3.md "Cell
-/// frames"; the same container). Version 7: version 6 with compact seam tables — a codec header's seams
-/// follow it as "the same as the header before", one entry per side pair bit-packed (every layout's table),
-/// or the explicit list (pack.cpp, write_seams; docs/codec-v3.md "Seam tables"): the four animals with a
-/// 64-quad layout at level 8 show their first level of detail after 609 bytes instead of 3,554 (manifest 511
-/// bytes instead of 3,456). Version 6: version 4's container, codec headers of versions 3 to 5 (the encoder
-/// writes 5: the geometry's wavelet filter kCubicLong, docs/codec-v3.md "Longer lifting filters"). Version 5:
-/// the same container, codec headers of versions 3 and 4 (4: the wavelet's lifting update, docs/codec-v3.md
-/// "Lifting update"); each bump lets an older reader say "unsupported version" instead of failing on the
-/// codec header. Version 4: the header diet — CRC32 trailers per chunk group instead of a CRC per chunk in
-/// the up-front table, a varint manifest size, compact doubles and codec headers (above); codec headers of
-/// version 3. Version 3: codec header version 3 (local frames, orientation weights; docs/codec-v3.md).
-/// Version 2: bit-plane segments hold one stream per patch (codec header version 2), decoded in parallel.
-/// Version 1: one joint stream per segment. Versions 1–9 are still read. "Version 4" in the layout notes
-/// means versions 4 and later.
-inline constexpr std::uint16_t kPackVersion = 10;
+/// Format version written. Version 11 (this one): version 10 with two-layer normal maps (normal_layers.h):
+/// a model's normal-map entry may say 2 (instead of 1) and then holds the xyz stream's header, how many of
+/// its passes the pack carries (layer 1), one orientation bit per patch, and the header of the layer-2
+/// stream (octahedral residuals in frames around layer 1's normals, no seams); the normal chunks are layer
+/// 1's passes, then layer 2's (PackModelInfo::normal_layers). Version 10: version 9 with codec headers of
+/// version 7 too (a bottom bit-plane: the samples quantized GeometryCodecOptions::headroom_bits finer and the
+/// stream ending that many weighted planes above plane 0, so the coarse bands keep more precision for the
+/// same bytes; docs/codec-v3.md, "Headroom for the coarse bands"; the same container). Version 9: version 8
+/// with a fourth form of seam table, the code of a closed genus-0 quad layout in canonical order
+/// (layout_code.h: about 4 bits per quad; the armadillo's 64-patch table 139 → 29 bytes;
+/// PackWriteOptions::canonical_layout puts a layout in that order). Version 8: version 7 with codec headers
+/// of version 6 too (cell frames: local frames from the coarse grid's normals and a table of octahedral
+/// cells; geometry_codec.cpp, docs/codec-v3.md "Cell frames"; the same container). Version 7: version 6 with
+/// compact seam tables — a codec header's seams follow it as "the same as the header before", one entry per
+/// side pair bit-packed (every layout's table), or the explicit list (pack.cpp, write_seams; docs/codec-v3.md
+/// "Seam tables"): the four animals with a 64-quad layout at level 8 show their first level of detail after
+/// 609 bytes instead of 3,554 (manifest 511 bytes instead of 3,456). Version 6: version 4's container, codec
+/// headers of versions 3 to 5 (the encoder writes 5: the geometry's wavelet filter kCubicLong,
+/// docs/codec-v3.md "Longer lifting filters"). Version 5: the same container, codec headers of versions 3 and
+/// 4 (4: the wavelet's lifting update, docs/codec-v3.md "Lifting update"); each bump lets an older reader say
+/// "unsupported version" instead of failing on the codec header. Version 4: the header diet — CRC32 trailers
+/// per chunk group instead of a CRC per chunk in the up-front table, a varint manifest size, compact doubles
+/// and codec headers (above); codec headers of version 3. Version 3: codec header version 3 (local frames,
+/// orientation weights; docs/codec-v3.md). Version 2: bit-plane segments hold one stream per patch (codec
+/// header version 2), decoded in parallel. Version 1: one joint stream per segment. Versions 1–10 are still
+/// read. "Version 4" in the layout notes means versions 4 and later.
+inline constexpr std::uint16_t kPackVersion = 11;
 inline constexpr std::uint16_t kOldestPackVersion = 1;
 
 enum class ChunkKind : std::uint8_t {
@@ -101,7 +107,19 @@ struct PackModelInfo {
   std::array<double, 16> normalization{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   GeometryCodecHeader geometry;
   bool has_normals = false;
-  GeometryCodecHeader normals;  ///< valid when has_normals
+  GeometryCodecHeader normals;  ///< valid when has_normals: the xyz normal stream (layer 1 of two)
+  /// 1: the normal chunks are passes of the xyz stream `normals`. 2 (format 11): its first
+  /// `normal_base_passes` passes (layer 1), then the passes of `normal_residual` (layer 2: the normal in
+  /// frames around layer 1's, normal_layers.h); the decoded normals take layer 1's seams.
+  int normal_layers = 1;
+  int normal_base_passes = 0;            ///< with normal_layers 2, in [1, passes of normals]
+  NormalOrientation normal_orientation;  ///< with normal_layers 2: one entry per patch
+  GeometryCodecHeader normal_residual;   ///< with normal_layers 2: same level and patches, no seams
+  /// With normal_layers 2: layer 2's pass q is placed after geometry pass q + normal_residual_delay (layer
+  /// 1's pass p, as one-layer maps, after geometry pass p + the pack's normals delay).
+  int normal_residual_delay = 0;
+  /// Normal-map chunks in the pack (layer 1's passes, then layer 2's).
+  int normal_passes() const;
   /// Per patch, per quad of the level-hole_mask_level grid (2^L × 2^L, row-major), 1 = the quad covers a
   /// filled hole of the source mesh (geomip repair) and is left out of decoded meshes. Empty = no holes.
   /// The manifest holds the masks 2 levels coarser than the pack's (a coarse quad is masked when half of its
@@ -158,6 +176,17 @@ struct PackWriteOptions {
                                     .tangential_shift = 0,
                                     .orientation_weights = false,
                                     .lifting_update = true};
+  /// 2: two-layer normal maps (format 11, normal_layers.h): layer 1 the first passes of the xyz stream above
+  /// that hold at least normal_base_bytes_per_texel bytes per texel (bunny: about 20 KB), layer 2 the
+  /// residual in frames around layer 1's normals, coded with normal_codec too. 1: the xyz stream alone, as
+  /// every pack before format 11. Maps too small for a layer 2 (the xyz stream ends within layer 1's bytes)
+  /// keep one layer.
+  int normal_layers = 2;
+  double normal_base_bytes_per_texel = 0.038;
+  /// Layer 2's quantization step as a multiple of the xyz stream's nominal step (2 / 2^quantization_bits of
+  /// normal_codec): its bits are the fewest (at most normal_codec's) that make the residual's step no
+  /// larger than that.
+  double normal_residual_step = 1.0;
   bool normals = true;  ///< false: geometry-only pack (for rate–distortion against Draco)
   /// CRC groups (format version 4, see the layout above): chunks with smaller payloads share one CRC32
   /// trailer until their payloads reach this many bytes; ≥ 1. Larger values save 4 bytes per merged chunk;
@@ -261,5 +290,10 @@ class PackDecoder {
 
 /// CRC-32 (IEEE 802.3, zlib's crc32).
 std::uint32_t crc32(std::span<const std::uint8_t> bytes);
+/// The manifest's CRC32 as format `version` stores it in the fixed header: from version 11 on of the format
+/// version (2 bytes, little-endian) and the manifest, so that a damaged version is caught as any damaged
+/// manifest byte (versions 10 and 11 would otherwise read one another's packs whenever the version-11 fields
+/// are absent); before, of the manifest alone. For tools and tests that craft manifests.
+std::uint32_t manifest_crc(std::uint16_t version, std::span<const std::uint8_t> manifest);
 
 }  // namespace geomip::codec

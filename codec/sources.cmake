@@ -4,6 +4,7 @@ set(GEOMIP_CODEC_SOURCES
   bitplane_coder.cpp
   geometry_codec.cpp
   layout_code.cpp
+  normal_layers.cpp
   normal_mesh.cpp
   pack.cpp
   status.cpp

@@ -93,7 +93,12 @@ nlohmann::json pack_info(const std::string& path) {
     mj["patches"] = m.geometry.num_patches;
     mj["geometry_passes"] = m.geometry.top_bitplane - m.geometry.bottom_bitplane + 1;
     mj["normals"] = m.has_normals;
-    if (m.has_normals) mj["normal_level"] = m.normals.level;
+    if (m.has_normals) {
+      mj["normal_level"] = m.normals.level;
+      mj["normal_layers"] = m.normal_layers;
+      mj["normal_passes"] = m.normal_passes();
+      if (m.normal_layers == 2) mj["normal_base_passes"] = m.normal_base_passes;
+    }
     mj["hole_mask"] = !m.hole_mask.empty();
     add_view_frame(m.normalization, mj);
     models.push_back(std::move(mj));
@@ -139,10 +144,16 @@ void print_pack(const nlohmann::json& j) {
     const std::string frame = up == "none" ? "frame none"
                                            : "up " + up + ", front " + mj["front"].get<std::string>() +
                                                  ", camera side " + mj["camera_side"].get<std::string>();
+    std::string normals;
+    if (mj["normals"].get<bool>()) {
+      normals = ", normal maps";
+      if (mj["normal_layers"].get<int>() == 2)
+        normals += " in two layers (passes 0-" + std::to_string(mj["normal_base_passes"].get<int>() - 1) +
+                   " the first)";
+    }
     std::printf("  model %zu '%s': %d patches of (2^%d+1)^2 samples, %d geometry passes%s%s; %s\n", m,
                 codec::one_line(mj["name"].get<std::string>()).c_str(), mj["patches"].get<int>(),
-                mj["level"].get<int>(), mj["geometry_passes"].get<int>(),
-                mj["normals"].get<bool>() ? ", normal maps" : "",
+                mj["level"].get<int>(), mj["geometry_passes"].get<int>(), normals.c_str(),
                 mj["hole_mask"].get<bool>() ? ", hole mask" : "", frame.c_str());
   }
   std::printf("  chunks (file order): model kind pass bytes -> cumulative\n");

@@ -123,6 +123,7 @@ codec::PackWriteOptions pack_write_options(const ConvertOptions& options, std::s
   write.geometry.quantization_bits = options.quantization_bits;
   write.normal_codec.quantization_bits = options.normal_bits;
   write.normal_codec.headroom_bits = options.normal_headroom_bits;
+  write.normal_layers = options.normal_layers;
   write.geometry.frame_steps = options.frame_steps;
   write.geometry.tangential_shift = options.tangential_shift;
   write.geometry.orientation_weights = options.orientation_weights;

@@ -50,6 +50,7 @@ struct ConvertOptions {
   /// every streamed prefix of the normal maps closer, the whole stream a little smaller and a little less
   /// exact than 0's (10 bits lossless).
   int normal_headroom_bits = codec::PackWriteOptions{}.normal_codec.headroom_bits;
+  int normal_layers = codec::PackWriteOptions{}.normal_layers;  ///< 1 or 2 (codec::PackWriteOptions)
   /// Codec tools of the geometry stream (codec::GeometryCodecOptions: local frames of the finest
   /// frame_steps wavelet steps, their tangential components 2^tangential_shift coarser, orientation
   /// weights, the wavelet's lifting update). The defaults are the codec's; the switches exist for ablations

@@ -189,6 +189,18 @@ void stream_report(const PackModelInput& in, int bits, std::size_t base_bytes, i
   }
 }
 
+/// "a,b,c" → {a, b, c} (numbers as atof reads them).
+template <typename T>
+std::vector<T> comma_list(const char* text) {
+  std::vector<T> out;
+  for (const char* p = text; *p;) {
+    out.push_back(static_cast<T>(std::atof(p)));
+    while (*p && *p != ',') ++p;
+    if (*p == ',') ++p;
+  }
+  return out;
+}
+
 }  // namespace
 
 int normals_report(int argc, char** argv) {
@@ -196,18 +208,17 @@ int normals_report(int argc, char** argv) {
   int normal_mesh_steps = geomip::tools::ConvertOptions{}.normal_mesh_steps;
   std::size_t base_bytes = 20000;
   int headroom = 2;
+  bool streams = true;
+  std::vector<int> pack_layers = {1, 2};
+  std::vector<double> residual_steps = {PackWriteOptions{}.normal_residual_step};
+  for (int i = 3; i < argc; ++i)
+    if (std::strcmp(argv[i], "--packs-only") == 0) streams = false;
   for (int i = 3; i + 1 < argc; ++i) {
+    if (std::strcmp(argv[i], "--residual-step") == 0) residual_steps = comma_list<double>(argv[i + 1]);
     if (std::strcmp(argv[i], "--normal-mesh") == 0) normal_mesh_steps = std::atoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--base") == 0) base_bytes = static_cast<std::size_t>(std::atol(argv[i + 1]));
     if (std::strcmp(argv[i], "--headroom") == 0) headroom = std::atoi(argv[i + 1]);
-    if (std::strcmp(argv[i], "--bits") == 0) {
-      bits_list.clear();
-      for (const char* p = argv[i + 1]; *p;) {
-        bits_list.push_back(std::atoi(p));
-        while (*p && *p != ',') ++p;
-        if (*p == ',') ++p;
-      }
-    }
+    if (std::strcmp(argv[i], "--bits") == 0) bits_list = comma_list<int>(argv[i + 1]);
   }
   const geomip::tools::PreparedModels models = geomip::tools::prepare_models({argv[2]}, "", "codec_bench", true);
   geomip::tools::ConvertOptions options;
@@ -224,18 +235,30 @@ int normals_report(int argc, char** argv) {
     std::printf("the fully decoded geometry's own normals: mean %.3f°, p95 %.3f°, max %.2f°\n", st.mean, st.p95,
                 st.max);
   }
-  for (int bits : bits_list) stream_report(in[0], bits, base_bytes, headroom);
+  if (streams)
+    for (int bits : bits_list) stream_report(in[0], bits, base_bytes, headroom);
   std::printf("today's pack (xyz normal maps, %d bits), all models\n  %-14s %9s %9s   %7s %7s %7s\n",
               PackWriteOptions{}.normal_codec.quantization_bits, "decode", "bytes", "normal B", "mean°", "p95°",
               "max°");
-  const std::vector<std::uint8_t> pack = write_pack(in);
-  PackInfo info;
-  read_pack_info(pack, info);
-  row("full", pack.size(), info, in, pack);
-  for (std::size_t prefix : {25000, 50000, 100000, 200000, 400000}) {
-    char label[32];
-    std::snprintf(label, sizeof label, "prefix %zuK", prefix / 1000);
-    if (prefix < pack.size()) row(label, prefix, info, in, pack);
+  for (std::size_t si = 0; si < residual_steps.size(); ++si) {
+    const double step = residual_steps[si];
+    for (int layers : pack_layers) {
+      if (layers == 1 && si > 0) continue;  // the residual step does not apply
+      PackWriteOptions pw;
+      pw.normal_layers = layers;
+      pw.normal_residual_step = step;
+      const std::vector<std::uint8_t> pack = write_pack(in, pw);
+      PackInfo info;
+      read_pack_info(pack, info);
+      std::printf("normal layers %d%s\n", info.models[0].normal_layers,
+                  layers == 2 ? (" (layer 2 step x" + std::to_string(step) + ")").c_str() : "");
+      row("full", pack.size(), info, in, pack);
+      for (std::size_t prefix : {25000, 50000, 100000, 200000, 300000, 400000, 500000, 600000}) {
+        char label[32];
+        std::snprintf(label, sizeof label, "prefix %zuK", prefix / 1000);
+        if (prefix < pack.size()) row(label, prefix, info, in, pack);
+      }
+    }
   }
   return 0;
 }

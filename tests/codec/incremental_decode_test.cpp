@@ -130,6 +130,8 @@ TEST(IncrementalDecode, FixtureHasPerPatchStreams) {
   }
   EXPECT_GT(per_patch_bytes, pack.size() / 2);
   EXPECT_GT(info.models[1].geometry.num_patches, 2);
+  // Two-layer normal maps (format 11) on both models: layer 2's stream is split and resumed too.
+  for (const PackModelInfo& m : info.models) EXPECT_EQ(m.normal_layers, 2) << m.name;
 }
 
 TEST(IncrementalDecode, AnySplitEqualsOneShotDecode) {

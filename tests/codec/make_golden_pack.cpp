@@ -1,11 +1,11 @@
 // Writes a golden pack of pack_test's GoldenPackDecodes: two pillows (level 5, scales 1 and 2) with normal
 // maps. Run by hand once per pack format version, to a new file (old ones stay: old packs must keep
 // decoding):
-//   ./build/tests/make_golden_pack tests/data/golden-pillow-v10.gip   (format version 10)
+//   ./build/tests/make_golden_pack tests/data/golden-pillow-v11.gip   (format version 11)
 // (tests/data/golden-pillow.gip was written by format version 1, golden-pillow-v2.gip by version 2,
 // golden-pillow-v3.gip by version 3, golden-pillow-v4.gip by version 4, golden-pillow-v5.gip by version 5,
 // golden-pillow-v6.gip by version 6, golden-pillow-v7.gip by version 7, golden-pillow-v8.gip by version 8,
-// golden-pillow-v9.gip by version 9.)
+// golden-pillow-v9.gip by version 9, golden-pillow-v10.gip by version 10.)
 // With --per-patch, a small fuzzer seed instead: one level-4 pillow with normal maps whose joint part ends
 // after 64 bytes, so most of its bytes are per-patch streams (the other seeds are smaller than the default
 // 2 KB joint part) — tests/fuzz/seeds/pack/pillow-l4-per-patch.gip (format 3),
@@ -15,9 +15,9 @@
 // frames), pillow-l4-per-patch-v9.gip (format 9, the seam table as a layout code),
 // pillow-l4-per-patch-v10.gip (format 10, a bottom bit-plane: the geometry's last 4 planes not coded),
 // pillow-l4-per-patch-v10-normal-headroom.gip (format 10 as written since 2026-12-07: the normal maps' last
-// 4 planes not coded either):
+// 4 planes not coded either), pillow-l4-per-patch-v11.gip (format 11: two-layer normal maps):
 //   ./build/tests/make_golden_pack --per-patch  (one command, continued:)
-//     tests/fuzz/seeds/pack/pillow-l4-per-patch-v10-normal-headroom.gip
+//     tests/fuzz/seeds/pack/pillow-l4-per-patch-v11.gip
 // With --layout, a fuzzer seed whose seam tables are long: two models of 24 level-2 patches glued in random
 // side pairs (a quad layout's mirrored table, then a reference to it), normal maps on the first —
 // tests/fuzz/seeds/pack/layout-24-v7.gip (format 7), layout-24-v8.gip (format 8):

@@ -9,7 +9,8 @@
 
 namespace geomip::fuzz {
 
-/// Samples of the grids the manifest announces (geometry, normal maps, hole masks), saturating at 2^40.
+/// Samples of the grids the manifest announces (geometry, normal maps and their second layer, hole masks),
+/// saturating at 2^40.
 inline std::uint64_t announced_samples(const codec::PackInfo& info) {
   constexpr std::uint64_t kCap = std::uint64_t{1} << 40;
   auto grid = [](int level) {
@@ -22,6 +23,7 @@ inline std::uint64_t announced_samples(const codec::PackInfo& info) {
     const auto patches = static_cast<std::uint64_t>(m.geometry.num_patches < 0 ? 0 : m.geometry.num_patches);
     total += patches * grid(m.geometry.level);
     if (m.has_normals) total += patches * grid(m.normals.level);
+    if (m.normal_layers == 2) total += patches * grid(m.normal_residual.level);  // format 11's layer 2
     total += patches * grid(m.fine_hole_mask_level);
     if (total > kCap) return kCap;
   }

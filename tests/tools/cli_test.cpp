@@ -47,8 +47,10 @@ std::string with_manifest_crc(std::string bytes) {
     manifest_size |= static_cast<std::size_t>(b & 0x7f) << shift;
     if (!(b & 0x80)) break;
   }
-  const std::uint32_t crc =
-      codec::crc32({reinterpret_cast<const std::uint8_t*>(bytes.data()) + at + 4, manifest_size});
+  const std::uint16_t version = static_cast<std::uint16_t>(static_cast<unsigned char>(bytes[8]) |
+                                                           static_cast<unsigned char>(bytes[9]) << 8);
+  const std::uint32_t crc = codec::manifest_crc(
+      version, {reinterpret_cast<const std::uint8_t*>(bytes.data()) + at + 4, manifest_size});
   for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>((crc >> (8 * k)) & 0xff);
   return bytes;
 }
@@ -1179,7 +1181,18 @@ TEST_F(CliGimage, AdaptiveRemeshIsWatertightSharedAndCoarserForLargerEps) {
 namespace geomip {
 namespace {
 
-class CliPack : public CliGimage {};
+class CliPack : public CliGimage {
+ protected:
+  /// `geomip convert` of the spot mesh at level 4 with `switches` into DIR/name; the pack's bytes (the
+  /// conversion must succeed).
+  std::vector<std::uint8_t> spot_pack(const std::string& switches, const std::string& name) {
+    const std::string pack = dir_ + "/" + name;
+    const Outcome c = geomip("convert -q '" + spot_ + "' --level 4 " + switches + " -o '" + pack + "'");
+    EXPECT_EQ(c.exit_code, 0) << c.err;
+    const std::string bytes = slurp(pack);
+    return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
+  }
+};
 
 // convert → decode: the whole pack gives the level-N remesh's connectivity (watertight, consistently oriented);
 // a prefix gives a coarser but still watertight model; --json keys; outputs atomic.
@@ -1452,23 +1465,58 @@ TEST_F(CliPack, CodecSwitchesForAblations) {
                    "--headroom-bits");
 }
 
+// convert --normal-layers: 2 (the default, pack format 11) codes the normal maps in two layers, 1 as the xyz
+// map alone; both decode to unit normals on the same geometry; out-of-range values and --no-normals exit 2
+// with one line and nothing written.
+TEST_F(CliPack, NormalLayersChooseTheCoding) {
+  const std::vector<std::uint8_t> two = spot_pack("", "l2.gip"),
+                                  one = spot_pack("--normal-layers 1", "l1.gip");
+  codec::PackInfo a, b;
+  ASSERT_EQ(codec::read_pack_info(two, a), codec::Status::kOk);
+  ASSERT_EQ(codec::read_pack_info(one, b), codec::Status::kOk);
+  EXPECT_EQ(a.models.at(0).normal_layers, 2);
+  EXPECT_EQ(b.models.at(0).normal_layers, 1);
+  const codec::PackDecodeResult x = codec::decode_pack(two), y = codec::decode_pack(one);
+  ASSERT_EQ(x.status, codec::Status::kOk);
+  ASSERT_EQ(y.status, codec::Status::kOk);
+  ASSERT_EQ(x.models.at(0).normals.size(), y.models.at(0).normals.size());
+  double worst = 1;
+  for (std::size_t p = 0; p < x.models[0].normals.size(); ++p) {
+    EXPECT_EQ(x.models[0].geometry[p].values, y.models[0].geometry[p].values) << "patch " << p;
+    const std::vector<float>& u = x.models[0].normals[p].values;
+    const std::vector<float>& v = y.models[0].normals[p].values;
+    ASSERT_EQ(u.size(), v.size());
+    for (std::size_t k = 0; k + 2 < u.size(); k += 3) {
+      ASSERT_NEAR(std::sqrt(u[k] * u[k] + u[k + 1] * u[k + 1] + u[k + 2] * u[k + 2]), 1.0, 1e-5);
+      // Both codings end near the same map: within a degree of each other (measured: 0.36° at most).
+      worst = std::min(worst, double(u[k] * v[k] + u[k + 1] * v[k + 1] + u[k + 2] * v[k + 2]));
+      ASSERT_GT(u[k] * v[k] + u[k + 1] * v[k + 1] + u[k + 2] * v[k + 2], std::cos(M_PI / 180)) << k;
+    }
+  }
+  std::cout << "[ figures  ] largest angle between the codings "
+            << std::acos(std::min(worst, 1.0)) * 180 / M_PI << "°\n";
+  const std::string pack = dir_ + "/bad.gip";
+  expect_bad_input("convert -q '" + spot_ + "' --level 4 --normal-layers 3 -o '" + pack + "'",
+                   "--normal-layers");
+  expect_bad_input("convert -q '" + spot_ + "' --level 4 --no-normals --normal-layers 2 -o '" + pack + "'",
+                   "--normal-layers");
+}
+
 // convert --normal-bits B: the normal maps are quantized with B bits instead of 10 — a smaller pack whose
 // decoded normals lie within the coarser quantization of the 10-bit pack's (without headroom a full decode
 // is lossless up to the quantization, each component within half a step of the unit input, step = extent /
 // 2^B ≤ 2 / 2^B, and is then renormalized: a unit vector off by e ends at most |e| ≤ √3·step/2 (to first
 // order) from the input); the geometry is untouched; out-of-range values and --no-normals exit 2 with one
 // line and nothing written. --normal-headroom-bits H reaches the normal maps' codec header (the bottom
-// bit-plane; 4 by default), with the same refusals.
+// bit-plane; 4 by default), with the same refusals. (The xyz coding: --normal-layers 1; two layers are
+// checked by NormalLayersChooseTheCoding.)
 TEST_F(CliPack, NormalBitsQuantizeTheNormalMaps) {
   const auto convert = [&](const std::string& switches, const std::string& name) {
-    const std::string pack = dir_ + "/" + name;
-    const Outcome c = geomip("convert -q '" + spot_ + "' --level 4 " + switches + " -o '" + pack + "'");
-    EXPECT_EQ(c.exit_code, 0) << c.err;
-    const std::string bytes = slurp(pack);
-    return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
+    return spot_pack(switches, name);
   };
-  const std::vector<std::uint8_t> ten = convert("--normal-headroom-bits 0", "n10.gip"),
-                                  seven = convert("--normal-bits 7 --normal-headroom-bits 0", "n7.gip"),
+  const std::vector<std::uint8_t> ten = convert("--normal-headroom-bits 0 --normal-layers 1", "n10.gip"),
+                                  seven = convert(
+                                      "--normal-bits 7 --normal-headroom-bits 0 --normal-layers 1", "n7.gip"),
                                   room = convert("", "n10h.gip"),
                                   room2 = convert("--normal-headroom-bits 2", "n10h2.gip");
   const auto bottom_plane = [](const std::vector<std::uint8_t>& pack) {

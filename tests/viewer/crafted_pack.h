@@ -70,7 +70,7 @@ inline std::vector<std::uint8_t> craft_pack(std::span<const std::uint8_t> pack,
     put_u32(out, 12, static_cast<std::uint32_t>(manifest.size()));
   }
   out.resize(out.size() + 4);
-  put_u32(out, out.size() - 4, codec::crc32(manifest));
+  put_u32(out, out.size() - 4, codec::manifest_crc(info.version, manifest));
   out.insert(out.end(), manifest.begin(), manifest.end());
   out.insert(out.end(), pack.begin() + static_cast<std::ptrdiff_t>(info.manifest_end), pack.end());
   return out;

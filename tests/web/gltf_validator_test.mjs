@@ -76,7 +76,7 @@ try {
   add('bunny', { ...textured, matrix: true, draco: false });
   decode('bunny-draco', 'web-bunny-l4.gip', '--draco');
   add('bunny-draco', { ...textured, matrix: true, draco: true });
-  decode('bunny-prefix', 'web-bunny-l4.gip', '--bytes', '260');  // geometry passes only: the mesh's normals
+  decode('bunny-prefix', 'web-bunny-l4.gip', '--bytes', '320');  // geometry passes only: the mesh's normals
   add('bunny-prefix', { ...textured, matrix: true, draco: false });
   decode('bunny-level2', 'web-bunny-l4.gip', '--level', '2', '--quad-split', 'fixed', '--no-untangle');
   add('bunny-level2', { ...textured, matrix: true, draco: false });

@@ -97,8 +97,19 @@ struct FetchAccess {
   // libcurl's callbacks: no exception may unwind through libcurl (a C library).
   static std::size_t write(char* ptr, std::size_t size, std::size_t nmemb, void* user) noexcept {
     auto* t = static_cast<Transfer*>(user);
+    const std::size_t n = size * nmemb;
     try {
-      return write_body(t, ptr, size * nmemb);
+      const std::uint64_t rate = t->self->options_.limit_rate;
+      if (rate == 0) return write_body(t, ptr, n);
+      // --limit-rate: let the bytes in block by block at the rate (waiting here, cancellable)
+      for (std::size_t used = 0; used < n;) {
+        const std::size_t piece =
+            static_cast<std::size_t>(std::min<std::uint64_t>(n - used, rate_block(rate)));
+        if (!t->self->pace(piece)) return 0;
+        if (write_body(t, ptr + used, piece) != piece) return 0;  // cut or stopped: as for the whole write
+        used += piece;
+      }
+      return n;
     } catch (...) {
       try {  // std::bad_alloc is the only exception write_body can throw
         t->error = "out of memory while fetching";
@@ -203,6 +214,13 @@ void Fetcher::publish(std::uint64_t received) {
   if (on_progress_) on_progress_();
 }
 
+bool Fetcher::pace(std::uint64_t bytes) {
+  paced_ += bytes;
+  const double due = static_cast<double>(paced_) / static_cast<double>(options_.limit_rate);
+  return sleep_until(pace_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                       std::chrono::duration<double>(due)));
+}
+
 bool Fetcher::sleep_until(std::chrono::steady_clock::time_point until) const {
   for (;;) {
     if (cancelled()) return false;
@@ -262,9 +280,8 @@ void Fetcher::fetch_file() {
   start_buffer(std::move(plan), head);
   const std::uint64_t end = plan_.buffer;
   // Rate-limited reads come in blocks of ~1/10 s of the rate, so progress (and cancelling) stays smooth.
-  const std::uint64_t block =
-      options_.limit_rate > 0 ? std::clamp<std::uint64_t>(options_.limit_rate / 10, 256, 16 << 10) : 16 << 10;
-  const auto start = std::chrono::steady_clock::now();
+  const std::uint64_t block = options_.limit_rate > 0 ? rate_block(options_.limit_rate) : 16 << 10;
+  pace_start_ = std::chrono::steady_clock::now();
   std::uint64_t at = manifest_end;
   while (at < end) {
     if (cancelled()) return;
@@ -272,12 +289,7 @@ void Fetcher::fetch_file() {
     in.read(reinterpret_cast<char*>(buffer_.get() + at), static_cast<std::streamsize>(n));
     if (!in) return fail(source_ + ": read error after " + std::to_string(at) + " bytes");
     at += n;
-    if (options_.limit_rate > 0) {
-      const double due = static_cast<double>(at - manifest_end) / static_cast<double>(options_.limit_rate);
-      if (!sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                   std::chrono::duration<double>(due))))
-        return;
-    }
+    if (options_.limit_rate > 0 && !pace(n)) return;
     publish(at);
   }
   if (plan_.truncated())
@@ -303,10 +315,16 @@ void Fetcher::fetch_http() {
   curl_easy_setopt(curl, CURLOPT_MAXREDIRS, kMaxRedirects);
   curl_easy_setopt(curl, CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
   curl_easy_setopt(curl, CURLOPT_CONNECTTIMEOUT, 10L);
-  curl_easy_setopt(curl, CURLOPT_LOW_SPEED_LIMIT, 1L);  // a stalled connection is an error after 20 s
-  curl_easy_setopt(curl, CURLOPT_LOW_SPEED_TIME, 20L);
+  // --limit-rate is paced in the write callback (write()), not with CURLOPT_MAX_RECV_SPEED_LARGE: libcurl
+  // 7.88 evens out the rate per transfer after the fact, so a 64 KiB range request came in at once (the bunny
+  // at 10,000 bytes/s in 1 s), and at 1000 bytes/s the wait after ~36 KiB tripped the stall guard (exit 3).
+  std::uint64_t stall_seconds = std::max<std::uint64_t>(options_.stall_seconds, 1);
   if (options_.limit_rate > 0)
-    curl_easy_setopt(curl, CURLOPT_MAX_RECV_SPEED_LARGE, static_cast<curl_off_t>(options_.limit_rate));
+    stall_seconds = std::max(stall_seconds, 2 * rate_block(options_.limit_rate) / options_.limit_rate + 1);
+  pace_start_ = std::chrono::steady_clock::now();
+  curl_easy_setopt(curl, CURLOPT_LOW_SPEED_LIMIT, 1L);  // a stalled connection is an error
+  curl_easy_setopt(curl, CURLOPT_LOW_SPEED_TIME,
+                   static_cast<long>(std::min<std::uint64_t>(stall_seconds, 1 << 30)));
 
   // Runs one transfer on the multi handle, polling at most 50 ms at a time so cancel_ is seen promptly
   // (also while libcurl waits out the rate limit or a stalled server).

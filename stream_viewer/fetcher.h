@@ -11,6 +11,7 @@
 // kMaxRedirects, http/https only); a server that ignores Range is read with the one GET it answered.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -27,9 +28,20 @@ namespace geomip::viewer {
 
 inline constexpr long kMaxRedirects = 5;
 
+/// The block a --limit-rate of `rate` bytes/s lets in at once: ~1/10 s of it, 256 B to 16 KiB.
+inline std::uint64_t rate_block(std::uint64_t rate) {
+  return std::clamp<std::uint64_t>(rate / 10, 256, 16 << 10);
+}
+
 struct FetchOptions {
-  std::uint64_t limit_rate = 0;      ///< bytes per second (CURLOPT_MAX_RECV_SPEED_LARGE; files: sleeps); 0 = none
+  /// Bytes per second, 0 = none: the bytes are let in at this pace in blocks of ~1/10 s of it (rate_block),
+  /// as from a slow network, for files and HTTP alike (libcurl's own limit let a whole 64 KiB request in at
+  /// once).
+  std::uint64_t limit_rate = 0;
   std::uint64_t request_bytes = 64 << 10;  ///< chunks are grouped into range requests of about this size
+  /// HTTP: a connection that delivers nothing for this long is an error ("Operation too slow"); under a
+  /// limit_rate at least two of its blocks' time, so a slow limit never trips it.
+  std::uint64_t stall_seconds = 20;
 };
 
 class Fetcher {
@@ -65,6 +77,8 @@ class Fetcher {
   /// Reserves plan.buffer bytes (not zero-filled), copies `head` in and publishes the manifest.
   void start_buffer(FetchPlan plan, const std::vector<std::uint8_t>& head);
   void publish(std::uint64_t received);
+  /// --limit-rate: waits until `bytes` more are due since pace_start_ (false if cancelled meanwhile).
+  bool pace(std::uint64_t bytes);
 
   std::string source_;
   FetchOptions options_;
@@ -75,6 +89,8 @@ class Fetcher {
   std::atomic<bool> finished_{false}, cancel_{false};
   mutable std::mutex error_mutex_;
   std::string error_;
+  std::chrono::steady_clock::time_point pace_start_;  ///< fetch thread only
+  std::uint64_t paced_ = 0;                           ///< bytes let in since pace_start_ (fetch thread only)
   std::thread thread_;
 
   friend struct FetchAccess;

@@ -46,6 +46,7 @@ struct Options {
   bool bench = false, checker = false, wireframe = false;
   bool decode_each_prefix = false;
   std::uint64_t limit_rate = 0;
+  std::uint64_t stall_timeout = 20;
   double timeout = 120;
   float yaw = 0.6f, pitch = 0.35f, distance = 3.2f;
   bool distance_given = false;  // --distance: no automatic framing
@@ -205,7 +206,8 @@ int run(const Options& opt) {
   {
     Renderer renderer;
     Offscreen target(opt.width, opt.height);
-    PackSource source(opt.source, FetchOptions{.limit_rate = opt.limit_rate},
+    PackSource source(opt.source,
+                      FetchOptions{.limit_rate = opt.limit_rate, .stall_seconds = opt.stall_timeout},
                       morph::DecodeSettings{.bands = wavelet ? opt.bands : 1,
                                             .align = !opt.no_align,
                                             .incremental = !opt.decode_each_prefix,
@@ -493,6 +495,10 @@ int main(int argc, char** argv) {
   app.add_option("--limit-rate", opt.limit_rate,
                  "download (or read) at most this many bytes per second (default 0: no limit)")
       ->check(non_negative("bytes per second"));
+  app.add_option("--stall-timeout", opt.stall_timeout,
+                 "HTTP: a connection that sends nothing for this many seconds is an error (default 20; under "
+                 "--limit-rate at least two of the limit's waits)")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{86400}));
   app.add_option("--timeout", opt.timeout, "headless: seconds to wait for the pack")->check(non_negative("seconds"));
   app.add_option(
          "--up", opt.up,

@@ -56,29 +56,26 @@ class PatchFrames {
       n_ = 0;
       return;
     }
+    geometry_ = &geometry;
     du_.resize(static_cast<std::size_t>(n_) * n_);
-    dv_.resize(du_.size());
-    const auto at = [&](int i, int j) {
-      const float* p = geometry.values.data() + 3 * (static_cast<std::size_t>(j) * n_ + i);
-      return Vec{p[0], p[1], p[2]};
-    };
     for (int j = 0; j < n_; ++j)
-      for (int i = 0; i < n_; ++i) {
+      for (int i = 0; i < n_; ++i)
         du_[static_cast<std::size_t>(j) * n_ + i] =
-            at(std::min(i + 1, n_ - 1), j) - at(std::max(i - 1, 0), j);
-        dv_[static_cast<std::size_t>(j) * n_ + i] =
-            at(i, std::min(j + 1, n_ - 1)) - at(i, std::max(j - 1, 0));
-      }
+            sample(std::min(i + 1, n_ - 1), j) - sample(std::max(i - 1, 0), j);
     shift_ = level_ - geometry.level;
   }
 
   /// The frame at texel (ti, tj); `axis` (or null): its normal instead of the grid's (t from ∂u as ever).
   Frame at(int ti, int tj, const float* axis = nullptr) const {
     Frame f;
-    const Vec du = derivative(du_, ti, tj);  // zero without a grid: t then comes from the fallback axis
+    const Vec du =
+        derivative(ti, tj, [&](int i, int j) { return du_[static_cast<std::size_t>(j) * n_ + i]; });
     Vec g;
     if (!axis || !normalize(g = Vec{axis[0], axis[1], axis[2]})) {
-      const Vec dv = derivative(dv_, ti, tj);  // the grid's own normal, only where there is no axis
+      // the grid's own normal, only where there is no axis: ∂v computed here (with axes it is rarely needed)
+      const Vec dv = derivative(ti, tj, [&](int i, int j) {
+        return sample(i, std::min(j + 1, n_ - 1)) - sample(i, std::max(j - 1, 0));
+      });
       g = along_ ? cross(du, dv) : cross(dv, du);
       if (!normalize(g)) return f;
     }
@@ -93,24 +90,29 @@ class PatchFrames {
   }
 
  private:
-  /// ∂u or ∂v (`d`) at texel (ti, tj): the grid's value there, or interpolated bilinearly between grid
-  /// samples when the texels are finer; zero without a grid.
-  Vec derivative(const std::vector<Vec>& d, int ti, int tj) const {
+  Vec sample(int i, int j) const {
+    const float* p = geometry_->values.data() + 3 * (static_cast<std::size_t>(j) * n_ + i);
+    return Vec{p[0], p[1], p[2]};
+  }
+
+  /// ∂u or ∂v (`d(i, j)` at grid samples) at texel (ti, tj): the grid's value there, or interpolated
+  /// bilinearly between grid samples when the texels are finer; zero without a grid.
+  template <typename D>
+  Vec derivative(int ti, int tj, const D& d) const {
     if (n_ == 0) return {};
-    if (shift_ <= 0)
-      return d[static_cast<std::size_t>(tj << -shift_) * n_ + static_cast<std::size_t>(ti << -shift_)];
+    if (shift_ <= 0) return d(ti << -shift_, tj << -shift_);
     const int mask = (1 << shift_) - 1;
     const int i0 = ti >> shift_, j0 = tj >> shift_;
     const int i1 = std::min(i0 + 1, n_ - 1), j1 = std::min(j0 + 1, n_ - 1);
     const double fi = static_cast<double>(ti & mask) / static_cast<double>(1 << shift_);
     const double fj = static_cast<double>(tj & mask) / static_cast<double>(1 << shift_);
-    const auto k = [&](int i, int j) { return static_cast<std::size_t>(j) * n_ + i; };
-    return lerp(lerp(d[k(i0, j0)], d[k(i1, j0)], fi), lerp(d[k(i0, j1)], d[k(i1, j1)], fi), fj);
+    return lerp(lerp(d(i0, j0), d(i1, j0), fi), lerp(d(i0, j1), d(i1, j1), fi), fj);
   }
 
   int level_ = 0, n_ = 0, shift_ = 0;
   bool along_ = true;
-  std::vector<Vec> du_, dv_;
+  const Grid3* geometry_ = nullptr;  ///< ∂v is computed from it where needed (held for the frames' life)
+  std::vector<Vec> du_;  ///< ∂u at every grid sample (central differences, one-sided at the border)
 };
 
 double sign(double v) {

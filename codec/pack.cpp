@@ -724,24 +724,33 @@ int PackModelInfo::normal_passes() const {
   return normal_layers == 2 ? normal_base_passes + passes_of(normal_residual) : passes_of(normals);
 }
 
-std::uint32_t manifest_crc(std::uint16_t version, std::span<const std::uint8_t> manifest) {
-  if (version < 11) return crc32(manifest);
-  const std::uint8_t v[2] = {static_cast<std::uint8_t>(version & 0xff),
-                             static_cast<std::uint8_t>(version >> 8)};
-  std::vector<std::uint8_t> both(v, v + 2);
-  both.insert(both.end(), manifest.begin(), manifest.end());
-  return crc32(both);
-}
+namespace {
 
-std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
-  uLong crc = ::crc32(0L, Z_NULL, 0);
+/// zlib's running CRC-32 over `bytes` (in pieces of at most 1 GiB: zlib takes a uInt length).
+uLong crc32_update(uLong crc, std::span<const std::uint8_t> bytes) {
   std::size_t at = 0;
   while (at < bytes.size()) {
     const std::size_t n = std::min<std::size_t>(bytes.size() - at, 1u << 30);
     crc = ::crc32(crc, bytes.data() + at, static_cast<uInt>(n));
     at += n;
   }
-  return static_cast<std::uint32_t>(crc);
+  return crc;
+}
+
+}  // namespace
+
+std::uint32_t manifest_crc(std::uint16_t version, std::span<const std::uint8_t> manifest) {
+  uLong crc = ::crc32(0L, Z_NULL, 0);
+  if (version >= 11) {  // from format 11 the version bytes (little-endian) come first
+    const std::uint8_t v[2] = {static_cast<std::uint8_t>(version & 0xff),
+                               static_cast<std::uint8_t>(version >> 8)};
+    crc = crc32_update(crc, v);
+  }
+  return static_cast<std::uint32_t>(crc32_update(crc, manifest));
+}
+
+std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
+  return static_cast<std::uint32_t>(crc32_update(::crc32(0L, Z_NULL, 0), bytes));
 }
 
 namespace {

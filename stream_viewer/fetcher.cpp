@@ -327,7 +327,7 @@ void Fetcher::fetch_http() {
                    static_cast<long>(std::min<std::uint64_t>(stall_seconds, 1 << 30)));
 
   // Runs one transfer on the multi handle, polling at most 50 ms at a time so cancel_ is seen promptly
-  // (also while libcurl waits out the rate limit or a stalled server).
+  // (also on a stalled server; --limit-rate waits in write() check it themselves).
   auto perform = [&]() -> CURLcode {
     curl_multi_add_handle(multi.get(), curl);
     CURLcode result = CURLE_ABORTED_BY_CALLBACK;

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,9 +47,10 @@ TriMesh compact(const TriMesh& mesh, const std::vector<unsigned int>& indices) {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 
-// CGAL edge_collapse with the Lindstrom–Turk defaults on the triangles `indices` of `mesh`.
-TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& indices,
-                       std::size_t target_faces) {
+// The triangles `indices` of `mesh` as a CGAL surface mesh; empty (with `why` set) when they do not form an
+// oriented 2-manifold, which CGAL's half-edge structure (and so its edge collapse) needs.
+std::optional<SurfaceMesh> surface_mesh(const TriMesh& mesh, const std::vector<unsigned int>& indices,
+                                        std::string& why) {
   SurfaceMesh sm;
   std::vector<SurfaceMesh::Vertex_index> vertex(mesh.positions.size());
   std::vector<bool> used(mesh.positions.size(), false);
@@ -60,9 +62,37 @@ TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& ind
     }
   for (std::size_t i = 0; i + 2 < indices.size(); i += 3)
     if (sm.add_face(vertex[indices[i]], vertex[indices[i + 1]], vertex[indices[i + 2]]) ==
-        SurfaceMesh::null_face())
-      throw InvalidInput("decimate_mesh: Lindstrom-Turk decimation needs an oriented 2-manifold; triangle " +
-                         std::to_string(i / 3) + " makes it non-manifold or flips the orientation");
+        SurfaceMesh::null_face()) {
+      why = "triangle " + std::to_string(i / 3) + " makes it non-manifold or flips the orientation";
+      return std::nullopt;
+    }
+  return sm;
+}
+
+// The triangles of `mesh` without those with a repeated corner (what every decimation works on).
+std::vector<unsigned int> proper_triangles(const TriMesh& mesh) {
+  const auto nv = mesh.positions.size();
+  std::vector<unsigned int> indices;
+  indices.reserve(3 * mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    for (int i : t)
+      if (i < 0 || static_cast<std::size_t>(i) >= nv)
+        throw InvalidInput("decimate_mesh: triangle index out of range");
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    indices.insert(indices.end(),
+                   {static_cast<unsigned>(t[0]), static_cast<unsigned>(t[1]), static_cast<unsigned>(t[2])});
+  }
+  return indices;
+}
+
+// CGAL edge_collapse with the Lindstrom–Turk defaults on the triangles `indices` of `mesh`.
+TriMesh lindstrom_turk(const TriMesh& mesh, const std::vector<unsigned int>& indices,
+                       std::size_t target_faces) {
+  std::string why;
+  std::optional<SurfaceMesh> built = surface_mesh(mesh, indices, why);
+  if (!built)
+    throw InvalidInput("decimate_mesh: Lindstrom-Turk decimation needs an oriented 2-manifold; " + why);
+  SurfaceMesh& sm = *built;
   // Count_stop_predicate stops on the edge count: E = (3F + B)/2 with B the boundary edges, which shrink as
   // the boundary is simplified too; so stop on the current B, then continue while the faces overshoot.
   for (int pass = 0; pass < 4; ++pass) {
@@ -106,15 +136,7 @@ DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces,
     if (!mesh.positions[v].allFinite()) throw InvalidInput(fn + "non-finite vertex coordinate");
     for (int k = 0; k < 3; ++k) xyz[3 * v + k] = static_cast<float>(mesh.positions[v][k]);
   }
-  std::vector<unsigned int> indices;
-  indices.reserve(3 * mesh.triangles.size());
-  for (const auto& t : mesh.triangles) {
-    for (int i : t)
-      if (i < 0 || static_cast<std::size_t>(i) >= nv) throw InvalidInput(fn + "triangle index out of range");
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
-    indices.insert(indices.end(),
-                   {static_cast<unsigned>(t[0]), static_cast<unsigned>(t[1]), static_cast<unsigned>(t[2])});
-  }
+  const std::vector<unsigned int> indices = proper_triangles(mesh);
   DecimationResult result;
   const std::size_t faces = indices.size() / 3;
   if (target_faces >= faces) {
@@ -154,6 +176,13 @@ DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces,
   }
   result.mesh = compact(mesh, out);
   return result;
+}
+
+std::optional<std::string> lindstrom_turk_refusal(const TriMesh& mesh) {
+  if (mesh.triangles.empty()) return "the mesh has no triangles";
+  std::string why;
+  if (!surface_mesh(mesh, proper_triangles(mesh), why)) return "not an oriented 2-manifold: " + why;
+  return std::nullopt;
 }
 
 }  // namespace geomip

@@ -18,6 +18,8 @@
 #include "mesh/mesh.h"
 
 #include <cstddef>
+#include <optional>
+#include <string>
 
 namespace geomip {
 
@@ -57,5 +59,10 @@ struct DecimationResult {
 /// \throw InvalidInput naming `decimate_mesh` when a precondition fails.
 DecimationResult decimate_mesh(const TriMesh& mesh, std::size_t target_faces,
                                const DecimationOptions& options = {});
+
+/// Why decimate_mesh() with kLindstromTurk would refuse `mesh` (one line: no triangles, or the first triangle
+/// that makes it non-manifold or flips its orientation), or nothing when it takes it. Linear in the mesh.
+/// \throw InvalidInput for a triangle index out of range.
+std::optional<std::string> lindstrom_turk_refusal(const TriMesh& mesh);
 
 }  // namespace geomip

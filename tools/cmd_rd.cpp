@@ -1,6 +1,7 @@
-// geomip rd MESH -o DIR [--json] [--quick] [--lindstrom-turk]: rate–distortion baselines of MESH — Draco on
-// the full mesh over quantization bits, Draco on QEM-decimated copies (faces × bits; meshoptimizer's
-// simplifier, and with --lindstrom-turk also CGAL's) and their upper envelopes, meshoptimizer's codec — each
+// geomip rd MESH -o DIR [--json] [--quick] [--no-lindstrom-turk]: rate–distortion baselines of MESH — Draco
+// on the full mesh over quantization bits, Draco on QEM-decimated copies (faces × bits; meshoptimizer's
+// simplifier, and CGAL's Lindstrom–Turk where the mesh is an oriented 2-manifold) and their upper envelopes,
+// meshoptimizer's codec — each
 // decoded mesh measured against MESH with the Metro-style surface distance — and geomip: MESH converted to a
 // geometry-only pack (DIR/<stem>.gip), measured at many byte prefixes. Writes DIR/rd.csv (every point) and
 // DIR/rd.svg (the plot).
@@ -54,7 +55,11 @@ struct RdArgs {
   bool json = false;
   bool quiet = false;  // -q: no progress bar, no table
   bool quick = false;
-  bool lindstrom_turk = false;  // also the draco_lt series (CGAL Lindstrom-Turk decimation) and its envelope
+  // The draco_lt series (CGAL Lindstrom–Turk decimation) and its envelope, the strongest baseline: by default
+  // whenever the mesh is an oriented 2-manifold (else a note, and none); --lindstrom-turk: required (a mesh
+  // it cannot take is an error); --no-lindstrom-turk: never.
+  bool lindstrom_turk = false;
+  bool no_lindstrom_turk = false;
   std::size_t samples = 0;  // face samples per surface for the evaluation; 0 = surface_distance's default
   unsigned threads = 0;     // 0 = hardware_concurrency
   int level = 8;  // geomip: the pack's geometry image level (without --level: default_grid_level(patches))
@@ -347,8 +352,21 @@ int run_rd(const RdArgs& args) {
       args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
   const Sweep sweep = make_sweep(args.quick);
 
+  bool lindstrom_turk = !args.no_lindstrom_turk;
+  if (lindstrom_turk) {
+    if (const std::optional<std::string> why = lindstrom_turk_refusal(*original)) {
+      if (args.lindstrom_turk)
+        throw InvalidInput("--lindstrom-turk needs an oriented 2-manifold, and " + args.mesh + " is " + *why +
+                           " (`geomip repair` makes one)");
+      lindstrom_turk = false;
+      std::fprintf(stderr,
+                   "note: no Lindstrom-Turk baseline (draco_lt, draco_lt_envelope), the strongest one: %s is "
+                   "%s (`geomip repair` makes an oriented 2-manifold; --no-lindstrom-turk drops this note)\n",
+                   args.mesh.c_str(), why->c_str());
+    }
+  }
   ProgressBar progress("rd", !args.json && !args.quiet);
-  std::vector<Series> plan = plan_series(original, sweep, args.lindstrom_turk, threads, progress);
+  std::vector<Series> plan = plan_series(original, sweep, lindstrom_turk, threads, progress);
   std::vector<std::uint8_t> pack;
   std::optional<SearchResult> searched;
   RelayoutChoice moved;  // the layout chosen for a shape two squares stretch
@@ -430,7 +448,7 @@ int run_rd(const RdArgs& args) {
   files.commit();
 
   // geomip against the Draco envelopes at the sizes issues 5 and 14 name: draco_envelope (meshoptimizer's
-  // decimation) always, draco_lt_envelope (Lindstrom–Turk, the stronger baseline) with --lindstrom-turk.
+  // decimation) always, draco_lt_envelope (Lindstrom–Turk, the stronger baseline) when it was built.
   // geomip is measured at exactly these sizes (prefix_sizes; --quick: only the rows it measured), so its
   // staircase is its prefix there (the whole pack above the pack's size); the envelopes are interpolated in
   // log(bytes) between their points, as scripts/prefix-vs-envelope and the README read them (a staircase
@@ -547,7 +565,9 @@ CommandRunner add_rd_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "rd",
       "Rate-distortion baselines of MESH: Draco (cl 10) at Q = 6..16 on the full mesh, Draco Q = 7..13 on "
-      "QEM-decimated copies (500..40k faces) and their upper envelope, meshoptimizer's codec; PSNR and "
+      "copies decimated to 500..40k faces by meshoptimizer (draco_qem) and, when MESH is an oriented "
+      "2-manifold, by CGAL's Lindstrom-Turk edge collapse (draco_lt), their upper envelopes, meshoptimizer's "
+      "codec; PSNR and "
       "Hausdorff of each decoded mesh vs MESH (as `geomip eval`), and geomip's own geometry-only pack at "
       "many prefixes. Writes DIR/rd.csv, DIR/rd.svg and the pack DIR/<stem>.gip");
   cmd->add_option("mesh", args->mesh, "Original mesh (.obj .ply .off .stl), used as it is (not repaired)")
@@ -557,10 +577,14 @@ CommandRunner add_rd_command(CLI::App& app) {
   cmd->add_flag("-q,--quiet", args->quiet,
                 "No progress bar and no table (rd.csv and rd.svg are still written)");
   cmd->add_flag("--quick", args->quick, "A few points only, coarser evaluation (for tests)");
-  cmd->add_flag(
+  CLI::Option* lt = cmd->add_flag(
       "--lindstrom-turk", args->lindstrom_turk,
-      "Also decimate with CGAL's Lindstrom-Turk edge collapse (series draco_lt, same faces x Q) and "
-      "write draco_lt_envelope over draco, draco_qem and draco_lt (needs a manifold MESH)");
+      "Require the Lindstrom-Turk baseline: an error when MESH is not an oriented 2-manifold (by default it "
+      "is built whenever MESH is one: CGAL's edge collapse, series draco_lt, same faces x Q, and "
+      "draco_lt_envelope over draco, draco_qem and draco_lt, the strongest baseline; otherwise a note)");
+  cmd->add_flag("--no-lindstrom-turk", args->no_lindstrom_turk,
+                "No Lindstrom-Turk baseline (draco_envelope is then the strongest one in the table)")
+      ->excludes(lt);
   // Bounded as `geomip eval --samples`: each sample is a closest-point query and 56 bytes.
   cmd->add_option("--samples", args->samples,
                   "Face samples per surface for the evaluation, in [1, 10^8] (default: as `geomip eval`; "

@@ -2,7 +2,7 @@
 # positions are (u, v, tiny z) and (octahedral normal, tiny z), to measure what Draco would spend on a
 # normal layer sent as the source (uv mesh + vertex normals) instead of texels. Input: `geomip param
 # ../shared/meshes/bunny.obj -o /tmp/bp`; then `geomip rd -q --quick --no-geomip --no-lindstrom-turk
-# /tmp/nm/uv.obj -o rd_uv` (and nrm.obj) and read the draco rows of rd.csv. See docs/codec-v3.md, "Normal maps
+# /tmp/nm/uv.obj -o rd_uv` (and nrm.obj; create /tmp/nm first) and read the draco rows of rd.csv. See docs/codec-v3.md, "Normal maps
 # from the parameterized mesh".
 import math
 V=[];VT=[];F=[]

@@ -128,7 +128,22 @@ void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const R
     db_lo = std::min(db_lo, p.psnr_db);
     db_hi = std::max(db_hi, p.psnr_db);
   }
-  if (names.empty()) throw InvalidInput("write_rd_svg: no point with bytes > 0 and a finite PSNR");
+  if (names.empty()) {
+    // Nothing to plot (e.g. a flat mesh: every coded copy lies on its surface, PSNR infinite): a valid SVG
+    // that says so, so that a run's table and plot are still written as one set.
+    const double W = options.width, H = options.height;
+    out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+        << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
+        << "\" viewBox=\"0 0 " << W << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+        << "<rect x=\"0\" y=\"0\" width=\"" << W << "\" height=\"" << H << "\" fill=\"white\"/>\n"
+        << "<text x=\"" << W / 2 << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">"
+        << xml_escape(options.title) << "</text>\n"
+        << "<text x=\"" << W / 2 << "\" y=\"" << H / 2
+        << "\" text-anchor=\"middle\">nothing to plot: no point has bytes &gt; 0 and a finite PSNR (every "
+           "decoded mesh lies on the original's surface)</text>\n"
+        << "</svg>\n";
+    return;
+  }
 
   // Axes: x in whole decades (log10), y in round steps.
   const double x0 = std::floor(std::log10(kb_lo)), x1 = std::max(x0 + 1, std::ceil(std::log10(kb_hi)));

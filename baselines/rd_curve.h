@@ -61,8 +61,8 @@ struct RdPlotOptions {
 /// Writes a self-contained SVG plot of `points` (x = size in KB = bytes/1000 on a log axis, y = PSNR in dB):
 /// one series per method in order of first appearance, each with its own color, a legend, ticks at 1-2-5
 /// steps per decade on x and round dB steps on y, and axis labels. Points with non-finite PSNR or zero bytes
-/// are left out of the plot.
-/// \throw InvalidInput when no point is plottable.
+/// are left out of the plot; when none is left (a flat mesh: every decoded copy lies on its surface), the SVG
+/// says so in place of the plot.
 void write_rd_svg(std::ostream& out, const std::vector<RdPoint>& points, const RdPlotOptions& options = {});
 
 }  // namespace geomip

@@ -198,8 +198,17 @@ TEST(RdFiles, SvgIsBalancedAndHasEverySeries) {
   for (std::size_t i = 0; (i = svg.find("<circle", i)) != std::string::npos; ++i) ++circles;
   EXPECT_EQ(circles, 14u + 4u);
 
+  // Nothing plottable (zero bytes, or every PSNR infinite as on a flat mesh): a valid SVG that says so, no
+  // series, no "inf" or "nan" in it.
   std::ostringstream empty;
-  EXPECT_THROW(write_rd_svg(empty, {point("x", 0, 10)}), InvalidInput);
+  write_rd_svg(empty, {point("x", 0, 10), point("y", 100, INFINITY)});
+  const std::string nothing = empty.str();
+  EXPECT_EQ(nothing.rfind("<?xml", 0), 0u);
+  EXPECT_NE(nothing.find("nothing to plot"), std::string::npos) << nothing;
+  EXPECT_EQ(nothing.find("data-method"), std::string::npos) << nothing;
+  EXPECT_EQ(nothing.find("inf"), std::string::npos) << nothing;
+  EXPECT_EQ(nothing.find("nan"), std::string::npos) << nothing;
+  EXPECT_NE(nothing.find("</svg>"), std::string::npos);
 }
 
 }  // namespace

@@ -304,6 +304,31 @@ TEST_F(RdCli, APackThatCannotBeWrittenLeavesNoTableOrPlot) {
   EXPECT_EQ(names, (std::set<std::string>{"sphere.gip"}));
 }
 
+// A flat mesh: every coded copy lies on its surface (PSNR infinite, nothing to plot). rd failed in the plot
+// after all its work and wrote nothing; now the table and a plot that says so are written.
+TEST_F(RdCli, FlatMeshStillWritesItsTableAndPlot) {
+  const std::string mesh = dir_ + "/flat.obj";
+  {
+    TriMesh flat;
+    const int n = 12;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) flat.positions.emplace_back(i / double(n - 1), j / double(n - 1), 0.0);
+    for (int j = 0; j + 1 < n; ++j)
+      for (int i = 0; i + 1 < n; ++i) {
+        const int a = j * n + i;
+        flat.triangles.push_back({a, a + 1, a + n + 1});
+        flat.triangles.push_back({a, a + n + 1, a + n});
+      }
+    std::ofstream out(mesh);
+    write_mesh(flat, out, MeshFormat::kObj);
+  }
+  const std::string out_dir = dir_ + "/rd";
+  std::string err;
+  ASSERT_EQ(geomip("rd -q --quick --no-geomip '" + mesh + "' -o '" + out_dir + "'", err), 0) << err;
+  EXPECT_NE(slurp(fs::path(out_dir) / "rd.csv").find("draco,"), std::string::npos);
+  EXPECT_NE(slurp(fs::path(out_dir) / "rd.svg").find("nothing to plot"), std::string::npos);
+}
+
 TEST_F(RdCli, MissingMeshFailsCleanly) {
   const std::string out_dir = dir_ + "/rd";
   std::string err;
